@@ -1,0 +1,115 @@
+//! Command definitions and dispatch. Each subcommand lives in its own file and only turns
+//! arguments into library calls and library results into text, JSON and exit codes.
+//!
+//! Exit codes: 0 success; 1 the operation ran and failed (e.g. `validate` found problems);
+//! 2 bad usage or unreadable/unparseable input.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Exit code for success.
+pub const EXIT_OK: u8 = 0;
+/// Exit code for a failed operation.
+pub const EXIT_FAILURE: u8 = 1;
+/// Exit code for bad usage or bad input.
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "fbakit",
+    version,
+    about = "MPEG-4 Face and Body Animation toolkit: FAP streams, feature points, FAPUs",
+    long_about = "fbakit reads, checks and writes MPEG-4 facial animation data: ASCII FAP \
+                  streams, facial feature points and their FAP units (FAPU).\n\n\
+                  Exit codes: 0 ok, 1 the operation failed (e.g. validation found problems), \
+                  2 bad usage or unreadable input."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Print the MPEG-4 FAP table (number, name, FAPU, direction, feature point).
+    #[command(after_help = "Example:\n  fbakit spec faps --json")]
+    Spec(SpecArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct SpecArgs {
+    /// Which table: `faps` or `feature-points`.
+    #[arg(value_parser = ["faps", "feature-points"], default_value = "faps")]
+    pub table: String,
+    /// Print JSON instead of a text table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs a parsed command line and maps the outcome to an exit code.
+pub fn run(cli: Cli) -> ExitCode {
+    let result = match cli.command {
+        Command::Spec(args) => spec(args),
+    };
+    match result {
+        Ok(code) => ExitCode::from(code),
+        Err(e) => report_error(&e),
+    }
+}
+
+/// Prints a library error to stderr and picks its exit code.
+pub fn report_error(e: &fbakit::error::Error) -> ExitCode {
+    eprintln!("error: {e}");
+    ExitCode::from(if e.is_input_error() {
+        EXIT_BAD_INPUT
+    } else {
+        EXIT_FAILURE
+    })
+}
+
+/// Prints any serialisable value as pretty JSON on stdout.
+pub fn print_json<T: serde::Serialize>(value: &T) -> fbakit::error::Result<()> {
+    let text = serde_json::to_string_pretty(value)
+        .map_err(|e| fbakit::error::Error::Invalid(format!("cannot encode JSON: {e}")))?;
+    println!("{text}");
+    Ok(())
+}
+
+fn spec(args: SpecArgs) -> fbakit::error::Result<u8> {
+    use fbakit::spec::{FapId, FeaturePointId};
+    if args.table == "faps" {
+        let rows: Vec<_> = FapId::all().map(|id| id.info()).collect();
+        if args.json {
+            print_json(&rows)?;
+        } else {
+            println!("{:>3}  {:<22} {:<6} {:<3} {:<15} fp", "fap", "name", "fapu", "dir", "positive");
+            for r in rows {
+                let fps: Vec<String> = r.feature_points.iter().map(|p| p.to_string()).collect();
+                println!(
+                    "{:>3}  {:<22} {:<6} {:<3} {:<15} {}",
+                    r.number,
+                    r.name,
+                    r.fapu.map_or("-", |f| f.abbreviation()),
+                    match r.directionality {
+                        Some(fbakit::spec::Directionality::Unidirectional) => "U",
+                        Some(fbakit::spec::Directionality::Bidirectional) => "B",
+                        None => "-",
+                    },
+                    r.positive_motion.map_or("-", |m| m.word()),
+                    fps.join(" ")
+                );
+            }
+        }
+    } else {
+        let rows: Vec<_> = FeaturePointId::all().map(|id| id.info()).collect();
+        if args.json {
+            print_json(&rows)?;
+        } else {
+            for r in rows {
+                println!("{:<6} {:?}  {}", r.id.to_string(), r.side, r.description);
+            }
+        }
+    }
+    Ok(EXIT_OK)
+}

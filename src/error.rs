@@ -1,0 +1,242 @@
+//! Errors and diagnostics shared by every reader and writer.
+//!
+//! A [`ParseError`] always names the file, the 1-based line and column, and what was expected,
+//! so a user can jump straight to the problem. Lenient readers collect [`Diagnostic`]s (warnings)
+//! with the same location information instead of failing.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+/// A place in a text input: file name (or `<input>` for in-memory text), 1-based line and column.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Location {
+    /// File the text came from (`<input>` when parsed from memory).
+    pub file: PathBuf,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column, counted in characters.
+    pub column: usize,
+}
+
+impl Location {
+    /// Location of byte `offset` inside `text` (clamped to the text's length; an offset inside a
+    /// multi-byte character counts as that character).
+    pub fn from_offset(file: &Path, text: &str, offset: usize) -> Location {
+        let offset = offset.min(text.len());
+        let before = &text.as_bytes()[..offset];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |p| p + 1);
+        // Count characters, not bytes; a partial UTF-8 sequence counts as one.
+        let column = before[line_start..]
+            .iter()
+            .filter(|&&b| (b & 0xC0) != 0x80)
+            .count()
+            + 1;
+        Location {
+            file: file.to_path_buf(),
+            line,
+            column,
+        }
+    }
+
+    /// Location of the suffix `rest` of `text` (for parsers that hand back the unparsed rest).
+    pub fn from_rest(file: &Path, text: &str, rest: &str) -> Location {
+        Location::from_offset(file, text, text.len().saturating_sub(rest.len()))
+    }
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.file.display(), self.line, self.column)
+    }
+}
+
+/// A syntax or content error in an input file.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, thiserror::Error)]
+#[error("{location}: expected {expected}{}", found_suffix(.found))]
+pub struct ParseError {
+    /// Where the problem is.
+    pub location: Location,
+    /// What the grammar or the standard expected there, e.g. `a frame count >= 0`.
+    pub expected: String,
+    /// What was there instead, shortened for display; `None` at end of input.
+    pub found: Option<String>,
+}
+
+fn found_suffix(found: &Option<String>) -> String {
+    match found {
+        Some(f) => format!(", found `{f}`"),
+        None => ", found end of input".to_string(),
+    }
+}
+
+impl ParseError {
+    /// An error at byte `offset` of `text`; `found` is taken from the text at that point.
+    pub fn at_offset(file: &Path, text: &str, offset: usize, expected: impl Into<String>) -> Self {
+        let offset = offset.min(text.len());
+        ParseError {
+            location: Location::from_offset(file, text, offset),
+            expected: expected.into(),
+            found: snippet(&text[floor_char_boundary(text, offset)..]),
+        }
+    }
+
+    /// An error at the start of the suffix `rest` of `text`.
+    pub fn at_rest(file: &Path, text: &str, rest: &str, expected: impl Into<String>) -> Self {
+        Self::at_offset(file, text, text.len().saturating_sub(rest.len()), expected)
+    }
+}
+
+fn floor_char_boundary(text: &str, mut offset: usize) -> usize {
+    while offset > 0 && !text.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    offset
+}
+
+/// The token at the start of `rest`, at most 40 characters, for "found `...`" messages.
+pub fn snippet(rest: &str) -> Option<String> {
+    let token: String = rest
+        .split(|c: char| c == '\n' || c == '\r')
+        .next()
+        .unwrap_or("")
+        .chars()
+        .take(40)
+        .collect();
+    if rest.is_empty() {
+        None
+    } else if token.trim().is_empty() {
+        Some(if rest.starts_with(['\n', '\r']) {
+            "end of line".to_string()
+        } else {
+            token
+        })
+    } else {
+        Some(token)
+    }
+}
+
+/// Severity of a [`Diagnostic`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Severity {
+    /// The input deviates from the standard but was read.
+    Warning,
+    /// The input violates the standard (reported by validators and strict readers).
+    Error,
+}
+
+/// A located message about an input: a lenient reader's warning or a validator's finding.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Diagnostic {
+    /// How serious.
+    pub severity: Severity,
+    /// Where (`None` for whole-file findings).
+    pub location: Option<Location>,
+    /// What is wrong and, where useful, what to do.
+    pub message: String,
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let sev = match self.severity {
+            Severity::Warning => "warning",
+            Severity::Error => "error",
+        };
+        match &self.location {
+            Some(loc) => write!(f, "{loc}: {sev}: {}", self.message),
+            None => write!(f, "{sev}: {}", self.message),
+        }
+    }
+}
+
+/// Every error the library returns.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The input is not well-formed.
+    #[error(transparent)]
+    Parse(#[from] ParseError),
+    /// The input is well-formed but its content is unusable (e.g. a missing feature point).
+    #[error("{0}")]
+    Invalid(String),
+    /// The requested operation or format is not supported.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+}
+
+impl Error {
+    /// An I/O error on `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// True for errors caused by the input (bad usage/input, exit code 2), false for failures
+    /// of the operation itself (exit code 1).
+    pub fn is_input_error(&self) -> bool {
+        match self {
+            Error::Io { source, .. } => matches!(
+                source.kind(),
+                std::io::ErrorKind::NotFound
+                    | std::io::ErrorKind::PermissionDenied
+                    | std::io::ErrorKind::InvalidData
+                    | std::io::ErrorKind::FileTooLarge
+            ),
+            Error::Parse(_) | Error::Invalid(_) | Error::Unsupported(_) => true,
+        }
+    }
+}
+
+/// Result with the crate's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn location_counts_lines_and_characters() {
+        let text = "ab\ncdé\nfg";
+        let p = Path::new("x.fap");
+        assert_eq!(Location::from_offset(p, text, 0).to_string(), "x.fap:1:1");
+        assert_eq!(Location::from_offset(p, text, 3).to_string(), "x.fap:2:1");
+        // 'é' is two bytes; 'g' after "\nf" on line 3.
+        let g = text.find('g').unwrap();
+        assert_eq!(Location::from_offset(p, text, g).to_string(), "x.fap:3:2");
+        let after_e = text.find('\n').unwrap() + 1 + "cdé".len();
+        assert_eq!(Location::from_offset(p, text, after_e).column, 4);
+        // Past the end clamps.
+        assert_eq!(Location::from_offset(p, text, 999).line, 3);
+    }
+
+    #[test]
+    fn parse_error_message_names_everything() {
+        let text = "2.1 name 25 x\n";
+        let e = ParseError::at_offset(Path::new("a.fap"), text, 12, "a frame count");
+        assert_eq!(e.to_string(), "a.fap:1:13: expected a frame count, found `x`");
+        let e = ParseError::at_offset(Path::new("a.fap"), text, text.len(), "a mask line");
+        assert_eq!(
+            e.to_string(),
+            "a.fap:2:1: expected a mask line, found end of input"
+        );
+        // Offsets inside a multi-byte character do not panic.
+        let e = ParseError::at_offset(Path::new("u"), "é", 1, "x");
+        assert_eq!(e.location.column, 2);
+    }
+}

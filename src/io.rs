@@ -1,0 +1,120 @@
+//! File input and output with the guarantees every command relies on: inputs are read with a
+//! size bound (a hostile file cannot make us allocate without limit) and outputs are written
+//! atomically (a temporary file in the same directory, renamed into place), so a failed run
+//! never leaves a half-written file behind.
+
+use std::io::{Read, Write};
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// Largest input file read by default: 1 GiB. Readers take text in memory; this keeps one
+/// hostile file from exhausting the machine.
+pub const DEFAULT_MAX_INPUT_BYTES: u64 = 1 << 30;
+
+/// Reads a whole file, refusing files larger than `max_bytes`.
+pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut buf = Vec::new();
+    // Read one byte past the limit to detect an oversized file without trusting metadata.
+    file.take(max_bytes.saturating_add(1))
+        .read_to_end(&mut buf)
+        .map_err(|e| Error::io(path, e))?;
+    if buf.len() as u64 > max_bytes {
+        return Err(Error::io(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::FileTooLarge,
+                format!("file is larger than the {max_bytes}-byte input limit"),
+            ),
+        ));
+    }
+    Ok(buf)
+}
+
+/// Reads a whole UTF-8 text file (bounded by [`DEFAULT_MAX_INPUT_BYTES`]).
+///
+/// Invalid UTF-8 is an error that names the byte offset of the first bad sequence.
+pub fn read_text(path: &Path) -> Result<String> {
+    let bytes = read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let valid = std::str::from_utf8(&e.as_bytes()[..at]).unwrap_or_default();
+        Error::Parse(crate::error::ParseError {
+            location: crate::error::Location::from_offset(path, valid, at),
+            expected: "UTF-8 text".to_string(),
+            found: Some(format!("byte 0x{:02X}", e.as_bytes()[at])),
+        })
+    })
+}
+
+/// Writes `bytes` to `path` atomically: into a temporary file beside it, flushed, then renamed.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// Writes to `path` atomically through a writer callback; if the callback fails, the target
+/// is left untouched and the temporary file is removed.
+pub fn write_atomic_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".fbakit-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(dir, e))?;
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
+        fill(&mut w).map_err(|e| Error::io(path, e))?;
+        w.flush().map_err(|e| Error::io(path, e))?;
+    }
+    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_write_replaces_and_failed_write_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.txt");
+        write_atomic(&p, b"first").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"first");
+        let err = write_atomic_with(&p, |w| {
+            w.write_all(b"partial")?;
+            Err(std::io::Error::other("boom"))
+        });
+        assert!(err.is_err());
+        assert_eq!(std::fs::read(&p).unwrap(), b"first", "target untouched");
+        let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(leftovers.len(), 1, "temporary file removed");
+    }
+
+    #[test]
+    fn bounded_read_refuses_large_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big");
+        std::fs::write(&p, vec![b'x'; 100]).unwrap();
+        assert!(read_bounded(&p, 100).is_ok());
+        let e = read_bounded(&p, 99).unwrap_err();
+        assert!(e.to_string().contains("input limit"), "{e}");
+        assert!(e.is_input_error());
+    }
+
+    #[test]
+    fn non_utf8_is_a_located_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("bad.fap");
+        std::fs::write(&p, b"2.1 x\n\xff\xfe").unwrap();
+        let e = read_text(&p).unwrap_err().to_string();
+        assert!(e.contains("bad.fap:2:1: expected UTF-8 text, found `byte 0xFF`"), "{e}");
+    }
+}

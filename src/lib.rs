@@ -1,0 +1,11 @@
+//! # fbakit — MPEG-4 Face and Body Animation toolkit
+//!
+//! Modules follow the data, from the standard's tables to the files built on them:
+//!
+//! - [`spec`]: the FAP table, feature points, FAP units, visemes and expressions as typed tables.
+//! - [`error`]: located parse errors and diagnostics shared by every reader.
+//! - [`io`]: bounded reads and atomic writes.
+
+pub mod error;
+pub mod io;
+pub mod spec;
