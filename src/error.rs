@@ -102,7 +102,7 @@ fn floor_char_boundary(text: &str, mut offset: usize) -> usize {
 /// The token at the start of `rest`, at most 40 characters, for "found `...`" messages.
 pub fn snippet(rest: &str) -> Option<String> {
     let token: String = rest
-        .split(|c: char| c == '\n' || c == '\r')
+        .split(['\n', '\r'])
         .next()
         .unwrap_or("")
         .chars()
@@ -229,7 +229,10 @@ mod tests {
     fn parse_error_message_names_everything() {
         let text = "2.1 name 25 x\n";
         let e = ParseError::at_offset(Path::new("a.fap"), text, 12, "a frame count");
-        assert_eq!(e.to_string(), "a.fap:1:13: expected a frame count, found `x`");
+        assert_eq!(
+            e.to_string(),
+            "a.fap:1:13: expected a frame count, found `x`"
+        );
         let e = ParseError::at_offset(Path::new("a.fap"), text, text.len(), "a mask line");
         assert_eq!(
             e.to_string(),

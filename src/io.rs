@@ -115,6 +115,9 @@ mod tests {
         let p = dir.path().join("bad.fap");
         std::fs::write(&p, b"2.1 x\n\xff\xfe").unwrap();
         let e = read_text(&p).unwrap_err().to_string();
-        assert!(e.contains("bad.fap:2:1: expected UTF-8 text, found `byte 0xFF`"), "{e}");
+        assert!(
+            e.contains("bad.fap:2:1: expected UTF-8 text, found `byte 0xFF`"),
+            "{e}"
+        );
     }
 }

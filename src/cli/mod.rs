@@ -83,7 +83,10 @@ fn spec(args: SpecArgs) -> fbakit::error::Result<u8> {
         if args.json {
             print_json(&rows)?;
         } else {
-            println!("{:>3}  {:<22} {:<6} {:<3} {:<15} fp", "fap", "name", "fapu", "dir", "positive");
+            println!(
+                "{:>3}  {:<22} {:<6} {:<3} {:<15} fp",
+                "fap", "name", "fapu", "dir", "positive"
+            );
             for r in rows {
                 let fps: Vec<String> = r.feature_points.iter().map(|p| p.to_string()).collect();
                 println!(
