@@ -5,9 +5,11 @@
 //! - [`spec`]: the FAP table, feature points, FAP units, visemes and expressions as typed tables.
 //! - [`fdp`]: feature points and the FAP units (FAPU) measured on them.
 //! - [`fat`]: Facial Animation Tables: model, evaluation, morph-target view, validation.
+//! - [`clone`]: facial motion cloning (Pandzic 2003 `fmc`, Fratarcangeli & Schaerf 2005 `rbf`).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 
+pub mod clone;
 pub mod error;
 pub mod fat;
 pub mod fdp;

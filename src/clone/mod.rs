@@ -1,0 +1,91 @@
+//! Facial motion cloning: copying a source face's animation (its FAT, seen as morph targets)
+//! onto a target face that is only a mesh with feature points.
+//!
+//! Two methods share one interface:
+//! - [`fmc`]: Pandzic 2003, "Facial Motion Cloning" — FAPU regional normalisation, cylindrical
+//!   projection into a 2D alignment space, feature-point-driven alignment, barycentric motion
+//!   mapping with an anti-aliasing filter and upper/lower lip separation.
+//! - [`rbf`]: Fratarcangeli & Schaerf 2005, "Fast Facial Motion Cloning in MPEG-4" — eye and
+//!   inner-lip contour extraction, a Hardy multiquadric RBF volume morph refined iteratively by
+//!   ray casting, and barycentric mapping of target vertices into the deformed source.
+//!
+//! Both work on a [`CloneSurface`]: the deformable skin of a face in the MPEG-4 face frame
+//! (meshes already placed by their transforms, concatenated into one vertex array), its feature
+//! points and its FAPU. Motions are sparse morph targets on that surface ([`SurfaceMotion`]).
+//! Rigid parts (eyes, teeth, tongue, head) move through transforms and are handled separately.
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+use serde::Serialize;
+
+use crate::fat::TableKey;
+use crate::fdp::Fapu;
+use crate::spec::FeaturePointId;
+
+/// The deformable surface of one face, as the cloning methods see it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CloneSurface {
+    /// Neutral vertex positions in the MPEG-4 face frame (+x face's left, +y up, +z forward).
+    pub positions: Vec<Vec3>,
+    /// Triangles (indices into `positions`), consistently oriented (counter-clockwise seen
+    /// from outside the face).
+    pub triangles: Vec<[u32; 3]>,
+    /// Feature points that are vertices of this surface.
+    pub fp_vertices: BTreeMap<FeaturePointId, u32>,
+    /// Positions of all known feature points, on the surface or not (pupils, teeth, 7.1, ...).
+    pub fp_positions: BTreeMap<FeaturePointId, Vec3>,
+    /// The face's FAP units.
+    pub fapu: Fapu,
+}
+
+impl CloneSurface {
+    /// Position of a feature point, if known.
+    pub fn fp(&self, id: FeaturePointId) -> Option<Vec3> {
+        self.fp_positions.get(&id).copied()
+    }
+}
+
+/// One morph target on a [`CloneSurface`]: the moved vertices and their displacement from
+/// neutral when the table `key` is at `value`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceMotion {
+    /// Which FAP / viseme / expression.
+    pub key: TableKey,
+    /// The value the displacements represent.
+    pub value: f64,
+    /// `(vertex, displacement)` for every moved vertex, sorted by vertex.
+    pub offsets: Vec<(u32, Vec3)>,
+}
+
+/// Time spent in each step of a cloning run, in seconds.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct StepTimings {
+    /// Named steps in execution order (e.g. `fit`, `refine`, `map`, `deform`).
+    pub steps: Vec<(String, f64)>,
+}
+
+impl StepTimings {
+    /// Records a step's duration.
+    pub fn push(&mut self, name: &str, seconds: f64) {
+        self.steps.push((name.to_string(), seconds));
+    }
+
+    /// Total seconds.
+    pub fn total(&self) -> f64 {
+        self.steps.iter().map(|(_, s)| s).sum()
+    }
+}
+
+/// What a cloning method produced for the surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceCloneResult {
+    /// One motion per source motion, on the target surface's vertices.
+    pub motions: Vec<SurfaceMotion>,
+    /// Per-step timings.
+    pub timings: StepTimings,
+    /// Method-specific figures (iterations, correspondence count, fallbacks, ...).
+    pub stats: BTreeMap<String, f64>,
+    /// Warnings for the user (missing optional feature points, ...).
+    pub warnings: Vec<String>,
+}
