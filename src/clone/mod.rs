@@ -89,3 +89,6 @@ pub struct SurfaceCloneResult {
     /// Warnings for the user (missing optional feature points, ...).
     pub warnings: Vec<String>,
 }
+
+#[cfg(test)]
+pub(crate) mod fixtures;
