@@ -112,16 +112,21 @@ mod tests {
             offsets: vec![(1, Vec3::new(0.0, -0.5, 0.0))],
         };
         assert_eq!(
-            morph_target_error(&neutral, &[m.clone()], &[m.clone()]),
+            morph_target_error(&neutral, std::slice::from_ref(&m), std::slice::from_ref(&m)),
             0.0
         );
-        assert_eq!(displacement_error(2, &[m.clone()], &[m.clone()]), 0.0);
+        assert_eq!(
+            displacement_error(2, std::slice::from_ref(&m), std::slice::from_ref(&m)),
+            0.0
+        );
         let mut half = m.clone();
         half.offsets[0].1 *= 0.5;
         // Displacement error: |0.25| / |0.5| = 50 %.
-        assert!((displacement_error(2, &[m.clone()], &[half.clone()]) - 50.0).abs() < 1e-9);
+        assert!(
+            (displacement_error(2, std::slice::from_ref(&m), &[half.clone()]) - 50.0).abs() < 1e-9
+        );
         // Formula (1): 0.25 / (1 + 0.5) = 16.67 %.
-        let e = morph_target_error(&neutral, &[m.clone()], &[half]);
+        let e = morph_target_error(&neutral, std::slice::from_ref(&m), &[half]);
         assert!((e - 100.0 / 6.0).abs() < 1e-4, "{e}");
         // A missing key counts as no motion at all.
         assert!((displacement_error(2, &[m], &[]) - 100.0).abs() < 1e-9);
