@@ -10,3 +10,7 @@ pub mod feature_points;
 
 pub use fapu::{Fapu, FapuDistances, FapuMeasurement};
 pub use feature_points::{FeaturePoint, FeaturePointSet, VertexBinding};
+pub mod csv;
+pub mod xface;
+pub mod xml;
+mod xml_support;
