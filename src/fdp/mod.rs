@@ -7,9 +7,14 @@
 
 pub mod fapu;
 pub mod feature_points;
+pub mod file;
 
 pub use fapu::{Fapu, FapuDistances, FapuMeasurement};
 pub use feature_points::{FeaturePoint, FeaturePointSet, VertexBinding};
+pub use file::{
+    detect_format, parse_feature_points, read_feature_points, FapuSource, FeaturePointFile,
+    FeaturePointFormat, FormatExtras,
+};
 pub mod csv;
 pub mod xface;
 pub mod xml;
