@@ -8,6 +8,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod fapu;
+
 /// Exit code for success.
 pub const EXIT_OK: u8 = 0;
 /// Exit code for a failed operation.
@@ -35,6 +37,18 @@ pub enum Command {
     /// Print the MPEG-4 FAP table (number, name, FAPU, direction, feature point).
     #[command(after_help = "Example:\n  fbakit spec faps --json")]
     Spec(SpecArgs),
+    /// Print the six FAP units (IRISD, ES, ENS, MNS, MW, AU) of a face from its feature points.
+    #[command(
+        long_about = "Print the six FAP units of a face: each neutral distance X0 and the unit \
+                      X0/1024 (AU is fixed at 1e-5 rad). Explicit FAPU distances in the file \
+                      (Xface <fapu>, fbakit <fapu>) are used as they are (\"from file\"); \
+                      otherwise they are measured on the feature points with the standard's \
+                      definitions (\"from feature points\"): IRISD0 = 3.1.y - 3.3.y, \
+                      ES0 = 3.5.x - 3.6.x, ENS0 = 3.5.y - 9.15.y, MNS0 = 9.15.y - 2.2.y, \
+                      MW0 = 8.3.x - 8.4.x.",
+        after_help = "Examples:\n  fbakit fapu samples/feature-points-example.xml\n  fbakit fapu alice.fdp --json"
+    )]
+    Fapu(fapu::FapuArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -51,6 +65,7 @@ pub struct SpecArgs {
 pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Spec(args) => spec(args),
+        Command::Fapu(args) => fapu::run(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

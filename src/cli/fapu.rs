@@ -1,0 +1,99 @@
+//! `fbakit fapu FILE`: the six FAP units of a face from its feature-point file.
+
+use std::path::PathBuf;
+
+use fbakit::error::{Error, Result};
+use fbakit::fdp::{read_feature_points, FapuSource};
+use fbakit::spec::{FapuKind, FAPU_DIVISOR};
+use serde::Serialize;
+
+use super::{print_json, EXIT_OK};
+
+#[derive(Debug, clap::Args)]
+pub struct FapuArgs {
+    /// Feature-point file: fbakit `.xml`, Xface `.fdp` or `.csv` (fp,vertices,combine,description).
+    pub file: PathBuf,
+    /// Neutral mesh whose vertices the feature points are bound to (for files that carry
+    /// vertex indices but no positions).
+    #[arg(long, value_name = "PATH")]
+    pub mesh: Option<PathBuf>,
+    /// Print JSON instead of a text table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize)]
+struct Row {
+    fapu: FapuKind,
+    /// Neutral distance X0 (`None` for AU).
+    distance: Option<f64>,
+    /// X0/1024, or radians for AU.
+    unit: f64,
+}
+
+#[derive(Serialize)]
+struct Report {
+    file: String,
+    source: FapuSource,
+    units: Vec<Row>,
+    notes: Vec<String>,
+}
+
+pub fn run(args: FapuArgs) -> Result<u8> {
+    let file = read_feature_points(&args.file)?;
+    if let Some(mesh) = &args.mesh {
+        // The mesh readers live elsewhere; until they are wired here, say so plainly.
+        return Err(Error::Unsupported(format!(
+            "--mesh {}: placing feature points on a mesh is not yet supported for this file type",
+            mesh.display()
+        )));
+    }
+    if file.fapu.is_none() && file.points.needs_mesh() {
+        return Err(Error::Invalid(format!(
+            "{}: the feature points are mesh-vertex indices without positions and the file has no FAPU distances; pass --mesh MESH with the neutral mesh they index",
+            args.file.display()
+        )));
+    }
+    let (source, measured) = file.fapu()?;
+    let units = FapuKind::ALL
+        .into_iter()
+        .map(|k| Row {
+            fapu: k,
+            distance: measured.fapu.distance(k),
+            unit: measured.fapu.unit(k),
+        })
+        .collect();
+    let report = Report {
+        file: args.file.display().to_string(),
+        source,
+        units,
+        notes: measured.notes,
+    };
+    if args.json {
+        print_json(&report)?;
+    } else {
+        print!("{}", text(&report));
+    }
+    Ok(EXIT_OK)
+}
+
+fn text(r: &Report) -> String {
+    use std::fmt::Write as _;
+    let source = match r.source {
+        FapuSource::File => "from file",
+        FapuSource::FeaturePoints => "from feature points",
+    };
+    let mut s = format!("FAPU of {} ({source})\n", r.file);
+    let _ = writeln!(s, "{:<6} {:<14} unit", "FAPU", "distance X0");
+    for row in &r.units {
+        let (d, u) = match row.distance {
+            Some(d) => (d.to_string(), format!("{} (X0/{FAPU_DIVISOR})", row.unit)),
+            None => ("-".to_string(), format!("{} rad", row.unit)),
+        };
+        let _ = writeln!(s, "{:<6} {:<14} {u}", row.fapu.abbreviation(), d);
+    }
+    for n in &r.notes {
+        let _ = writeln!(s, "note: {n}");
+    }
+    s
+}
