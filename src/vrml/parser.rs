@@ -230,7 +230,7 @@ impl<'a> Parser<'a> {
             node_fields(type_name)
         };
         self.open.push(id);
-        let result = self.node_body(body, id, type_name, table, depth);
+        let result = self.node_body(body, type_name, table, depth);
         self.open.pop();
         let (rest, fields) = result?;
         self.scene.nodes[id.0].fields = fields;
@@ -241,7 +241,6 @@ impl<'a> Parser<'a> {
     fn node_body(
         &mut self,
         mut rest: &'a str,
-        _id: NodeId,
         type_name: &str,
         table: Option<&'static [FieldDecl]>,
         depth: usize,

@@ -166,7 +166,7 @@ impl Writer<'_> {
             V::SFImage(img) => {
                 let _ = write!(self.out, "{} {} {}", img.width, img.height, img.components);
                 let items = img.pixels.iter().map(|p| format!("0x{p:X}"));
-                self.wrapped(items, false, level, " ");
+                self.wrapped(items, level, " ");
             }
             V::SFNode(None) => self.out.push_str("NULL"),
             V::SFNode(Some(r)) => self.node(*r, level),
@@ -293,13 +293,7 @@ impl Writer<'_> {
     }
 
     /// Appends items after the current text, each preceded by a separator.
-    fn wrapped(
-        &mut self,
-        items: impl Iterator<Item = String>,
-        _comma: bool,
-        level: usize,
-        sep: &str,
-    ) {
+    fn wrapped(&mut self, items: impl Iterator<Item = String>, level: usize, sep: &str) {
         let mut first = false;
         self.wrapped_from_here(items, &mut first, level, sep);
     }
