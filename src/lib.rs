@@ -8,6 +8,7 @@
 //! - [`clone`]: facial motion cloning (Pandzic 2003 `fmc`, Fratarcangeli & Schaerf 2005 `rbf`).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
+//! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
 
 pub mod clone;
 pub mod error;
@@ -15,3 +16,4 @@ pub mod fat;
 pub mod fdp;
 pub mod io;
 pub mod spec;
+pub mod vrml;
