@@ -8,6 +8,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub mod fap;
+
 /// Exit code for success.
 pub const EXIT_OK: u8 = 0;
 /// Exit code for a failed operation.
@@ -35,6 +37,14 @@ pub enum Command {
     /// Print the MPEG-4 FAP table (number, name, FAPU, direction, feature point).
     #[command(after_help = "Example:\n  fbakit spec faps --json")]
     Spec(SpecArgs),
+    /// Inspect, validate and convert ASCII FAP streams (`.fap`, `.json`).
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  fbakit fap info samples/speech.fap\n  \
+                                        fbakit fap validate samples/lowlevel.fap\n  \
+                                        fbakit fap convert samples/speech.fap speech.json"
+    )]
+    Fap(fap::FapCommand),
 }
 
 #[derive(Debug, clap::Args)]
@@ -51,6 +61,7 @@ pub struct SpecArgs {
 pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Spec(args) => spec(args),
+        Command::Fap(cmd) => fap::run(cmd),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -13,15 +13,23 @@
 //! assert_eq!(write_fap_string(&stream), text);
 //! ```
 
+mod convert;
 mod model;
 mod parse;
+mod summary;
+mod timeline;
 mod write;
 
+pub use convert::{is_json_path, read_stream_file, write_stream_file};
 pub use model::{
     ExpressionParams, FapFrame, FapMask, FapStream, VisemeParams, DEFAULT_VERSION, NUM_LOW_LEVEL,
 };
 pub use parse::{
     read_fap_file, read_fap_str, validate_fap_file, validate_fap_str, ReadMode, ReadOptions,
     MAX_DECLARED_FRAMES,
+};
+pub use summary::{summarize, FapSummary, FapUsage};
+pub use timeline::{
+    displacement, resample, DenseFrame, FapMotion, FapTimeline, MAX_RESAMPLED_FRAMES,
 };
 pub use write::{write_fap_file, write_fap_string};

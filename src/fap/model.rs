@@ -46,10 +46,16 @@ impl FapStream {
         n as f64 / self.frame_rate
     }
 
-    /// Problems that make the stream unwritable as a valid `.fap` file: a frame rate that is
-    /// not finite and positive, frame numbers not strictly increasing, non-finite values, or
-    /// negative values of unidirectional FAPs. Empty when the stream is valid.
+    /// Every problem of [`FapStream::structural_problems`] and [`FapStream::value_problems`].
     pub fn problems(&self) -> Vec<String> {
+        let mut out = self.structural_problems();
+        out.extend(self.value_problems());
+        out
+    }
+
+    /// Problems that make the stream unplayable: a frame rate that is not finite and
+    /// positive, or frame numbers that do not strictly increase.
+    pub fn structural_problems(&self) -> Vec<String> {
         let mut out = Vec::new();
         if !(self.frame_rate.is_finite() && self.frame_rate > 0.0) {
             out.push(format!(
@@ -57,17 +63,22 @@ impl FapStream {
                 self.frame_rate
             ));
         }
-        let mut previous: Option<u64> = None;
-        for f in &self.frames {
-            if let Some(p) = previous {
-                if f.number <= p {
-                    out.push(format!(
-                        "frame number {} does not increase (previous {p})",
-                        f.number
-                    ));
-                }
+        for w in self.frames.windows(2) {
+            if w[1].number <= w[0].number {
+                out.push(format!(
+                    "frame number {} does not increase (previous {})",
+                    w[1].number, w[0].number
+                ));
             }
-            previous = Some(f.number);
+        }
+        out
+    }
+
+    /// Values the standard does not allow: non-finite values and negative values of
+    /// unidirectional FAPs.
+    pub fn value_problems(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for f in &self.frames {
             for (id, v) in f.low_level() {
                 if !id.info().accepts(v) {
                     out.push(format!(
