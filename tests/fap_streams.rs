@@ -292,3 +292,31 @@ mod round_trip {
         }
     }
 }
+
+#[path = "../examples/make_sample_faps.rs"]
+mod make_sample_faps;
+
+#[test]
+fn committed_samples_match_the_generator() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples");
+    for (file, text) in [
+        ("speech.fap", make_sample_faps::speech()),
+        ("lowlevel.fap", make_sample_faps::lowlevel()),
+    ] {
+        let committed = std::fs::read_to_string(dir.join(file)).unwrap();
+        assert_eq!(
+            committed, text,
+            "{file} drifted: run `cargo run --example make_sample_faps`"
+        );
+        let (s, w) = read_fap_str(&text, Path::new(file), &ReadOptions::strict()).unwrap();
+        assert!(w.is_empty());
+        // Comments aside, the samples are in canonical form.
+        let body: String = text
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        assert_eq!(write_fap_string(&s), body);
+        insta::assert_snapshot!(format!("canonical_{file}"), write_fap_string(&s));
+    }
+}
