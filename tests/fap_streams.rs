@@ -320,3 +320,31 @@ fn committed_samples_match_the_generator() {
         insta::assert_snapshot!(format!("canonical_{file}"), write_fap_string(&s));
     }
 }
+
+/// Replays every input in `tests/fuzz-regressions/fap/` through the fuzz target's checks.
+#[test]
+fn fuzz_regressions_replay() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz-regressions/fap");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let bytes = std::fs::read(&path).unwrap();
+        let Ok(text) = std::str::from_utf8(&bytes) else {
+            continue;
+        };
+        n += 1;
+        let p = Path::new("fuzz.fap");
+        if let Ok((s, _)) = read_fap_str(text, p, &ReadOptions::strict()) {
+            let (back, _) = read_fap_str(&write_fap_string(&s), p, &ReadOptions::strict()).unwrap();
+            assert_eq!(back, s, "{}", path.display());
+            assert!(validate_fap_str(text, p).is_empty(), "{}", path.display());
+        }
+        if let Ok((s, _)) = read_fap_str(text, p, &ReadOptions::lenient()) {
+            let (back, _) =
+                read_fap_str(&write_fap_string(&s), p, &ReadOptions::lenient()).unwrap();
+            assert_eq!(back, s, "{}", path.display());
+        }
+        let _ = validate_fap_str(text, p);
+    }
+    assert!(n >= 3, "regression inputs present");
+}

@@ -41,22 +41,19 @@ pub fn write_fap_file(path: &Path, stream: &FapStream) -> Result<()> {
 /// The version as written: the stream's own if it is one clean token, else `2.1`.
 fn version_token(stream: &FapStream) -> &str {
     let v = stream.version.as_str();
-    if v.is_empty() || v.starts_with('#') || v.chars().any(|c| c.is_whitespace()) {
+    if v.is_empty() || v.starts_with('#') || v.bytes().any(|c| c.is_ascii_whitespace()) {
         DEFAULT_VERSION
     } else {
         v
     }
 }
 
-/// The name as written: line breaks (which would split the header) become spaces, blanks at
-/// the ends are dropped, and an empty name becomes `-` so the header keeps four fields.
+/// The name as written: line feeds (which would split the header) become spaces, spaces and
+/// tabs at the ends are dropped (as the reader does), and an empty name becomes `-` so the
+/// header keeps four fields.
 fn name_text(stream: &FapStream) -> String {
-    let n: String = stream
-        .name
-        .chars()
-        .map(|c| if c == '\n' || c == '\r' { ' ' } else { c })
-        .collect();
-    let n = n.trim();
+    let n = stream.name.replace('\n', " ");
+    let n = n.trim_matches([' ', '\t']);
     if n.is_empty() {
         "-".to_string()
     } else {
