@@ -3,6 +3,7 @@
 //! Modules follow the data, from the standard's tables to the files built on them:
 //!
 //! - [`spec`]: the FAP table, feature points, FAP units, visemes and expressions as typed tables.
+//! - [`fap`]: ASCII FAP streams (`.fap`): reader, writer, hold semantics, resampling.
 //! - [`fdp`]: feature points and the FAP units (FAPU) measured on them.
 //! - [`fat`]: Facial Animation Tables: model, evaluation, morph-target view, validation.
 //! - [`clone`]: facial motion cloning (Pandzic 2003 `fmc`, Fratarcangeli & Schaerf 2005 `rbf`).
@@ -12,6 +13,7 @@
 
 pub mod clone;
 pub mod error;
+pub mod fap;
 pub mod fat;
 pub mod fdp;
 pub mod io;

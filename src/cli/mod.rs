@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub mod fap;
 mod fapu;
 
 /// Exit code for success.
@@ -49,6 +50,14 @@ pub enum Command {
         after_help = "Examples:\n  fbakit fapu samples/feature-points-example.xml\n  fbakit fapu alice.fdp --json"
     )]
     Fapu(fapu::FapuArgs),
+    /// Inspect, validate and convert ASCII FAP streams (`.fap`, `.json`).
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  fbakit fap info samples/speech.fap\n  \
+                                        fbakit fap validate samples/lowlevel.fap\n  \
+                                        fbakit fap convert samples/speech.fap speech.json"
+    )]
+    Fap(fap::FapCommand),
 }
 
 #[derive(Debug, clap::Args)]
@@ -66,6 +75,7 @@ pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Spec(args) => spec(args),
         Command::Fapu(args) => fapu::run(args),
+        Command::Fap(cmd) => fap::run(cmd),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -1,0 +1,184 @@
+//! `fbakit fap info|validate|convert`: FAP stream commands.
+
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand};
+use fbakit::error::Result;
+use fbakit::fap::{
+    read_stream_file, summarize, validate_fap_file, write_stream_file, FapSummary, ReadOptions,
+};
+
+use super::{print_json, EXIT_FAILURE, EXIT_OK};
+
+/// FAP stream subcommands.
+#[derive(Debug, Subcommand)]
+pub enum FapCommand {
+    /// Summarise a FAP stream: header, timing, FAPs used with ranges, masks, visemes,
+    /// expressions and reader warnings.
+    #[command(after_help = "Examples:\n  fbakit fap info samples/speech.fap\n  \
+                            fbakit fap info joy.fap --json --strict")]
+    Info(InfoArgs),
+    /// Check a `.fap` file strictly and list every problem as file:line:column.
+    /// Exit code 0 when valid, 1 when problems were found, 2 when unreadable.
+    #[command(after_help = "Example:\n  fbakit fap validate samples/lowlevel.fap")]
+    Validate(ValidateArgs),
+    /// Convert between `.fap` and `.json` (chosen by extension); writes atomically.
+    #[command(after_help = "Examples:\n  fbakit fap convert joy.fap joy.json\n  \
+                            fbakit fap convert joy.json joy-canonical.fap --strict")]
+    Convert(ConvertArgs),
+}
+
+/// Arguments of `fap info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Input `.fap` (or `.json`) file.
+    pub file: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Read strictly (deviations are errors instead of warnings).
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// Arguments of `fap validate`.
+#[derive(Debug, Args)]
+pub struct ValidateArgs {
+    /// Input `.fap` file.
+    pub file: PathBuf,
+    /// Print the findings as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `fap convert`.
+#[derive(Debug, Args)]
+pub struct ConvertArgs {
+    /// Input file (`.fap` or `.json`).
+    pub input: PathBuf,
+    /// Output file (`.fap` or `.json`).
+    pub output: PathBuf,
+    /// Read the input strictly.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// Runs one FAP subcommand and returns its exit code.
+pub fn run(cmd: FapCommand) -> Result<u8> {
+    match cmd {
+        FapCommand::Info(a) => info(a),
+        FapCommand::Validate(a) => validate(a),
+        FapCommand::Convert(a) => convert(a),
+    }
+}
+
+fn options(strict: bool) -> ReadOptions {
+    if strict {
+        ReadOptions::strict()
+    } else {
+        ReadOptions::lenient()
+    }
+}
+
+fn info(a: InfoArgs) -> Result<u8> {
+    let (stream, warnings) = read_stream_file(&a.file, &options(a.strict))?;
+    let s = summarize(&stream, warnings);
+    if a.json {
+        print_json(&s)?;
+    } else {
+        print!("{}", info_text(&s));
+    }
+    Ok(EXIT_OK)
+}
+
+/// The text form of `fap info`.
+pub fn info_text(s: &FapSummary) -> String {
+    use std::fmt::Write as _;
+    let mut o = String::new();
+    let _ = writeln!(o, "version:    {}", s.version);
+    let _ = writeln!(o, "name:       {}", s.name);
+    let _ = writeln!(o, "frame rate: {} fps", s.frame_rate);
+    let _ = writeln!(o, "frames:     {}", s.frames);
+    let _ = writeln!(o, "duration:   {:.3} s", s.duration_seconds);
+    match s.frame_numbers {
+        Some((a, b)) => {
+            let gaps = if s.skipped_frame_numbers {
+                " (with gaps)"
+            } else {
+                ""
+            };
+            let _ = writeln!(o, "numbers:    {a}..={b}{gaps}");
+        }
+        None => {
+            let _ = writeln!(o, "numbers:    none");
+        }
+    }
+    let _ = writeln!(o, "masks:      {} distinct", s.distinct_masks);
+    let visemes: Vec<String> = s.visemes.iter().map(|v| v.to_string()).collect();
+    let _ = writeln!(o, "visemes:    {}", none_if_empty(&visemes.join(" ")));
+    let _ = writeln!(
+        o,
+        "expressions: {}",
+        none_if_empty(&s.expressions.join(" "))
+    );
+    let _ = writeln!(o, "FAPs used:  {}", s.faps.len());
+    for f in &s.faps {
+        match (f.min, f.max) {
+            (Some(lo), Some(hi)) => {
+                let _ = writeln!(
+                    o,
+                    "  {:>2} {:<22} {:>6} frames  min {lo:>8}  max {hi:>8}",
+                    f.number, f.name, f.frames
+                );
+            }
+            _ => {
+                let _ = writeln!(o, "  {:>2} {:<22} {:>6} frames", f.number, f.name, f.frames);
+            }
+        }
+    }
+    let _ = writeln!(o, "warnings:   {}", s.warnings.len());
+    for w in &s.warnings {
+        let _ = writeln!(o, "  {w}");
+    }
+    o
+}
+
+fn none_if_empty(s: &str) -> &str {
+    if s.is_empty() {
+        "none"
+    } else {
+        s
+    }
+}
+
+fn validate(a: ValidateArgs) -> Result<u8> {
+    let findings = validate_fap_file(&a.file)?;
+    if a.json {
+        print_json(&serde_json::json!({
+            "file": a.file,
+            "valid": findings.is_empty(),
+            "problems": findings,
+        }))?;
+    } else if findings.is_empty() {
+        println!("{}: valid", a.file.display());
+    } else {
+        for f in &findings {
+            println!("{f}");
+        }
+        println!("{}: {} problem(s)", a.file.display(), findings.len());
+    }
+    Ok(if findings.is_empty() {
+        EXIT_OK
+    } else {
+        EXIT_FAILURE
+    })
+}
+
+fn convert(a: ConvertArgs) -> Result<u8> {
+    let (stream, warnings) = read_stream_file(&a.input, &options(a.strict))?;
+    for w in &warnings {
+        eprintln!("{w}");
+    }
+    write_stream_file(&a.output, &stream)?;
+    Ok(EXIT_OK)
+}
