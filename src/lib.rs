@@ -5,11 +5,13 @@
 //! - [`spec`]: the FAP table, feature points, FAP units, visemes and expressions as typed tables.
 //! - [`fdp`]: feature points and the FAP units (FAPU) measured on them.
 //! - [`fat`]: Facial Animation Tables: model, evaluation, morph-target view, validation.
+//! - [`gltf`]: glTF 2.0 export (`.glb`/`.gltf`): meshes, morph targets, nodes, animations.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 
 pub mod error;
 pub mod fat;
 pub mod fdp;
+pub mod gltf;
 pub mod io;
 pub mod spec;
