@@ -19,7 +19,7 @@ use crate::error::{Error, Result};
 
 /// Handle of a mesh added to a [`SceneBuilder`]; meshes are written in the order added.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct MeshId(u32);
+pub struct MeshId(pub(super) u32);
 
 impl MeshId {
     /// Index of the mesh in the written `meshes` array.
@@ -30,7 +30,7 @@ impl MeshId {
 
 /// Handle of a node added to a [`SceneBuilder`]; nodes are written in the order added.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct NodeId(u32);
+pub struct NodeId(pub(super) u32);
 
 impl NodeId {
     /// Index of the node in the written `nodes` array.

@@ -307,9 +307,8 @@ fn is_zero(n: &u32) -> bool {
 
 /// Serialises attribute lists as JSON objects, keeping insertion order.
 mod ordered_map {
-    use serde::de::Deserializer;
+    use serde::de::{Deserializer, MapAccess, Visitor};
     use serde::ser::{SerializeMap, Serializer};
-    use serde::Deserialize;
 
     pub fn serialize<S: Serializer>(attrs: &[(String, u32)], s: S) -> Result<S::Ok, S::Error> {
         let mut m = s.serialize_map(Some(attrs.len()))?;
@@ -319,9 +318,27 @@ mod ordered_map {
         m.end()
     }
 
+    /// Reads a JSON object keeping its key order (so a written file reads back equal).
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(String, u32)>, D::Error> {
-        let map = std::collections::BTreeMap::<String, u32>::deserialize(d)?;
-        Ok(map.into_iter().collect())
+        d.deserialize_map(InOrder)
+    }
+
+    struct InOrder;
+
+    impl<'de> Visitor<'de> for InOrder {
+        type Value = Vec<(String, u32)>;
+
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("an object of accessor indices")
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+            let mut out = Vec::new();
+            while let Some(entry) = map.next_entry::<String, u32>()? {
+                out.push(entry);
+            }
+            Ok(out)
+        }
     }
 }
 
@@ -350,7 +367,9 @@ mod ordered_map_vec {
     pub fn deserialize<'de, D: Deserializer<'de>>(
         d: D,
     ) -> Result<Vec<Vec<(String, u32)>>, D::Error> {
-        let maps = Vec::<std::collections::BTreeMap<String, u32>>::deserialize(d)?;
-        Ok(maps.into_iter().map(|m| m.into_iter().collect()).collect())
+        #[derive(Deserialize)]
+        struct Attrs(#[serde(with = "super::ordered_map")] Vec<(String, u32)>);
+        let maps = Vec::<Attrs>::deserialize(d)?;
+        Ok(maps.into_iter().map(|m| m.0).collect())
     }
 }
