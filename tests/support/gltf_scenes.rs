@@ -165,7 +165,7 @@ pub fn tiny_scene() -> GltfDocument {
 }
 
 /// A `side × side` grid in the z = 0 plane (more than 65 535 vertices for side >= 256), with a
-/// sparse target moving the first row.
+/// sparse target moving the first row (with normal deltas).
 pub fn grid_scene(side: u32) -> GltfDocument {
     let positions: Vec<Vec3> = (0..side * side)
         .map(|i| Vec3::new((i % side) as f32, (i / side) as f32, 0.0) * 0.01)
@@ -181,9 +181,11 @@ pub fn grid_scene(side: u32) -> GltfDocument {
     let row: Vec<u32> = (0..side).collect();
     let lift = vec![Vec3::new(0.0, 0.0, 0.1); side as usize];
     let mut s = SceneBuilder::new("grid");
-    let mesh = s
-        .add_mesh(MeshData::new("grid", positions, triangles).with_sparse_target("lift", row, lift))
-        .unwrap();
+    let mut grid =
+        MeshData::new("grid", positions, triangles).with_sparse_target("lift", row, lift);
+    // Lifting one row tilts the neighbouring normals: sparse NORMAL deltas at u32 scale.
+    grid.morph_normals = true;
+    let mesh = s.add_mesh(grid).unwrap();
     s.add_node(NodeData::new("grid").with_mesh(mesh)).unwrap();
     s.build().unwrap()
 }
