@@ -7,6 +7,7 @@
 //! - [`fdp`]: feature points and the FAP units (FAPU) measured on them.
 //! - [`fat`]: Facial Animation Tables: model, evaluation, morph-target view, validation.
 //! - [`clone`]: facial motion cloning (Pandzic 2003 `fmc`, Fratarcangeli & Schaerf 2005 `rbf`).
+//! - [`gltf`]: glTF 2.0 export (`.glb`/`.gltf`): meshes, morph targets, nodes, animations.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -16,6 +17,7 @@ pub mod error;
 pub mod fap;
 pub mod fat;
 pub mod fdp;
+pub mod gltf;
 pub mod io;
 pub mod spec;
 pub mod vrml;

@@ -1,0 +1,55 @@
+// Runs the Khronos glTF validator (npm package `gltf-validator`) on the files given as
+// arguments and prints one JSON line per file: {file, errors, warnings, infos, messages}.
+//
+// The package is looked up in $GLTF_VALIDATOR_DIR (an `npm install --prefix` directory) first,
+// then through ordinary node_modules resolution. Exit codes: 0 = all files validated (read the
+// counts), 3 = validator package not found (callers treat that as "skip"), 1 = other failure.
+import { createRequire } from "node:module";
+import { readFileSync } from "node:fs";
+import path from "node:path";
+
+function loadValidator() {
+  const bases = [];
+  if (process.env.GLTF_VALIDATOR_DIR) {
+    bases.push(path.join(path.resolve(process.env.GLTF_VALIDATOR_DIR), "package.json"));
+  }
+  bases.push(import.meta.url);
+  for (const base of bases) {
+    try {
+      return createRequire(base)("gltf-validator");
+    } catch {
+      // try the next place
+    }
+  }
+  return null;
+}
+
+const validator = loadValidator();
+if (!validator) {
+  console.error("gltf-validator not found (set GLTF_VALIDATOR_DIR)");
+  process.exit(3);
+}
+
+try {
+  for (const file of process.argv.slice(2)) {
+    const report = await validator.validateBytes(new Uint8Array(readFileSync(file)), {
+      uri: path.basename(file),
+      maxIssues: 100,
+      // Sidecar files are not used by fbakit; refuse any external reference.
+      externalResourceFunction: (uri) => Promise.reject(`external resource ${uri} not allowed`),
+    });
+    const issues = report.issues;
+    console.log(
+      JSON.stringify({
+        file,
+        errors: issues.numErrors,
+        warnings: issues.numWarnings,
+        infos: issues.numInfos,
+        messages: issues.messages.map((m) => `${m.severity} ${m.code} ${m.pointer ?? ""}: ${m.message}`),
+      }),
+    );
+  }
+} catch (e) {
+  console.error(`validation failed: ${e}`);
+  process.exit(1);
+}
