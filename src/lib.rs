@@ -5,6 +5,8 @@
 //! - [`spec`]: the FAP table, feature points, FAP units, visemes and expressions as typed tables.
 //! - [`fdp`]: feature points and the FAP units (FAPU) measured on them.
 //! - [`fat`]: Facial Animation Tables: model, evaluation, morph-target view, validation.
+//! - [`synth`]: deterministic procedural faces (`alma`, `bruno`) with exact FATs, for demos,
+//!   tests and as cloning ground truth.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 
@@ -13,3 +15,4 @@ pub mod fat;
 pub mod fdp;
 pub mod io;
 pub mod spec;
+pub mod synth;
