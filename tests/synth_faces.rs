@@ -631,3 +631,128 @@ fn presets_differ_in_proportions_and_topology() {
     assert_ne!(a.columns, b.columns);
     assert_ne!(a.polygons, b.polygons);
 }
+
+/// Visual check (not run by default): `SYNTH_PREVIEW_DIR=/tmp cargo test --test synth_faces
+/// preview -- --ignored` writes flat-shaded orthographic PPM renders of both faces, neutral and
+/// animated (open jaw + joy + gaze left), front and side.
+#[test]
+#[ignore]
+fn preview() {
+    let Ok(dir) = std::env::var("SYNTH_PREVIEW_DIR") else {
+        return;
+    };
+    for face in faces() {
+        let (mut eval, mut out) = evaluator(face);
+        for (tag, acts) in [
+            ("neutral", vec![]),
+            (
+                "animated",
+                vec![
+                    Activation {
+                        key: TableKey::LowLevel(FapId::OPEN_JAW),
+                        value: 500.0,
+                    },
+                    Activation {
+                        key: TableKey::Expression(Expression::Joy),
+                        value: 63.0,
+                    },
+                    Activation {
+                        key: TableKey::LowLevel(FapId::new(23).unwrap()),
+                        value: 25_000.0,
+                    },
+                    Activation {
+                        key: TableKey::LowLevel(FapId::new(24).unwrap()),
+                        value: 25_000.0,
+                    },
+                ],
+            ),
+        ] {
+            eval.evaluate(&acts, &mut out);
+            for view in ["front", "side"] {
+                let (w, h) = (400usize, 500usize);
+                let mut img = vec![[40u8, 40, 60]; w * h];
+                let mut depth = vec![f64::NEG_INFINITY; w * h];
+                let project = |p: DVec3| -> (f64, f64, f64) {
+                    let (u, d) = if view == "front" {
+                        (p.x, p.z)
+                    } else {
+                        (p.z, p.x)
+                    };
+                    (
+                        w as f64 / 2.0 + u * 1.5,
+                        h as f64 / 2.0 - p.y * 1.5 - 20.0,
+                        d,
+                    )
+                };
+                for (mi, m) in face.meshes.iter().enumerate() {
+                    let pos: Vec<DVec3> = (0..m.positions.len() as u32)
+                        .map(|v| animated(face, &out, mi, v))
+                        .collect();
+                    for poly in &m.polygons {
+                        for k in 1..poly.len() - 1 {
+                            let tri = [
+                                pos[poly[0] as usize],
+                                pos[poly[k] as usize],
+                                pos[poly[k + 1] as usize],
+                            ];
+                            let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize_or_zero();
+                            let view_dir = if view == "front" { DVec3::Z } else { DVec3::X };
+                            let shade = n.dot(view_dir.lerp(DVec3::Y, 0.3).normalize());
+                            if n.dot(view_dir) <= 0.0 {
+                                continue; // back face
+                            }
+                            let s = shade.clamp(0.1, 1.0);
+                            let c = m.colour.map(|c| (c as f64 * s * 255.0) as u8);
+                            let pr = tri.map(project);
+                            let (x0, x1) = (
+                                pr.iter().map(|p| p.0).fold(f64::MAX, f64::min).max(0.0) as usize,
+                                pr.iter()
+                                    .map(|p| p.0)
+                                    .fold(f64::MIN, f64::max)
+                                    .min(w as f64 - 1.0) as usize,
+                            );
+                            let (y0, y1) = (
+                                pr.iter().map(|p| p.1).fold(f64::MAX, f64::min).max(0.0) as usize,
+                                pr.iter()
+                                    .map(|p| p.1)
+                                    .fold(f64::MIN, f64::max)
+                                    .min(h as f64 - 1.0) as usize,
+                            );
+                            let area = (pr[1].0 - pr[0].0) * (pr[2].1 - pr[0].1)
+                                - (pr[2].0 - pr[0].0) * (pr[1].1 - pr[0].1);
+                            if area.abs() < 1e-12 {
+                                continue;
+                            }
+                            for y in y0..=y1 {
+                                for x in x0..=x1 {
+                                    let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+                                    let e = |a: (f64, f64, f64), b: (f64, f64, f64)| {
+                                        (b.0 - a.0) * (py - a.1) - (px - a.0) * (b.1 - a.1)
+                                    };
+                                    let (w0, w1, w2) = (
+                                        e(pr[1], pr[2]) / area,
+                                        e(pr[2], pr[0]) / area,
+                                        e(pr[0], pr[1]) / area,
+                                    );
+                                    if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                                        continue;
+                                    }
+                                    let d = w0 * pr[0].2 + w1 * pr[1].2 + w2 * pr[2].2;
+                                    if d > depth[y * w + x] {
+                                        depth[y * w + x] = d;
+                                        img[y * w + x] = c;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                let mut bytes = format!("P6\n{w} {h}\n255\n").into_bytes();
+                bytes.extend(img.iter().flatten());
+                let path = std::path::Path::new(&dir)
+                    .join(format!("synth_{}_{tag}_{view}.ppm", face.name));
+                fbakit::io::write_atomic(&path, &bytes).unwrap();
+            }
+        }
+    }
+}

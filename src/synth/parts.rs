@@ -251,10 +251,11 @@ pub(super) fn build(p: &HeadParams, skin: &Skin) -> Parts {
     let teeth_lower = arch(slit.y - tooth_h, slit.y);
     let mid = (4 * ((samples - 1) / 2)) as u32;
 
-    // Tongue: a flat ellipsoid, tip (front pole) at the teeth boundary just behind the teeth.
+    // Tongue: a flat ellipsoid lying on the floor of the mouth, its top level with the teeth
+    // boundary and its tip (front pole) just behind the lower front teeth.
     let t_rings = 2 * (seg / 6) + 1; // odd: a ring at the equator (theta = pi/2)
-    let (rx, ry, rz) = (0.6 * p.mouth_half_width, 5.0, 0.9 * p.mouth_half_width);
-    let t_centre = DVec3::new(0.0, slit.y - 1.0, z_front - thickness - 1.0 - rz);
+    let (rx, ry, rz) = (0.6 * p.mouth_half_width, 3.5, 0.9 * p.mouth_half_width);
+    let t_centre = DVec3::new(0.0, slit.y - ry, z_front - thickness - 1.0 - rz);
     let t_seg = 4 * (seg / 4);
     let rings: Vec<Vec<DVec3>> = (1..=t_rings)
         .map(|i| {

@@ -104,3 +104,12 @@ fn open_jaw_does_not_move_the_upper_face() {
 }
 
 use crate::spec::FapId;
+
+#[test]
+fn teeth_sit_behind_the_lips() {
+    let f = alma();
+    let slit = f.feature_point(label("2.2")).unwrap().position;
+    let teeth = f.feature_point(label("9.10")).unwrap().position;
+    eprintln!("slit {slit} teeth {teeth}");
+    assert!(teeth.z < slit.z && teeth.z > slit.z - 12.0);
+}
