@@ -110,6 +110,5 @@ fn teeth_sit_behind_the_lips() {
     let f = alma();
     let slit = f.feature_point(label("2.2")).unwrap().position;
     let teeth = f.feature_point(label("9.10")).unwrap().position;
-    eprintln!("slit {slit} teeth {teeth}");
     assert!(teeth.z < slit.z && teeth.z > slit.z - 12.0);
 }
