@@ -8,6 +8,8 @@
 //! - [`fat`]: Facial Animation Tables: model, evaluation, morph-target view, validation.
 //! - [`clone`]: facial motion cloning (Pandzic 2003 `fmc`, Fratarcangeli & Schaerf 2005 `rbf`).
 //! - [`gltf`]: glTF 2.0 export (`.glb`/`.gltf`): meshes, morph targets, nodes, animations.
+//! - [`synth`]: deterministic procedural faces (`alma`, `bruno`) with exact FATs, for demos,
+//!   tests and as cloning ground truth.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -21,3 +23,4 @@ pub mod gltf;
 pub mod io;
 pub mod spec;
 pub mod vrml;
+pub mod synth;
