@@ -22,5 +22,5 @@ pub mod fdp;
 pub mod gltf;
 pub mod io;
 pub mod spec;
-pub mod vrml;
 pub mod synth;
+pub mod vrml;
