@@ -49,7 +49,6 @@ pub(crate) fn fail<'a, T>(at: &'a str, what: &'static str) -> Res<'a, T> {
 }
 
 /// Spaces and tabs (possibly none).
-#[allow(dead_code)]
 pub(crate) fn spaces(i: &str) -> Res<'_, &str> {
     let n = i.bytes().take_while(|&b| b == b' ' || b == b'\t').count();
     Ok((&i[n..], &i[..n]))
