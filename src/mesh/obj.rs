@@ -646,7 +646,8 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
             "cannot write non-finite uvs, normals or colours".into(),
         ));
     }
-    let bad_name = |s: &str| s.contains(['\n', '\r', '#']) || s.trim() != s;
+    // A trailing `\` would read back as a line continuation.
+    let bad_name = |s: &str| s.contains(['\n', '\r', '#']) || s.trim() != s || s.ends_with('\\');
     let names = m.groups.iter().flat_map(|g| {
         g.object
             .iter()
@@ -657,7 +658,7 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
     for n in names.chain(scene.material_libraries.iter().map(String::as_str)) {
         if bad_name(n) {
             return Err(Error::Invalid(format!(
-                "name `{}` cannot be written to OBJ (line break, `#` or outer spaces)",
+                "name `{}` cannot be written to OBJ (line break, `#`, outer spaces or trailing `\\`)",
                 n.escape_debug()
             )));
         }
