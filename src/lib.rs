@@ -10,10 +10,14 @@
 //! - [`gltf`]: glTF 2.0 export (`.glb`/`.gltf`): meshes, morph targets, nodes, animations.
 //! - [`synth`]: deterministic procedural faces (`alma`, `bruno`) with exact FATs, for demos,
 //!   tests and as cloning ground truth.
+//! - [`mesh`]: polygon meshes, their geometry (triangulation, normals, nearest vertex) and
+//!   Wavefront OBJ reading/writing.
+//! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
 
+pub mod candide;
 pub mod clone;
 pub mod error;
 pub mod fap;
@@ -21,6 +25,7 @@ pub mod fat;
 pub mod fdp;
 pub mod gltf;
 pub mod io;
+pub mod mesh;
 pub mod spec;
 pub mod synth;
 pub mod vrml;
