@@ -1,12 +1,13 @@
 //! Step 1: eye and inner-lip contour extraction by greedy mesh walks from feature points.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 use glam::{Vec2, Vec3};
 
 use crate::spec::FeaturePointId;
 
 use super::super::CloneSurface;
+use super::mesh::VertexTriangles;
 
 /// The extracted contours of one face (vertex paths). A contour that could not be walked is
 /// `None` and the reason is in the warnings.
@@ -31,7 +32,7 @@ fn fp_vertex(surface: &CloneSurface, label: &str) -> Option<u32> {
 pub(crate) fn extract(
     surface: &CloneSurface,
     adj: &[Vec<u32>],
-    opposites: &HashMap<(u32, u32), Vec<u32>>,
+    incidence: &VertexTriangles,
     face: &str,
     warnings: &mut Vec<String>,
 ) -> Contours {
@@ -59,7 +60,7 @@ pub(crate) fn extract(
     match (fp_vertex(surface, "2.5"), fp_vertex(surface, "2.4")) {
         (Some(s), Some(e)) => {
             for (upper, slot) in [(true, &mut upper_lip), (false, &mut lower_lip)] {
-                match lip_walk(pos, adj, opposites, s, e, upper) {
+                match lip_walk(pos, adj, (incidence, &surface.triangles), s, e, upper) {
                     Ok(c) => *slot = Some(c),
                     Err(err) => warnings.push(format!(
                         "{face}: {} inner lip contour skipped: {err}",
@@ -168,7 +169,7 @@ fn cross2(a: Vec2, b: Vec2) -> f32 {
 pub(crate) fn lip_walk(
     pos: &[Vec3],
     adj: &[Vec<u32>],
-    opposites: &HashMap<(u32, u32), Vec<u32>>,
+    (incidence, triangles): (&VertexTriangles, &[[u32; 3]]),
     start: u32,
     end: u32,
     upper: bool,
@@ -201,8 +202,7 @@ pub(crate) fn lip_walk(
                 if a.abs() >= std::f32::consts::FRAC_PI_2 {
                     return None;
                 }
-                let key = (v.min(n), v.max(n));
-                let ws = opposites.get(&key).map(Vec::as_slice).unwrap_or(&[]);
+                let ws: Vec<u32> = incidence.opposites(triangles, v, n).collect();
                 let own_side = |w: &u32| {
                     let s = cross2(d, xy(*w) - xy(v)) * up;
                     if upper {
@@ -276,7 +276,7 @@ pub(crate) fn nearest_on_polyline(p: Vec3, pts: &[Vec3], closed: bool) -> Option
 
 #[cfg(test)]
 mod tests {
-    use super::super::mesh::{adjacency, edge_opposites};
+    use super::super::mesh::adjacency;
     use super::*;
 
     /// A 5×5 grid of vertices (x, y in 0..4) with a slit mouth along y = 2 between the
@@ -314,10 +314,11 @@ mod tests {
     fn lip_walks_separate_a_closed_slit_mouth() {
         let (pos, tris) = slit_grid();
         let adj = adjacency(pos.len(), &tris);
-        let opp = edge_opposites(&tris);
+        let vt = VertexTriangles::new(pos.len(), &tris);
+        let opp = (&vt, tris.as_slice());
         // Start 2.5 at x = 0 (right corner, −x side), end 2.4 at x = 4.
-        let upper = lip_walk(&pos, &adj, &opp, 10, 14, true).unwrap();
-        let lower = lip_walk(&pos, &adj, &opp, 10, 14, false).unwrap();
+        let upper = lip_walk(&pos, &adj, opp, 10, 14, true).unwrap();
+        let lower = lip_walk(&pos, &adj, opp, 10, 14, false).unwrap();
         assert_eq!(upper, vec![10, 25, 26, 27, 14]);
         assert_eq!(lower, vec![10, 11, 12, 13, 14]);
     }

@@ -5,9 +5,13 @@
 use std::collections::HashMap;
 
 use glam::Vec3;
-use parry3d::math::Vector as PVec;
-use parry3d::query::{PointQuery, Ray, RayCast};
-use parry3d::shape::TriMesh;
+use parry3d::math::{Pose, Vector as PVec};
+use parry3d::partitioning::Bvh;
+use parry3d::query::details::NormalConstraints;
+use parry3d::query::Ray;
+use parry3d::shape::{
+    CompositeShape, CompositeShapeRef, Shape, TriMesh, Triangle, TypedCompositeShape,
+};
 
 use super::regions::{Region, TriRegion};
 
@@ -30,16 +34,52 @@ pub(crate) fn adjacency(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<
     adj
 }
 
-/// For every undirected edge `(min, max)`, the third vertices of the triangles that share it.
-pub(crate) fn edge_opposites(triangles: &[[u32; 3]]) -> HashMap<(u32, u32), Vec<u32>> {
-    let mut map: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
-            map.entry((a.min(b), a.max(b))).or_default().push(c);
+/// The triangles around each vertex (compressed rows), to find the triangles on either side
+/// of an edge without a hash map over all edges.
+pub(crate) struct VertexTriangles {
+    start: Vec<u32>,
+    tris: Vec<u32>,
+}
+
+impl VertexTriangles {
+    pub fn new(vertex_count: usize, triangles: &[[u32; 3]]) -> Self {
+        let mut start = vec![0u32; vertex_count + 1];
+        for t in triangles {
+            for &v in t {
+                start[v as usize + 1] += 1;
+            }
         }
+        for i in 0..vertex_count {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut tris = vec![0u32; start[vertex_count] as usize];
+        for (k, t) in triangles.iter().enumerate() {
+            for &v in t {
+                tris[fill[v as usize] as usize] = k as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        VertexTriangles { start, tris }
     }
-    map
+
+    /// Third vertices of the triangles that have edge `a–b`.
+    pub fn opposites<'a>(
+        &'a self,
+        triangles: &'a [[u32; 3]],
+        a: u32,
+        b: u32,
+    ) -> impl Iterator<Item = u32> + 'a {
+        let range = self.start[a as usize] as usize..self.start[a as usize + 1] as usize;
+        self.tris[range].iter().filter_map(move |&k| {
+            let t = triangles[k as usize];
+            if t.contains(&b) {
+                t.iter().copied().find(|&w| w != a && w != b)
+            } else {
+                None
+            }
+        })
+    }
 }
 
 /// Area-weighted vertex normals (unit length; zero for isolated or degenerate vertices).
@@ -124,32 +164,6 @@ fn gvec(v: PVec) -> Vec3 {
     Vec3::new(v.x, v.y, v.z)
 }
 
-/// One BVH over a subset of a surface's triangles.
-struct Part {
-    mesh: TriMesh,
-    /// Part-local triangle index → surface triangle index.
-    triangles: Vec<u32>,
-}
-
-impl Part {
-    fn new(
-        positions: &[Vec3],
-        triangles: &[[u32; 3]],
-        keep: impl Fn(usize) -> bool,
-    ) -> Option<Part> {
-        let ids: Vec<u32> = (0..triangles.len())
-            .filter(|&t| keep(t))
-            .map(|t| t as u32)
-            .collect();
-        let idx: Vec<[u32; 3]> = ids.iter().map(|&t| triangles[t as usize]).collect();
-        let verts = positions.iter().map(|&p| pvec(p)).collect();
-        TriMesh::new(verts, idx).ok().map(|mesh| Part {
-            mesh,
-            triangles: ids,
-        })
-    }
-}
-
 /// A surface hit: triangle and point on it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Hit {
@@ -159,45 +173,87 @@ pub(crate) struct Hit {
     pub point: Vec3,
 }
 
-/// Ray and closest-point queries on a surface, restricted by lip region: a query for an
-/// upper-lip vertex never sees lower-lip (or mixed) triangles, and vice versa.
+/// Ray and closest-point queries on a surface (one parry3d BVH), restricted by lip region: a
+/// query for an upper-lip vertex never sees lower-lip (or mixed) triangles, and vice versa.
 pub(crate) struct RegionBvh {
-    all: Option<Part>,
-    no_lower: Option<Part>,
-    no_upper: Option<Part>,
+    mesh: Option<TriMesh>,
+    regions: Vec<TriRegion>,
+}
+
+/// The surface as seen from one region: the same BVH, with the other lip's triangles
+/// skipped during traversal (so no second BVH has to be built).
+struct View<'a> {
+    mesh: &'a TriMesh,
+    regions: &'a [TriRegion],
+    query: Region,
+}
+
+impl View<'_> {
+    fn allowed(&self, triangle: u32) -> bool {
+        let Some(r) = self.regions.get(triangle as usize) else {
+            return true;
+        };
+        match self.query {
+            Region::Other => true,
+            Region::Upper => matches!(r, TriRegion::Other | TriRegion::Upper),
+            Region::Lower => matches!(r, TriRegion::Other | TriRegion::Lower),
+        }
+    }
+}
+
+impl CompositeShape for View<'_> {
+    fn map_part_at(
+        &self,
+        shape_id: u32,
+        f: &mut dyn FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>),
+    ) {
+        let _ = self.map_untyped_part_at(shape_id, f);
+    }
+
+    fn bvh(&self) -> &Bvh {
+        self.mesh.bvh()
+    }
+}
+
+impl TypedCompositeShape for View<'_> {
+    type PartShape = Triangle;
+    type PartNormalConstraints = ();
+
+    fn map_typed_part_at<T>(
+        &self,
+        i: u32,
+        mut f: impl FnMut(Option<&Pose>, &Triangle, Option<&()>) -> T,
+    ) -> Option<T> {
+        self.allowed(i)
+            .then(|| f(None, &self.mesh.triangle(i), None))
+    }
+
+    fn map_untyped_part_at<T>(
+        &self,
+        i: u32,
+        mut f: impl FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>) -> T,
+    ) -> Option<T> {
+        self.allowed(i)
+            .then(|| f(None, &self.mesh.triangle(i), None))
+    }
 }
 
 impl RegionBvh {
-    /// Builds the BVHs; `tri_regions` empty means no lip separation.
+    /// Builds the BVH; `tri_regions` empty means no lip separation.
     pub fn new(positions: &[Vec3], triangles: &[[u32; 3]], tri_regions: &[TriRegion]) -> Self {
-        let all = Part::new(positions, triangles, |_| true);
-        if tri_regions.is_empty() {
-            return RegionBvh {
-                all,
-                no_lower: None,
-                no_upper: None,
-            };
-        }
-        let no_lower = Part::new(positions, triangles, |t| {
-            matches!(tri_regions[t], TriRegion::Other | TriRegion::Upper)
-        });
-        let no_upper = Part::new(positions, triangles, |t| {
-            matches!(tri_regions[t], TriRegion::Other | TriRegion::Lower)
-        });
+        let verts = positions.iter().map(|&p| pvec(p)).collect();
         RegionBvh {
-            all,
-            no_lower,
-            no_upper,
+            mesh: TriMesh::new(verts, triangles.to_vec()).ok(),
+            regions: tri_regions.to_vec(),
         }
     }
 
-    fn part(&self, region: Region) -> Option<&Part> {
-        let restricted = match region {
-            Region::Upper => self.no_lower.as_ref(),
-            Region::Lower => self.no_upper.as_ref(),
-            Region::Other => None,
-        };
-        restricted.or(self.all.as_ref())
+    fn view(&self, region: Region) -> Option<View<'_>> {
+        Some(View {
+            mesh: self.mesh.as_ref()?,
+            regions: &self.regions,
+            query: region,
+        })
     }
 
     /// The nearest surface point along `±dir` from `origin` within `length`.
@@ -208,38 +264,36 @@ impl RegionBvh {
         dir: Vec3,
         length: f32,
     ) -> Option<Hit> {
-        let part = self.part(region)?;
-        if dir == Vec3::ZERO || !origin.is_finite() {
+        let view = self.view(region)?;
+        if dir == Vec3::ZERO || !origin.is_finite() || !dir.is_finite() {
             return None;
         }
-        let mut best: Option<(f32, Hit)> = None;
+        let mut best: Option<(f32, u32, Vec3)> = None;
         for d in [dir, -dir] {
             let ray = Ray::new(pvec(origin), pvec(d));
-            if let Some(hit) = part.mesh.cast_local_ray_and_get_normal(&ray, length, false) {
-                let t = hit.time_of_impact;
-                if best.is_none_or(|(bt, _)| t < bt) {
-                    let tri = part.triangles[hit.subshape as usize];
-                    best = Some((
-                        t,
-                        Hit {
-                            triangle: tri,
-                            point: origin + d * t,
-                        },
-                    ));
+            if let Some((tri, t)) = CompositeShapeRef(&view).cast_local_ray(&ray, length, false) {
+                if best.is_none_or(|(bt, _, _)| t < bt) {
+                    best = Some((t, tri, d));
                 }
             }
         }
-        best.map(|b| b.1)
+        best.map(|(t, triangle, d)| Hit {
+            triangle,
+            point: origin + d * t,
+        })
     }
 
     /// The closest surface point to `p`.
     pub fn closest(&self, region: Region, p: Vec3) -> Option<Hit> {
-        let part = self.part(region)?;
+        let view = self.view(region)?;
         if !p.is_finite() {
             return None;
         }
-        let proj = part.mesh.project_local_point(pvec(p), false);
-        let tri = *part.triangles.get(proj.subshape as usize)?;
+        let (tri, proj, _) = CompositeShapeRef(&view).project_local_point_and_get_location(
+            pvec(p),
+            f32::MAX,
+            false,
+        )?;
         Some(Hit {
             triangle: tri,
             point: gvec(proj.point),
@@ -287,7 +341,9 @@ mod tests {
         let n = vertex_normals(&pos, &tris);
         assert!(n[0].distance(Vec3::Z) < 1e-6 && n[4] == Vec3::ZERO);
         assert_eq!(coincidence_classes(&pos, 1e-6), vec![0, 1, 2, 3, 1]);
-        assert_eq!(edge_opposites(&tris)[&(1, 2)], vec![0, 3]);
+        let vt = VertexTriangles::new(pos.len(), &tris);
+        assert_eq!(vt.opposites(&tris, 1, 2).collect::<Vec<_>>(), vec![0, 3]);
+        assert_eq!(vt.opposites(&tris, 0, 3).count(), 0);
     }
 
     #[test]

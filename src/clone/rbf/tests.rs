@@ -58,7 +58,13 @@ fn candide_contours_follow_the_inner_lips_and_eyes() {
     let s = &face.surface;
     let adj = adjacency(s.positions.len(), &s.triangles);
     let mut warnings = Vec::new();
-    let c = contours::extract(s, &adj, &edge_opposites(&s.triangles), "t", &mut warnings);
+    let c = contours::extract(
+        s,
+        &adj,
+        &VertexTriangles::new(s.positions.len(), &s.triangles),
+        "t",
+        &mut warnings,
+    );
     assert!(warnings.is_empty(), "{warnings:?}");
     // Candide-3: 2.5 = 89, 2.4 = 88; upper 82, 2.2 = 87, 81; lower 84, 2.3 = 40, 83.
     assert_eq!(c.upper_lip.unwrap(), vec![89, 82, 87, 81, 88]);
@@ -78,7 +84,13 @@ fn candide_contours_follow_the_inner_lips_and_eyes() {
     let (r, _) = lip_regions(
         s,
         &adj,
-        &contours::extract(s, &adj, &edge_opposites(&s.triangles), "t", &mut warnings),
+        &contours::extract(
+            s,
+            &adj,
+            &VertexTriangles::new(s.positions.len(), &s.triangles),
+            "t",
+            &mut warnings,
+        ),
         true,
     );
     assert_eq!(
