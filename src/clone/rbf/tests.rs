@@ -164,10 +164,11 @@ fn closed_lips_stay_apart() {
     let Some(face) = candide(&[], 0, VALUE) else {
         return;
     };
-    let Some(wide) = candide(&RESHAPE, 0, VALUE) else {
+    let (Some(wide), Some(fine)) = (candide(&RESHAPE, 0, VALUE), candide(&RESHAPE, 1, VALUE))
+    else {
         return;
     };
-    for target in [&face, &wide] {
+    for target in [&face, &wide, &fine] {
         let r = run(&face, target);
         // FAP 4 lower_t_midlip moves 2.2 (87) down; 2.3 (40) must stay.
         assert!(offset_of(&r, 4, 87).y < 0.0);
