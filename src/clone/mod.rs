@@ -15,6 +15,7 @@
 //! Rigid parts (eyes, teeth, tongue, head) move through transforms and are handled separately.
 
 pub mod quality;
+pub mod rbf;
 
 use std::collections::BTreeMap;
 

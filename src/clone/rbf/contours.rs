@@ -1,0 +1,355 @@
+//! Step 1: eye and inner-lip contour extraction by greedy mesh walks from feature points.
+
+use std::collections::HashSet;
+
+use glam::{Vec2, Vec3};
+
+use crate::spec::FeaturePointId;
+
+use super::super::CloneSurface;
+use super::mesh::VertexTriangles;
+
+/// The extracted contours of one face (vertex paths). A contour that could not be walked is
+/// `None` and the reason is in the warnings.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Contours {
+    /// Right eye loop 3.2 ⇒ 3.8 ⇒ 3.4 ⇒ 3.12 (closed; the start is not repeated).
+    pub right_eye: Option<Vec<u32>>,
+    /// Left eye loop 3.1 ⇒ 3.7 ⇒ 3.3 ⇒ 3.11.
+    pub left_eye: Option<Vec<u32>>,
+    /// Upper inner lip, 2.5 ⇒ 2.4 (both corners included).
+    pub upper_lip: Option<Vec<u32>>,
+    /// Lower inner lip, 2.5 ⇒ 2.4.
+    pub lower_lip: Option<Vec<u32>>,
+}
+
+fn fp_vertex(surface: &CloneSurface, label: &str) -> Option<u32> {
+    let id: FeaturePointId = label.parse().ok()?;
+    surface.fp_vertices.get(&id).copied()
+}
+
+/// Extracts all four contours; failures become warnings (`what: reason`).
+pub(crate) fn extract(
+    surface: &CloneSurface,
+    adj: &[Vec<u32>],
+    incidence: &VertexTriangles,
+    face: &str,
+    warnings: &mut Vec<String>,
+) -> Contours {
+    let pos = &surface.positions;
+    let mut eye = |labels: [&str; 4], name: &str| -> Option<Vec<u32>> {
+        let fps: Option<Vec<u32>> = labels.iter().map(|l| fp_vertex(surface, l)).collect();
+        let Some(fps) = fps else {
+            warnings.push(format!(
+                "{face}: {name} contour skipped: feature points {} are not all surface vertices",
+                labels.join(", ")
+            ));
+            return None;
+        };
+        match eye_loop(pos, adj, &fps) {
+            Ok(c) => Some(c),
+            Err(e) => {
+                warnings.push(format!("{face}: {name} contour skipped: {e}"));
+                None
+            }
+        }
+    };
+    let right_eye = eye(["3.2", "3.8", "3.4", "3.12"], "right eye");
+    let left_eye = eye(["3.1", "3.7", "3.3", "3.11"], "left eye");
+    let (mut upper_lip, mut lower_lip) = (None, None);
+    match (fp_vertex(surface, "2.5"), fp_vertex(surface, "2.4")) {
+        (Some(s), Some(e)) => {
+            for (upper, slot) in [(true, &mut upper_lip), (false, &mut lower_lip)] {
+                match lip_walk(pos, adj, (incidence, &surface.triangles), s, e, upper) {
+                    Ok(c) => *slot = Some(c),
+                    Err(err) => warnings.push(format!(
+                        "{face}: {} inner lip contour skipped: {err}",
+                        if upper { "upper" } else { "lower" }
+                    )),
+                }
+            }
+        }
+        _ => warnings.push(format!(
+            "{face}: lip contours skipped: feature points 2.4 and 2.5 are not both surface vertices"
+        )),
+    }
+    Contours {
+        right_eye,
+        left_eye,
+        upper_lip,
+        lower_lip,
+    }
+}
+
+/// The eye loop through four feature-point vertices, one greedy path per quarter. Vertices
+/// of earlier quarters are not revisited (except the loop's start at the very end).
+pub(crate) fn eye_loop(pos: &[Vec3], adj: &[Vec<u32>], fps: &[u32]) -> Result<Vec<u32>, String> {
+    let mut visited: HashSet<u32> = HashSet::new();
+    let mut contour = vec![fps[0]];
+    visited.insert(fps[0]);
+    for k in 0..fps.len() {
+        let (start, end) = (fps[k], fps[(k + 1) % fps.len()]);
+        let path = greedy_path(pos, adj, start, end, &mut visited)?;
+        contour.extend(path);
+    }
+    // The last quarter ends at the start vertex again.
+    contour.pop();
+    Ok(contour)
+}
+
+/// The paper's greedy walk from `start` to `end`: from `v` step to the neighbour `n` whose
+/// direction `(n − v)/‖n − v‖` points best towards `end`. The paper minimises
+/// `‖v + n̂ − end‖` with a unit step, which depends on the model's unit of length; we use its
+/// scale-free limit (largest cosine between `n − v` and `end − v`, ties to the neighbour
+/// nearer `end`), and step to `end` directly when it is a neighbour. Visited vertices are
+/// never re-entered and the walk is capped at the vertex count, so it always terminates;
+/// it fails when it runs into a dead end. Returns the path without `start`, ending at `end`.
+pub(crate) fn greedy_path(
+    pos: &[Vec3],
+    adj: &[Vec<u32>],
+    start: u32,
+    end: u32,
+    visited: &mut HashSet<u32>,
+) -> Result<Vec<u32>, String> {
+    let mut path = Vec::new();
+    let mut v = start;
+    let target = pos[end as usize];
+    while v != end {
+        if path.len() > pos.len() {
+            return Err(format!("walk {start}⇒{end} exceeded the step cap"));
+        }
+        let here = pos[v as usize];
+        let next = if adj[v as usize].contains(&end) {
+            Some(end)
+        } else {
+            let to_end = (target - here).normalize_or_zero();
+            adj[v as usize]
+                .iter()
+                .copied()
+                .filter(|n| !visited.contains(n))
+                .filter_map(|n| {
+                    let d = pos[n as usize] - here;
+                    let len = d.length();
+                    (len > 0.0).then(|| (n, d.dot(to_end) / len, pos[n as usize].distance(target)))
+                })
+                .max_by(|a, b| a.1.total_cmp(&b.1).then(b.2.total_cmp(&a.2)))
+                .map(|c| c.0)
+        };
+        let Some(n) = next else {
+            return Err(format!(
+                "walk {start}⇒{end} reached a dead end at vertex {v}"
+            ));
+        };
+        visited.insert(n);
+        path.push(n);
+        v = n;
+    }
+    Ok(path)
+}
+
+fn cross2(a: Vec2, b: Vec2) -> f32 {
+    a.x * b.y - a.y * b.x
+}
+
+/// The inner-lip walk from 2.5 to 2.4 (paper: at each step the neighbour with the smallest
+/// [upper] or greatest [lower] xy-plane angle to `v_direction = end − start`, within
+/// (−π/2, π/2)).
+///
+/// Taken literally the rule fails at the corners: there the lower lip's first vertex has the
+/// smallest angle, and on a closed mouth the upper and lower candidates coincide. We keep the
+/// angle rule, measured towards "up" (so the sign does not depend on which way x points), but
+/// rank the candidate edges first by topology: (0) edges whose triangles all lie on the lip's
+/// own side — the border of the mouth opening, which on an open or closed (slit) mouth is the
+/// inner lip contour; (1) edges with some triangle on that side; (2) the rest. "The lip's own
+/// side" of an edge `v → n` is left of it for the upper lip when walking towards +x (above
+/// the edge), right of it for the lower lip. Coincident upper/lower vertices of a closed
+/// mouth are therefore told apart by topology, not by position. Ties go to the vertex nearer
+/// the end; zero-length edges are skipped, visited vertices never re-entered, and the walk
+/// is capped at the vertex count, so it always terminates.
+pub(crate) fn lip_walk(
+    pos: &[Vec3],
+    adj: &[Vec<u32>],
+    (incidence, triangles): (&VertexTriangles, &[[u32; 3]]),
+    start: u32,
+    end: u32,
+    upper: bool,
+) -> Result<Vec<u32>, String> {
+    let xy = |i: u32| pos[i as usize].truncate();
+    let dir = xy(end) - xy(start);
+    if dir.x == 0.0 {
+        return Err("lip corners 2.4 and 2.5 have the same x".into());
+    }
+    let dir = dir.normalize();
+    // +1 when "left of the walking direction" is up (+y).
+    let up = dir.x.signum();
+    let mut visited: HashSet<u32> = HashSet::from([start]);
+    let mut contour = vec![start];
+    let mut v = start;
+    while v != end {
+        if contour.len() > pos.len() {
+            return Err("lip walk exceeded the step cap".into());
+        }
+        let cands: Vec<(u32, f32, u8)> = adj[v as usize]
+            .iter()
+            .copied()
+            .filter(|n| !visited.contains(n))
+            .filter_map(|n| {
+                let d = xy(n) - xy(v);
+                if d.length() == 0.0 {
+                    return None;
+                }
+                let a = cross2(dir, d).atan2(dir.dot(d)) * up;
+                if a.abs() >= std::f32::consts::FRAC_PI_2 {
+                    return None;
+                }
+                let ws: Vec<u32> = incidence.opposites(triangles, v, n).collect();
+                let own_side = |w: &u32| {
+                    let s = cross2(d, xy(*w) - xy(v)) * up;
+                    if upper {
+                        s > 0.0
+                    } else {
+                        s < 0.0
+                    }
+                };
+                let on_side = ws.iter().filter(|w| own_side(w)).count();
+                // Tier 0: the edge borders the mouth (triangles on the lip's side only);
+                // tier 1: some triangle on the lip's side; tier 2: anything else.
+                let tier = if on_side > 0 && on_side == ws.len() {
+                    0
+                } else if on_side > 0 {
+                    1
+                } else {
+                    2
+                };
+                Some((n, a, tier))
+            })
+            .collect();
+        let target = pos[end as usize];
+        let pick = cands
+            .iter()
+            .min_by(|a, b| {
+                let (ka, kb) = if upper { (a.1, b.1) } else { (-a.1, -b.1) };
+                a.2.cmp(&b.2).then(ka.total_cmp(&kb)).then(
+                    pos[a.0 as usize]
+                        .distance(target)
+                        .total_cmp(&pos[b.0 as usize].distance(target)),
+                )
+            })
+            .map(|c| c.0);
+        let Some(n) = pick else {
+            return Err(format!("lip walk reached a dead end at vertex {v}"));
+        };
+        visited.insert(n);
+        contour.push(n);
+        v = n;
+    }
+    Ok(contour)
+}
+
+/// The point nearest `p` on a polyline (closed: also the segment last → first).
+pub(crate) fn nearest_on_polyline(p: Vec3, pts: &[Vec3], closed: bool) -> Option<Vec3> {
+    let segs = if closed {
+        pts.len()
+    } else {
+        pts.len().saturating_sub(1)
+    };
+    let mut best: Option<(f32, Vec3)> = None;
+    if pts.len() == 1 {
+        return Some(pts[0]);
+    }
+    for i in 0..segs {
+        let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+        let ab = b - a;
+        let t = if ab.length_squared() > 0.0 {
+            ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let q = a + ab * t;
+        let d = q.distance_squared(p);
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, q));
+        }
+    }
+    best.map(|b| b.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::mesh::adjacency;
+    use super::*;
+
+    /// A 5×5 grid of vertices (x, y in 0..4) with a slit mouth along y = 2 between the
+    /// corners (0,2) and (4,2): the middle row is duplicated (upper copies 25..=27 for
+    /// x = 1..3), so upper and lower lip vertices coincide, as on a closed-mouth face.
+    fn slit_grid() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut pos: Vec<Vec3> = (0..25)
+            .map(|i| Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0))
+            .collect();
+        for x in 1..4 {
+            pos.push(Vec3::new(x as f32, 2.0, 0.0));
+        }
+        let id = |x: u32, y: u32, from_above: bool| -> u32 {
+            if y == 2 && (1..4).contains(&x) && from_above {
+                24 + x
+            } else {
+                y * 5 + x
+            }
+        };
+        let mut tris = Vec::new();
+        for y in 0..4 {
+            for x in 0..4 {
+                // Cells above the slit use the upper copies of row 2.
+                let above = y == 2;
+                let (a, b) = (id(x, y, above), id(x + 1, y, above));
+                let (c, d) = (id(x + 1, y + 1, above), id(x, y + 1, above));
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            }
+        }
+        (pos, tris)
+    }
+
+    #[test]
+    fn lip_walks_separate_a_closed_slit_mouth() {
+        let (pos, tris) = slit_grid();
+        let adj = adjacency(pos.len(), &tris);
+        let vt = VertexTriangles::new(pos.len(), &tris);
+        let opp = (&vt, tris.as_slice());
+        // Start 2.5 at x = 0 (right corner, −x side), end 2.4 at x = 4.
+        let upper = lip_walk(&pos, &adj, opp, 10, 14, true).unwrap();
+        let lower = lip_walk(&pos, &adj, opp, 10, 14, false).unwrap();
+        assert_eq!(upper, vec![10, 25, 26, 27, 14]);
+        assert_eq!(lower, vec![10, 11, 12, 13, 14]);
+    }
+
+    #[test]
+    fn greedy_eye_loop_walks_around_a_ring() {
+        // An octagon ring around a centre vertex 8, plus the centre.
+        let mut pos: Vec<Vec3> = (0..8)
+            .map(|k| {
+                let a = k as f32 * std::f32::consts::FRAC_PI_4;
+                Vec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        pos.push(Vec3::ZERO);
+        let tris: Vec<[u32; 3]> = (0..8).map(|k| [8, k, (k + 1) % 8]).collect();
+        let adj = adjacency(pos.len(), &tris);
+        // UP (2) ⇒ LEFT (4) ⇒ DOWN (6) ⇒ RIGHT (0).
+        let c = eye_loop(&pos, &adj, &[2, 4, 6, 0]).unwrap();
+        assert_eq!(c, vec![2, 3, 4, 5, 6, 7, 0, 1]);
+        // A dead end is an error, not a hang: an isolated end vertex.
+        pos.push(Vec3::new(5.0, 5.0, 0.0));
+        let adj = adjacency(pos.len(), &tris);
+        assert!(eye_loop(&pos, &adj, &[2, 9, 6, 0]).is_err());
+    }
+
+    #[test]
+    fn nearest_point_on_polyline() {
+        let pts = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0)];
+        let q = nearest_on_polyline(Vec3::new(0.5, -1.0, 0.0), &pts, false).unwrap();
+        assert!(q.distance(Vec3::new(0.5, 0.0, 0.0)) < 1e-6);
+        let q = nearest_on_polyline(Vec3::new(0.2, 0.8, 0.0), &pts, true).unwrap();
+        assert!(q.distance(Vec3::new(0.5, 0.5, 0.0)) < 1e-6);
+    }
+}

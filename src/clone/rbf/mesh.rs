@@ -1,0 +1,372 @@
+//! Mesh helpers for the RBF cloning method: vertex adjacency, vertex normals, barycentric
+//! coordinates, groups of coincident vertices and region-filtered ray/closest-point queries
+//! (parry3d BVHs).
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+use parry3d::math::{Pose, Vector as PVec};
+use parry3d::partitioning::Bvh;
+use parry3d::query::details::NormalConstraints;
+use parry3d::query::Ray;
+use parry3d::shape::{
+    CompositeShape, CompositeShapeRef, Shape, TriMesh, Triangle, TypedCompositeShape,
+};
+
+use super::regions::{Region, TriRegion};
+
+/// Sorted, de-duplicated neighbours of every vertex (edges of the triangles).
+pub(crate) fn adjacency(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut adj = vec![Vec::new(); vertex_count];
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if a != b {
+                adj[a as usize].push(b);
+                adj[b as usize].push(a);
+            }
+        }
+    }
+    for n in &mut adj {
+        n.sort_unstable();
+        n.dedup();
+    }
+    adj
+}
+
+/// The triangles around each vertex (compressed rows), to find the triangles on either side
+/// of an edge without a hash map over all edges.
+pub(crate) struct VertexTriangles {
+    start: Vec<u32>,
+    tris: Vec<u32>,
+}
+
+impl VertexTriangles {
+    pub fn new(vertex_count: usize, triangles: &[[u32; 3]]) -> Self {
+        let mut start = vec![0u32; vertex_count + 1];
+        for t in triangles {
+            for &v in t {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for i in 0..vertex_count {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut tris = vec![0u32; start[vertex_count] as usize];
+        for (k, t) in triangles.iter().enumerate() {
+            for &v in t {
+                tris[fill[v as usize] as usize] = k as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        VertexTriangles { start, tris }
+    }
+
+    /// Third vertices of the triangles that have edge `a–b`.
+    pub fn opposites<'a>(
+        &'a self,
+        triangles: &'a [[u32; 3]],
+        a: u32,
+        b: u32,
+    ) -> impl Iterator<Item = u32> + 'a {
+        let range = self.start[a as usize] as usize..self.start[a as usize + 1] as usize;
+        self.tris[range].iter().filter_map(move |&k| {
+            let t = triangles[k as usize];
+            if t.contains(&b) {
+                t.iter().copied().find(|&w| w != a && w != b)
+            } else {
+                None
+            }
+        })
+    }
+}
+
+/// Area-weighted vertex normals (unit length; zero for isolated or degenerate vertices).
+pub(crate) fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::ZERO; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        // The cross product's length is twice the area: area weighting comes for free.
+        let face = (b - a).cross(c - a);
+        for &i in t {
+            n[i as usize] += face;
+        }
+    }
+    for v in &mut n {
+        *v = v.normalize_or_zero();
+    }
+    n
+}
+
+/// Barycentric coordinates `(wa, wb, wc)` of `p` with respect to triangle `a b c`, for a
+/// point on (or very near) the triangle. Small negative weights from rounding are clamped and
+/// the weights renormalised; a degenerate triangle gives its vertex nearest to `p` weight 1.
+pub(crate) fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+    let (e0, e1, ep) = ((b - a).as_dvec3(), (c - a).as_dvec3(), (p - a).as_dvec3());
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let (d20, d21) = (ep.dot(e0), ep.dot(e1));
+    let denom = d00 * d11 - d01 * d01;
+    let scale = d00.max(d11);
+    if denom.is_nan() || denom <= 1e-12 * scale * scale {
+        let d = [p.distance(a), p.distance(b), p.distance(c)];
+        let k = (0..3).min_by(|&i, &j| d[i].total_cmp(&d[j])).unwrap_or(0);
+        let mut w = [0.0; 3];
+        w[k] = 1.0;
+        return w;
+    }
+    let v = (d11 * d20 - d01 * d21) / denom;
+    let w = (d00 * d21 - d01 * d20) / denom;
+    let mut out = [(1.0 - v - w).max(0.0), v.max(0.0), w.max(0.0)];
+    let s: f64 = out.iter().sum();
+    for x in &mut out {
+        *x /= s;
+    }
+    out.map(|x| x as f32)
+}
+
+/// Groups of vertices at the same position (within `eps`): `class[v]` is the smallest vertex
+/// index of `v`'s group. A closed mouth has such pairs (upper and lower inner lip).
+pub(crate) fn coincidence_classes(positions: &[Vec3], eps: f32) -> Vec<u32> {
+    let cell = |p: Vec3| -> [i64; 3] { (p / eps).floor().to_array().map(|x| x as i64) };
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut class: Vec<u32> = (0..positions.len() as u32).collect();
+    for (i, &p) in positions.iter().enumerate() {
+        let c = cell(p);
+        let mut found = None;
+        'search: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    if let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                        for &j in list {
+                            if positions[j as usize].distance(p) <= eps {
+                                found = Some(class[j as usize]);
+                                break 'search;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(k) = found {
+            class[i] = k;
+        }
+        grid.entry(c).or_default().push(i as u32);
+    }
+    class
+}
+
+fn pvec(v: Vec3) -> PVec {
+    PVec::new(v.x, v.y, v.z)
+}
+
+fn gvec(v: PVec) -> Vec3 {
+    Vec3::new(v.x, v.y, v.z)
+}
+
+/// A surface hit: triangle and point on it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Hit {
+    /// Surface triangle index.
+    pub triangle: u32,
+    /// The point on that triangle.
+    pub point: Vec3,
+}
+
+/// Ray and closest-point queries on a surface (one parry3d BVH), restricted by lip region: a
+/// query for an upper-lip vertex never sees lower-lip (or mixed) triangles, and vice versa.
+pub(crate) struct RegionBvh {
+    mesh: Option<TriMesh>,
+    regions: Vec<TriRegion>,
+}
+
+/// The surface as seen from one region: the same BVH, with the other lip's triangles
+/// skipped during traversal (so no second BVH has to be built).
+struct View<'a> {
+    mesh: &'a TriMesh,
+    regions: &'a [TriRegion],
+    query: Region,
+}
+
+impl View<'_> {
+    fn allowed(&self, triangle: u32) -> bool {
+        let Some(r) = self.regions.get(triangle as usize) else {
+            return true;
+        };
+        match self.query {
+            Region::Other => true,
+            Region::Upper => matches!(r, TriRegion::Other | TriRegion::Upper),
+            Region::Lower => matches!(r, TriRegion::Other | TriRegion::Lower),
+        }
+    }
+}
+
+impl CompositeShape for View<'_> {
+    fn map_part_at(
+        &self,
+        shape_id: u32,
+        f: &mut dyn FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>),
+    ) {
+        let _ = self.map_untyped_part_at(shape_id, f);
+    }
+
+    fn bvh(&self) -> &Bvh {
+        self.mesh.bvh()
+    }
+}
+
+impl TypedCompositeShape for View<'_> {
+    type PartShape = Triangle;
+    type PartNormalConstraints = ();
+
+    fn map_typed_part_at<T>(
+        &self,
+        i: u32,
+        mut f: impl FnMut(Option<&Pose>, &Triangle, Option<&()>) -> T,
+    ) -> Option<T> {
+        self.allowed(i)
+            .then(|| f(None, &self.mesh.triangle(i), None))
+    }
+
+    fn map_untyped_part_at<T>(
+        &self,
+        i: u32,
+        mut f: impl FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>) -> T,
+    ) -> Option<T> {
+        self.allowed(i)
+            .then(|| f(None, &self.mesh.triangle(i), None))
+    }
+}
+
+impl RegionBvh {
+    /// Builds the BVH; `tri_regions` empty means no lip separation.
+    pub fn new(positions: &[Vec3], triangles: &[[u32; 3]], tri_regions: &[TriRegion]) -> Self {
+        let verts = positions.iter().map(|&p| pvec(p)).collect();
+        RegionBvh {
+            mesh: TriMesh::new(verts, triangles.to_vec()).ok(),
+            regions: tri_regions.to_vec(),
+        }
+    }
+
+    fn view(&self, region: Region) -> Option<View<'_>> {
+        Some(View {
+            mesh: self.mesh.as_ref()?,
+            regions: &self.regions,
+            query: region,
+        })
+    }
+
+    /// The nearest surface point along `±dir` from `origin` within `length`.
+    pub fn ray_both_ways(
+        &self,
+        region: Region,
+        origin: Vec3,
+        dir: Vec3,
+        length: f32,
+    ) -> Option<Hit> {
+        let view = self.view(region)?;
+        if dir == Vec3::ZERO || !origin.is_finite() || !dir.is_finite() {
+            return None;
+        }
+        let mut best: Option<(f32, u32, Vec3)> = None;
+        for d in [dir, -dir] {
+            let ray = Ray::new(pvec(origin), pvec(d));
+            if let Some((tri, t)) = CompositeShapeRef(&view).cast_local_ray(&ray, length, false) {
+                if best.is_none_or(|(bt, _, _)| t < bt) {
+                    best = Some((t, tri, d));
+                }
+            }
+        }
+        best.map(|(t, triangle, d)| Hit {
+            triangle,
+            point: origin + d * t,
+        })
+    }
+
+    /// The closest surface point to `p`.
+    pub fn closest(&self, region: Region, p: Vec3) -> Option<Hit> {
+        let view = self.view(region)?;
+        if !p.is_finite() {
+            return None;
+        }
+        let (tri, proj, _) = CompositeShapeRef(&view).project_local_point_and_get_location(
+            pvec(p),
+            f32::MAX,
+            false,
+        )?;
+        Some(Hit {
+            triangle: tri,
+            point: gvec(proj.point),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn barycentric_reproduces_points_and_clamps() {
+        let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        let w = barycentric(Vec3::new(0.25, 0.5, 0.0), a, b, c);
+        assert!(
+            (w[0] - 0.25).abs() < 1e-6 && (w[1] - 0.25).abs() < 1e-6 && (w[2] - 0.5).abs() < 1e-6
+        );
+        let back = a * w[0] + b * w[1] + c * w[2];
+        assert!(back.distance(Vec3::new(0.25, 0.5, 0.0)) < 1e-6);
+        assert_eq!(barycentric(b, a, b, c), [0.0, 1.0, 0.0]);
+        // Slightly outside: clamped, still sums to one.
+        let w = barycentric(Vec3::new(-1e-4, 0.5, 0.0), a, b, c);
+        assert!(w.iter().all(|&x| x >= 0.0) && (w.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        // Degenerate triangle: nearest vertex.
+        assert_eq!(
+            barycentric(Vec3::X * 0.9, a, Vec3::X, Vec3::X * 2.0)[1],
+            1.0
+        );
+    }
+
+    #[test]
+    fn adjacency_normals_and_classes() {
+        let pos = vec![
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::Y,
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::X,
+        ];
+        let tris = vec![[0, 1, 2], [1, 3, 2]];
+        let adj = adjacency(pos.len(), &tris);
+        assert_eq!(adj[1], vec![0, 2, 3]);
+        assert!(adj[4].is_empty());
+        let n = vertex_normals(&pos, &tris);
+        assert!(n[0].distance(Vec3::Z) < 1e-6 && n[4] == Vec3::ZERO);
+        assert_eq!(coincidence_classes(&pos, 1e-6), vec![0, 1, 2, 3, 1]);
+        let vt = VertexTriangles::new(pos.len(), &tris);
+        assert_eq!(vt.opposites(&tris, 1, 2).collect::<Vec<_>>(), vec![0, 3]);
+        assert_eq!(vt.opposites(&tris, 0, 3).count(), 0);
+    }
+
+    #[test]
+    fn rays_hit_through_vertices_or_fall_back() {
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+        let tris = vec![[0, 1, 2], [1, 3, 2]];
+        let bvh = RegionBvh::new(&pos, &tris, &[]);
+        let h = bvh
+            .ray_both_ways(Region::Other, Vec3::new(0.2, 0.2, -0.5), Vec3::Z, 1.0)
+            .unwrap();
+        assert_eq!(h.triangle, 0);
+        assert!(h.point.distance(Vec3::new(0.2, 0.2, 0.0)) < 1e-6);
+        // Backwards along the direction too.
+        let h = bvh
+            .ray_both_ways(Region::Other, Vec3::new(0.8, 0.8, 0.5), Vec3::Z, 1.0)
+            .unwrap();
+        assert_eq!(h.triangle, 1);
+        assert!(bvh
+            .ray_both_ways(Region::Other, Vec3::new(0.8, 0.8, 5.0), Vec3::Z, 1.0)
+            .is_none());
+        let c = bvh
+            .closest(Region::Other, Vec3::new(2.0, 0.5, 0.3))
+            .unwrap();
+        assert!(c.point.distance(Vec3::new(1.0, 0.5, 0.0)) < 1e-6);
+    }
+}
