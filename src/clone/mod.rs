@@ -14,6 +14,7 @@
 //! points and its FAPU. Motions are sparse morph targets on that surface ([`SurfaceMotion`]).
 //! Rigid parts (eyes, teeth, tongue, head) move through transforms and are handled separately.
 
+pub mod fmc;
 pub mod quality;
 pub mod rbf;
 

@@ -1,0 +1,320 @@
+//! Step 4 — interpolation from a 2D triangle mesh (the paper's "Interpolation from 2D triangle
+//! mesh" section): bounding-box test (an R-tree of triangle boxes), barycentric coordinates,
+//! overlap resolution by the smallest interpolated depth, and the closest-triangle rule with
+//! clamped, renormalised coordinates for points outside every triangle.
+
+use glam::DVec2;
+use rstar::{Envelope, PointDistance, RTree, RTreeObject, AABB};
+
+/// Tolerance on the sum of excess barycentric coordinates under which a point counts as
+/// inside (points on shared edges and vertices must be inside both neighbours).
+const INSIDE_EPS: f64 = 1e-9;
+
+/// Depth differences below this are the same surface (shared edges), not an overlap.
+const DEPTH_EPS: f64 = 1e-9;
+
+/// How many allowed triangles, nearest bounding box first, the closest-triangle rule examines.
+/// The paper's measure (sum of excess barycentrics) is not a Euclidean distance, so an exact
+/// minimum needs every triangle; the few nearest boxes always contain the closest triangle on
+/// a mesh whose triangles are of similar size, and keep the search logarithmic.
+const OUTSIDE_CANDIDATES: usize = 16;
+
+/// Barycentric coordinates of `p` in triangle `(a, b, c)`, `None` for a degenerate triangle.
+pub(crate) fn barycentric(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> Option<[f64; 3]> {
+    let (v0, v1, v2) = (b - a, c - a, p - a);
+    let det = v0.x * v1.y - v1.x * v0.y;
+    let scale = v0.length_squared().max(v1.length_squared());
+    // Relative test: |det| / edge² is the sine of the angle at `a`; NaN fails it too.
+    if det.abs().partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let b1 = (v2.x * v1.y - v1.x * v2.y) / det;
+    let b2 = (v0.x * v2.y - v2.x * v0.y) / det;
+    Some([1.0 - b1 - b2, b1, b2])
+}
+
+/// The paper's distance of a point to a triangle: the sum of the barycentric coordinates'
+/// excess below 0 and above 1.
+pub(crate) fn excess(b: [f64; 3]) -> f64 {
+    b.iter()
+        .map(|&x| {
+            if x < 0.0 {
+                -x
+            } else if x > 1.0 {
+                x - 1.0
+            } else {
+                0.0
+            }
+        })
+        .sum()
+}
+
+/// The paper's closest point on the triangle: coordinates truncated to [0, 1] and divided by
+/// their sum (never zero: coordinates sum to 1, so one of them is positive).
+pub(crate) fn clamp(b: [f64; 3]) -> [f64; 3] {
+    let c = b.map(|x| x.clamp(0.0, 1.0));
+    let s: f64 = c.iter().sum();
+    c.map(|x| x / s)
+}
+
+/// A triangle's bounding box in the R-tree.
+struct TriBox {
+    tri: u32,
+    aabb: AABB<[f64; 2]>,
+}
+
+impl RTreeObject for TriBox {
+    type Envelope = AABB<[f64; 2]>;
+    fn envelope(&self) -> Self::Envelope {
+        self.aabb
+    }
+}
+
+impl PointDistance for TriBox {
+    fn distance_2(&self, point: &[f64; 2]) -> f64 {
+        self.aabb.distance_2(point)
+    }
+    fn contains_point(&self, point: &[f64; 2]) -> bool {
+        self.aabb.contains_point(point)
+    }
+}
+
+/// Where a point fell: the chosen triangle and the coordinates to interpolate with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Hit {
+    /// Index into [`TriMesh2::triangles`].
+    pub tri: u32,
+    /// Barycentric coordinates (clamped and renormalised when `outside`).
+    pub bary: [f64; 3],
+    /// The point was outside every allowed triangle (closest-triangle rule).
+    pub outside: bool,
+    /// The point was inside several allowed triangles at different depths.
+    pub overlap: bool,
+}
+
+/// Input points with depths and a triangulation, indexed for point location.
+pub(crate) struct TriMesh2 {
+    /// Input points P_i.
+    pub points: Vec<DVec2>,
+    /// Depth of each point; smaller is in front.
+    pub depth: Vec<f64>,
+    /// The non-degenerate triangles, as given (degenerate ones are dropped).
+    pub triangles: Vec<[u32; 3]>,
+    /// For each kept triangle, its index in the caller's list.
+    pub original: Vec<u32>,
+    tree: RTree<TriBox>,
+}
+
+impl TriMesh2 {
+    /// Indexes `triangles` over `points`. Triangles with zero area, an out-of-range index or
+    /// a horizontal extent over `max_width` (a cylinder seam) are left out.
+    pub fn new(
+        points: Vec<DVec2>,
+        depth: Vec<f64>,
+        triangles: &[[u32; 3]],
+        max_width: f64,
+    ) -> TriMesh2 {
+        let mut kept = Vec::with_capacity(triangles.len());
+        let mut original = Vec::with_capacity(triangles.len());
+        let mut boxes = Vec::with_capacity(triangles.len());
+        for (i, t) in triangles.iter().enumerate() {
+            if t.iter().any(|&v| v as usize >= points.len()) {
+                continue;
+            }
+            let [a, b, c] = t.map(|v| points[v as usize]);
+            if barycentric(a, a, b, c).is_none() {
+                continue;
+            }
+            let lo = a.min(b).min(c);
+            let hi = a.max(b).max(c);
+            if hi.x - lo.x > max_width {
+                continue;
+            }
+            boxes.push(TriBox {
+                tri: kept.len() as u32,
+                aabb: AABB::from_corners([lo.x, lo.y], [hi.x, hi.y]),
+            });
+            kept.push(*t);
+            original.push(i as u32);
+        }
+        TriMesh2 {
+            points,
+            depth,
+            triangles: kept,
+            original,
+            tree: RTree::bulk_load(boxes),
+        }
+    }
+
+    fn coords(&self, tri: u32, p: DVec2) -> [f64; 3] {
+        let [a, b, c] = self.triangles[tri as usize].map(|v| self.points[v as usize]);
+        // Kept triangles are non-degenerate, so this is always `Some`.
+        barycentric(p, a, b, c).unwrap_or([1.0 / 3.0; 3])
+    }
+
+    fn depth_at(&self, tri: u32, b: [f64; 3]) -> f64 {
+        let t = self.triangles[tri as usize];
+        (0..3).map(|k| b[k] * self.depth[t[k] as usize]).sum()
+    }
+
+    /// Locates `p` among the triangles for which `allowed(kept index)` holds: the front-most
+    /// (smallest interpolated depth) containing triangle — or, with `near = Some(d)`, the one
+    /// whose interpolated depth is closest to `d` — else the closest one by the excess
+    /// measure with clamped coordinates. `None` only when no triangle is allowed.
+    pub fn locate(
+        &self,
+        p: DVec2,
+        near: Option<f64>,
+        allowed: impl Fn(u32) -> bool,
+    ) -> Option<Hit> {
+        let mut best: Option<(f64, u32, [f64; 3])> = None;
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for tb in self.tree.locate_all_at_point([p.x, p.y]) {
+            if !allowed(tb.tri) {
+                continue;
+            }
+            let b = self.coords(tb.tri, p);
+            if excess(b) > INSIDE_EPS {
+                continue;
+            }
+            let raw = self.depth_at(tb.tri, b);
+            (lo, hi) = (lo.min(raw), hi.max(raw));
+            let d = near.map_or(raw, |n| (raw - n).abs());
+            // Ties (shared edges) go to the lower index, for determinism.
+            let better = best.is_none_or(|(bd, bt, _)| {
+                d < bd - DEPTH_EPS || ((d - bd).abs() <= DEPTH_EPS && tb.tri < bt)
+            });
+            if better {
+                best = Some((d, tb.tri, b));
+            }
+        }
+        let overlap = hi - lo > DEPTH_EPS;
+        if let Some((_, tri, bary)) = best {
+            return Some(Hit {
+                tri,
+                bary,
+                outside: false,
+                overlap,
+            });
+        }
+        let mut closest: Option<(f64, u32, [f64; 3])> = None;
+        for tb in self
+            .tree
+            .nearest_neighbor_iter([p.x, p.y])
+            .filter(|tb| allowed(tb.tri))
+            .take(OUTSIDE_CANDIDATES)
+        {
+            let b = self.coords(tb.tri, p);
+            let e = excess(b);
+            if closest.is_none_or(|(ce, ct, _)| e < ce || (e == ce && tb.tri < ct)) {
+                closest = Some((e, tb.tri, b));
+            }
+        }
+        closest.map(|(_, tri, b)| Hit {
+            tri,
+            bary: clamp(b),
+            outside: true,
+            overlap: false,
+        })
+    }
+
+    /// The input-point indices and weights of a hit.
+    pub fn weights(&self, hit: &Hit) -> [(u32, f64); 3] {
+        let t = self.triangles[hit.tri as usize];
+        [
+            (t[0], hit.bary[0]),
+            (t[1], hit.bary[1]),
+            (t[2], hit.bary[2]),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> TriMesh2 {
+        // Two triangles of the unit square, plus a small triangle in front overlapping the
+        // upper-right corner of the square.
+        let points = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(0.0, 1.0),
+            DVec2::new(0.6, 0.6),
+            DVec2::new(1.2, 0.6),
+            DVec2::new(0.6, 1.2),
+        ];
+        let depth = vec![1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+        TriMesh2::new(points, depth, &[[0, 1, 2], [0, 2, 3], [4, 5, 6]], 10.0)
+    }
+
+    #[test]
+    fn barycentric_matches_hand_computation() {
+        let b = barycentric(
+            DVec2::new(0.25, 0.5),
+            DVec2::ZERO,
+            DVec2::new(1.0, 0.0),
+            DVec2::new(0.0, 1.0),
+        )
+        .unwrap();
+        assert!((b[0] - 0.25).abs() < 1e-12 && (b[1] - 0.25).abs() < 1e-12);
+        assert!((b[2] - 0.5).abs() < 1e-12);
+        assert!(barycentric(DVec2::ZERO, DVec2::ZERO, DVec2::X, DVec2::X * 2.0).is_none());
+    }
+
+    #[test]
+    fn inside_point_interpolates_its_triangle() {
+        let m = square();
+        let h = m.locate(DVec2::new(0.75, 0.25), None, |_| true).unwrap();
+        assert!(!h.outside && !h.overlap);
+        assert_eq!(m.triangles[h.tri as usize], [0, 1, 2]);
+        // P = 0.25·A + 0.5·B + 0.25·C for A(0,0) B(1,0) C(1,1).
+        let w = h.bary;
+        assert!((w[0] - 0.25).abs() < 1e-12 && (w[1] - 0.5).abs() < 1e-12);
+        assert!((w[2] - 0.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn overlap_goes_to_the_smallest_depth() {
+        let m = square();
+        let h = m.locate(DVec2::new(0.8, 0.8), None, |_| true).unwrap();
+        assert!(h.overlap);
+        assert_eq!(m.triangles[h.tri as usize], [4, 5, 6]);
+        // With the front triangle excluded, the square behind is used.
+        let h = m.locate(DVec2::new(0.8, 0.8), None, |t| t != 2).unwrap();
+        assert_eq!(m.triangles[h.tri as usize], [0, 1, 2]);
+        assert!(!h.overlap);
+    }
+
+    #[test]
+    fn outside_point_uses_closest_triangle_with_clamped_coordinates() {
+        let m = TriMesh2::new(
+            vec![DVec2::ZERO, DVec2::new(1.0, 0.0), DVec2::new(0.0, 1.0)],
+            vec![0.0; 3],
+            &[[0, 1, 2]],
+            10.0,
+        );
+        // P(1.5, -0.5): b = (0, 1.5, -0.5); excess 1.0; clamped (0, 1, 0).
+        let p = DVec2::new(1.5, -0.5);
+        let b = barycentric(p, DVec2::ZERO, DVec2::X, DVec2::Y).unwrap();
+        assert!((excess(b) - 1.0).abs() < 1e-12);
+        let h = m.locate(p, None, |_| true).unwrap();
+        assert!(h.outside);
+        assert_eq!(h.bary, [0.0, 1.0, 0.0]);
+        // P(0.8, 0.8): b = (-0.6, 0.8, 0.8); clamped (0, 0.8, 0.8) / 1.6 = (0, 0.5, 0.5).
+        let h = m.locate(DVec2::new(0.8, 0.8), None, |_| true).unwrap();
+        assert!(h.outside);
+        assert!((h.bary[1] - 0.5).abs() < 1e-12 && (h.bary[2] - 0.5).abs() < 1e-12);
+        assert!(m.locate(p, None, |_| false).is_none());
+    }
+
+    #[test]
+    fn closest_triangle_is_chosen_by_excess() {
+        let m = square();
+        // Left of the square: only triangle [0,2,3] is close by the excess measure.
+        let h = m.locate(DVec2::new(-0.2, 0.7), None, |t| t != 2).unwrap();
+        assert!(h.outside);
+        assert_eq!(m.triangles[h.tri as usize], [0, 2, 3]);
+    }
+}
