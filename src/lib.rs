@@ -13,6 +13,7 @@
 //! - [`mesh`]: polygon meshes, their geometry (triangulation, normals, nearest vertex) and
 //!   Wavefront OBJ reading/writing.
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
+//! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -20,6 +21,7 @@
 pub mod candide;
 pub mod clone;
 pub mod error;
+pub mod face;
 pub mod fap;
 pub mod fat;
 pub mod fdp;

@@ -1,0 +1,351 @@
+//! A complete MPEG-4 face model: scene graph (meshes under transforms), feature points (FDP)
+//! and Facial Animation Tables (FAT).
+//!
+//! [`FaceModel`] is what cloning and playing work on. It is read from and written to VRML97
+//! face files ([`vrml_io`]), built from OBJ morph sets, from CANDIDE-3 or from the procedural
+//! generator ([`FaceModel::from_synth`]).
+//!
+//! Frames: mesh positions and FAT displacements are in each mesh's local frame (its
+//! `Coordinate` node); [`FaceModel::mesh_world`] places them in the face frame (MPEG-4: +x the
+//! face's own left, +y up, +z forward), where feature points and FAPUs live.
+
+pub mod validate;
+pub mod vrml_io;
+
+use std::collections::HashMap;
+
+use glam::{Affine3A, Quat, Vec3};
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::fat::eval::FatEvaluator;
+use crate::fat::Fat;
+use crate::fdp::{Fapu, FeaturePoint, FeaturePointSet, VertexBinding};
+use crate::mesh::{Mesh, Polygons};
+use crate::spec::FeaturePointId;
+
+/// A `Transform` node of the face.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FaceTransform {
+    /// `DEF` name (unique within the face).
+    pub name: String,
+    /// Enclosing transform, if any.
+    pub parent: Option<usize>,
+    /// `translation`.
+    pub translation: Vec3,
+    /// `rotation`.
+    pub rotation: Quat,
+    /// `scale`.
+    pub scale: Vec3,
+    /// `scaleOrientation`.
+    pub scale_orientation: Quat,
+    /// `center`: the centre of rotation and scaling.
+    pub center: Vec3,
+}
+
+impl FaceTransform {
+    /// A neutral transform with the given name, parent and centre.
+    pub fn new(name: impl Into<String>, parent: Option<usize>, center: Vec3) -> Self {
+        FaceTransform {
+            name: name.into(),
+            parent,
+            translation: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            scale: Vec3::ONE,
+            scale_orientation: Quat::IDENTITY,
+            center,
+        }
+    }
+
+    /// The VRML97 local matrix `T · C · R · SR · S · SR⁻¹ · C⁻¹`.
+    pub fn local_matrix(&self) -> Affine3A {
+        local_matrix(
+            self.translation,
+            self.rotation,
+            self.scale,
+            self.scale_orientation,
+            self.center,
+        )
+    }
+}
+
+/// The VRML97 `Transform` matrix from its fields.
+pub fn local_matrix(t: Vec3, r: Quat, s: Vec3, so: Quat, c: Vec3) -> Affine3A {
+    Affine3A::from_translation(t + c)
+        * Affine3A::from_quat(r)
+        * Affine3A::from_quat(so)
+        * Affine3A::from_scale(s)
+        * Affine3A::from_quat(so.inverse())
+        * Affine3A::from_translation(-c)
+}
+
+/// One `IndexedFaceSet` of the face with its appearance.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FaceMesh {
+    /// `DEF` name of the `IndexedFaceSet` (unique within the face; FATs refer to it).
+    pub name: String,
+    /// Enclosing transform, if any.
+    pub transform: Option<usize>,
+    /// Geometry in the mesh's local frame.
+    pub mesh: Mesh,
+    /// `Material.diffuseColor`, if given.
+    pub color: Option<[f32; 3]>,
+}
+
+/// A face: meshes, transforms, feature points and FAT.
+///
+/// Equality compares the content (transforms, meshes, feature points, FAT), not the name or
+/// the kept scene, so a face equals itself after a write → read round trip.
+#[derive(Clone, Debug)]
+pub struct FaceModel {
+    /// A name for messages and outputs.
+    pub name: String,
+    /// Transforms, parents before children.
+    pub transforms: Vec<FaceTransform>,
+    /// Meshes.
+    pub meshes: Vec<FaceMesh>,
+    /// Feature points: positions in the face frame, bound to mesh vertices where known.
+    pub feature_points: FeaturePointSet,
+    /// The Facial Animation Tables (empty for a plain target face).
+    pub fat: Fat,
+    /// The VRML scene it was read from, kept so writing preserves every other node.
+    pub scene: Option<crate::vrml::Scene>,
+}
+
+impl PartialEq for FaceModel {
+    fn eq(&self, other: &Self) -> bool {
+        self.transforms == other.transforms
+            && self.meshes == other.meshes
+            && self.feature_points == other.feature_points
+            && self.fat == other.fat
+    }
+}
+
+/// The face frame of each transform and mesh, computed once.
+#[derive(Clone, Debug)]
+pub struct FaceFrames {
+    /// World matrix of each transform.
+    pub transforms: Vec<Affine3A>,
+    /// World matrix of each mesh (its transform's, or identity).
+    pub meshes: Vec<Affine3A>,
+}
+
+impl FaceModel {
+    /// An empty face.
+    pub fn new(name: impl Into<String>) -> Self {
+        FaceModel {
+            name: name.into(),
+            transforms: Vec::new(),
+            meshes: Vec::new(),
+            feature_points: FeaturePointSet::new(),
+            fat: Fat::default(),
+            scene: None,
+        }
+    }
+
+    /// Index of the mesh named `name`.
+    pub fn mesh_index(&self, name: &str) -> Option<usize> {
+        self.meshes.iter().position(|m| m.name == name)
+    }
+
+    /// Index of the transform named `name`.
+    pub fn transform_index(&self, name: &str) -> Option<usize> {
+        self.transforms.iter().position(|t| t.name == name)
+    }
+
+    /// World (face-frame) matrices of all transforms and meshes at neutral.
+    pub fn frames(&self) -> FaceFrames {
+        let locals: Vec<Affine3A> = self.transforms.iter().map(|t| t.local_matrix()).collect();
+        self.frames_with(&locals)
+    }
+
+    /// World matrices given each transform's local matrix (e.g. animated ones). Transforms
+    /// must come parents first, which readers and builders guarantee.
+    pub fn frames_with(&self, locals: &[Affine3A]) -> FaceFrames {
+        let mut world: Vec<Affine3A> = Vec::with_capacity(self.transforms.len());
+        for (i, t) in self.transforms.iter().enumerate() {
+            let parent = t
+                .parent
+                .filter(|&p| p < i)
+                .map_or(Affine3A::IDENTITY, |p| world[p]);
+            world.push(parent * locals[i]);
+        }
+        let meshes = self
+            .meshes
+            .iter()
+            .map(|m| m.transform.map_or(Affine3A::IDENTITY, |t| world[t]))
+            .collect();
+        FaceFrames {
+            transforms: world,
+            meshes,
+        }
+    }
+
+    /// Face-frame position of vertex `vertex` of mesh `mesh` at neutral.
+    pub fn vertex_world(&self, frames: &FaceFrames, mesh: usize, vertex: u32) -> Option<Vec3> {
+        let p = *self.meshes.get(mesh)?.mesh.positions.get(vertex as usize)?;
+        Some(frames.meshes[mesh].transform_point3(p))
+    }
+
+    /// Re-derives every feature point bound to mesh vertices from the current geometry (the
+    /// mean of its vertices, in the face frame). Points bound to unknown meshes or vertices
+    /// are an error naming them all.
+    pub fn resolve_feature_points(&mut self) -> Result<()> {
+        let frames = self.frames();
+        let names: HashMap<&str, usize> = self
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| (m.name.as_str(), i))
+            .collect();
+        let meshes = &self.meshes;
+        let lookup = |mesh: Option<&str>, v: u32| -> Option<Vec3> {
+            let mi = match mesh {
+                Some(n) => *names.get(n)?,
+                None if meshes.len() == 1 => 0,
+                None => return None,
+            };
+            let p = *meshes[mi].mesh.positions.get(v as usize)?;
+            Some(frames.meshes[mi].transform_point3(p))
+        };
+        self.feature_points.resolve_positions(lookup).map(|_| ())
+    }
+
+    /// The face's FAP units measured on its feature points.
+    pub fn fapu(&self) -> Result<Fapu> {
+        Fapu::from_feature_points(&self.feature_points)
+    }
+
+    /// `(mesh name, vertex count)` pairs, the form FAT evaluation and validation take.
+    pub fn mesh_sizes(&self) -> Vec<(&str, usize)> {
+        self.meshes
+            .iter()
+            .map(|m| (m.name.as_str(), m.mesh.vertex_count()))
+            .collect()
+    }
+
+    /// Transform names in order.
+    pub fn transform_names(&self) -> Vec<&str> {
+        self.transforms.iter().map(|t| t.name.as_str()).collect()
+    }
+
+    /// A FAT evaluator bound to this face's meshes and transforms.
+    pub fn evaluator(&self) -> Result<FatEvaluator> {
+        FatEvaluator::new(&self.fat, &self.mesh_sizes(), &self.transform_names())
+    }
+
+    /// Total vertex count over all meshes.
+    pub fn vertex_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.mesh.vertex_count()).sum()
+    }
+
+    /// Checks names are unique and transforms come parents first (what every reader and
+    /// builder must produce).
+    pub fn check_structure(&self) -> Result<()> {
+        let mut seen = HashMap::new();
+        for m in &self.meshes {
+            if seen.insert(m.name.as_str(), ()).is_some() {
+                return Err(Error::Invalid(format!("two meshes are named `{}`", m.name)));
+            }
+        }
+        let mut seen = HashMap::new();
+        for (i, t) in self.transforms.iter().enumerate() {
+            if seen.insert(t.name.as_str(), ()).is_some() {
+                return Err(Error::Invalid(format!(
+                    "two transforms are named `{}`",
+                    t.name
+                )));
+            }
+            if t.parent.is_some_and(|p| p >= i) {
+                return Err(Error::Invalid(format!(
+                    "transform `{}` comes before its parent",
+                    t.name
+                )));
+            }
+        }
+        if let Some(m) = self
+            .meshes
+            .iter()
+            .find(|m| m.transform.is_some_and(|t| t >= self.transforms.len()))
+        {
+            return Err(Error::Invalid(format!(
+                "mesh `{}` refers to a missing transform",
+                m.name
+            )));
+        }
+        Ok(())
+    }
+
+    /// The face made by the procedural generator ([`crate::synth`]).
+    pub fn from_synth(face: &crate::synth::SynthFace) -> FaceModel {
+        let transforms = face
+            .transforms
+            .iter()
+            .map(|t| FaceTransform {
+                name: t.name.clone(),
+                parent: t.parent,
+                translation: t.translation,
+                rotation: Quat::from_axis_angle(
+                    t.rotation_axis.try_normalize().unwrap_or(Vec3::Z),
+                    t.rotation_angle,
+                ),
+                scale: t.scale,
+                scale_orientation: Quat::IDENTITY,
+                center: t.center,
+            })
+            .collect();
+        let meshes = face
+            .meshes
+            .iter()
+            .map(|m| {
+                let mut mesh = Mesh {
+                    name: m.name.clone(),
+                    positions: m.positions.clone(),
+                    polygons: Polygons::from_lists(m.polygons.iter().map(|p| p.as_slice())),
+                    ..Mesh::default()
+                };
+                if let Some(uvs) = &m.uvs {
+                    mesh.uvs = uvs.iter().map(|&[u, v]| glam::Vec2::new(u, v)).collect();
+                    mesh.uv_polygons = Some(mesh.polygons.clone());
+                }
+                FaceMesh {
+                    name: m.name.clone(),
+                    transform: Some(m.transform),
+                    mesh,
+                    color: Some(m.colour),
+                }
+            })
+            .collect();
+        let mut feature_points = FeaturePointSet::new();
+        for fp in &face.feature_points {
+            let mut point = FeaturePoint::at(fp.id, fp.position);
+            point.binding = Some(VertexBinding {
+                mesh: Some(face.meshes[fp.mesh].name.clone()),
+                vertices: vec![fp.vertex],
+            });
+            feature_points.insert(point);
+        }
+        FaceModel {
+            name: face.name.clone(),
+            transforms,
+            meshes,
+            feature_points,
+            fat: face.fat.clone(),
+            scene: None,
+        }
+    }
+
+    /// The mesh and vertex a feature point is bound to (first vertex of its binding).
+    pub fn fp_vertex(&self, id: FeaturePointId) -> Option<(usize, u32)> {
+        let b = self.feature_points.get(id)?.binding.as_ref()?;
+        let mesh = match &b.mesh {
+            Some(name) => self.mesh_index(name)?,
+            None if self.meshes.len() == 1 => 0,
+            None => return None,
+        };
+        Some((mesh, *b.vertices.first()?))
+    }
+}
+
+#[cfg(test)]
+mod tests;
