@@ -5,23 +5,7 @@
 
 use fbakit::clone::rbf::{clone_rbf, RbfOptions};
 
-/// The crate's test fixture, compiled into this bench; the items below stand in for the
-/// crate paths it imports (`super::…`, `crate::fat`, `crate::fdp`, `crate::spec`).
-#[allow(dead_code)]
-#[path = "../src/clone/fixtures.rs"]
-mod fixtures;
-use fbakit::clone::{CloneSurface, SurfaceMotion};
-mod fat {
-    pub use fbakit::fat::TableKey;
-}
-mod fdp {
-    pub use fbakit::fdp::{Fapu, FapuDistances};
-}
-mod spec {
-    pub use fbakit::spec::{FapId, FapuKind, FeaturePointId};
-}
-
-use fixtures::{candide, CandideFace};
+use fbakit::clone::fixtures::{candide, CandideFace};
 
 fn main() {
     divan::main();

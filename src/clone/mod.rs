@@ -94,5 +94,4 @@ pub struct SurfaceCloneResult {
     pub warnings: Vec<String>,
 }
 
-#[cfg(test)]
-pub(crate) mod fixtures;
+pub mod fixtures;
