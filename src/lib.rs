@@ -13,6 +13,8 @@
 //! - [`mesh`]: polygon meshes, their geometry (triangulation, normals, nearest vertex) and
 //!   Wavefront OBJ reading/writing.
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
+//! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
+//!   cloning grid.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -26,6 +28,7 @@ pub mod fdp;
 pub mod gltf;
 pub mod io;
 pub mod mesh;
+pub mod render;
 pub mod spec;
 pub mod synth;
 pub mod vrml;
