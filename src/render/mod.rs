@@ -327,7 +327,7 @@ pub struct RenderOptions {
     /// Background, sRGB with alpha.
     pub background: [u8; 4],
     /// Samples per pixel along each axis: 1 (none) or 2 (4 samples per pixel); clamped to
-    /// `1..=4`.
+    /// `1..=4`, and lowered so the sample grid stays within `MAX_IMAGE_SIDE` on each side.
     pub supersample: u32,
     /// Skip triangles facing away from the camera. Off by default: back faces seen through
     /// openings (inside the mouth) are drawn darkened instead of leaving holes.

@@ -70,7 +70,12 @@ const EMPTY: Sample = Sample {
 pub fn render(meshes: &[RenderMesh], camera: &Camera, opts: &RenderOptions) -> Image {
     let width = opts.width.clamp(1, MAX_IMAGE_SIDE);
     let height = opts.height.clamp(1, MAX_IMAGE_SIDE);
-    let ss = opts.supersample.clamp(1, 4);
+    // The sample grid is bounded by MAX_IMAGE_SIDE too: large frames get fewer samples.
+    let ss = opts
+        .supersample
+        .clamp(1, 4)
+        .min(MAX_IMAGE_SIDE / width.max(height))
+        .max(1);
     let (sw, sh) = ((width * ss) as usize, (height * ss) as usize);
 
     let (vertices, triangles) = setup(meshes, camera, opts, sw, sh);
