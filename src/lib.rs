@@ -14,6 +14,8 @@
 //!   Wavefront OBJ reading/writing.
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
 //! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
+//! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
+//!   cloning grid.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -28,6 +30,7 @@ pub mod fdp;
 pub mod gltf;
 pub mod io;
 pub mod mesh;
+pub mod render;
 pub mod spec;
 pub mod synth;
 pub mod vrml;
