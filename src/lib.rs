@@ -13,6 +13,7 @@
 //! - [`mesh`]: polygon meshes, their geometry (triangulation, normals, nearest vertex) and
 //!   Wavefront OBJ reading/writing.
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
+//! - [`player`]: plays FAP streams on faces (FAT evaluation per frame), glTF and OBJ output.
 //! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
@@ -28,6 +29,7 @@ pub mod fdp;
 pub mod gltf;
 pub mod io;
 pub mod mesh;
+pub mod player;
 pub mod spec;
 pub mod synth;
 pub mod vrml;
