@@ -373,6 +373,22 @@ fn reserve_total<T>(v: &mut Vec<T>, total: usize) {
     }
 }
 
+/// Names accepted by [`load_face`] for the built-in procedural faces.
+pub const BUILTIN_FACES: [&str; 2] = ["alma", "bruno"];
+
+/// A face from a VRML face file, or one of the built-in faces by name (`alma`, `bruno`) when
+/// no file of that name exists.
+pub fn load_face(spec: &std::path::Path) -> Result<FaceModel> {
+    if !spec.exists() {
+        match spec.to_str() {
+            Some("alma") => return Ok(FaceModel::from_synth(&crate::synth::alma())),
+            Some("bruno") => return Ok(FaceModel::from_synth(&crate::synth::bruno())),
+            _ => {}
+        }
+    }
+    crate::face::vrml_io::read_face_file(spec).map(|(face, _)| face)
+}
+
 /// 66 low-level FAPs, two viseme and two expression activations.
 const ACTIVATIONS_PER_FRAME: usize = 66 + 4;
 
