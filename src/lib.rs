@@ -13,6 +13,7 @@
 //! - [`mesh`]: polygon meshes, their geometry (triangulation, normals, nearest vertex) and
 //!   Wavefront OBJ reading/writing.
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
+//! - [`player`]: plays FAP streams on faces (FAT evaluation per frame), glTF and OBJ output.
 //! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
 //! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
 //!   cloning grid.
@@ -30,6 +31,7 @@ pub mod fdp;
 pub mod gltf;
 pub mod io;
 pub mod mesh;
+pub mod player;
 pub mod render;
 pub mod spec;
 pub mod synth;

@@ -8,8 +8,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod face_export;
 pub mod fap;
 mod fapu;
+pub mod play;
 
 /// Exit code for success.
 pub const EXIT_OK: u8 = 0;
@@ -58,6 +60,22 @@ pub enum Command {
                                         fbakit fap convert samples/speech.fap speech.json"
     )]
     Fap(fap::FapCommand),
+    /// Play a FAP stream on a face: animated glTF (.glb/.gltf) or an OBJ sequence.
+    #[command(
+        long_about = "Play a FAP stream on a face with its Facial Animation Tables and write \
+                      the result: OUT ending in .glb or .gltf gives an animated glTF (morph \
+                      targets + node rotations); a directory (or --format obj) gives one OBJ \
+                      per frame (frame_00000.obj, ...) and frames.json. FAPs not sent in a \
+                      frame hold their last value. FACE is a VRML face file or `alma` / \
+                      `bruno` (built-in faces). FAPs, visemes and expressions the face has no \
+                      table for are reported.",
+        after_help = "Examples:\n  fbakit play alma samples/speech.fap -o speech.glb\n  \
+                      fbakit play bruno samples/lowlevel.fap -o frames/ --fps 50 --frames 0..25"
+    )]
+    Play(play::PlayArgs),
+    /// Export a face with its FAT as glTF morph targets (no animation).
+    #[command(after_help = "Example:\n  fbakit export-face alma -o alma.glb")]
+    ExportFace(face_export::FaceExportArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -76,6 +94,8 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Spec(args) => spec(args),
         Command::Fapu(args) => fapu::run(args),
         Command::Fap(cmd) => fap::run(cmd),
+        Command::Play(args) => play::run(args),
+        Command::ExportFace(args) => face_export::run_face_export(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -1,0 +1,85 @@
+//! `fbakit export-face FACE -o OUT.glb|.gltf`: a face with its FAT as morph targets (no
+//! animation). Kept as one small function so it can move under a `face` command group.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use fbakit::error::{Error, Result};
+use fbakit::player::gltf::export_face;
+use fbakit::player::load_face;
+use serde::Serialize;
+
+use super::{print_json, EXIT_OK};
+
+/// Arguments of `export-face`.
+#[derive(Debug, Args)]
+pub struct FaceExportArgs {
+    /// Face: a VRML face file, or `alma` / `bruno` for the built-in faces.
+    pub face: PathBuf,
+    /// Output `.glb` or `.gltf` file.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize)]
+struct Report {
+    face: String,
+    output: String,
+    meshes: usize,
+    morph_targets: usize,
+    warnings: Vec<String>,
+}
+
+/// Runs `export-face`.
+pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
+    let ext = a
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    let glb = match ext.as_deref() {
+        Some("glb") => true,
+        Some("gltf") => false,
+        _ => {
+            return Err(Error::Unsupported(format!(
+                "`{}`: the output must end in .glb or .gltf",
+                a.output.display()
+            )))
+        }
+    };
+    let face = load_face(&a.face)?;
+    let export = export_face(&face, None)?;
+    if glb {
+        export.document.write_glb(&a.output)?;
+    } else {
+        export.document.write_gltf(&a.output)?;
+    }
+    let root = &export.document.root;
+    let report = Report {
+        face: face.name.clone(),
+        output: a.output.display().to_string(),
+        meshes: root.meshes.len(),
+        morph_targets: root
+            .meshes
+            .iter()
+            .flat_map(|m| m.primitives.first())
+            .map(|p| p.targets.len())
+            .sum(),
+        warnings: export.warnings,
+    };
+    if a.json {
+        print_json(&report)?;
+    } else {
+        println!(
+            "wrote {}: {} meshes, {} morph targets",
+            report.output, report.meshes, report.morph_targets
+        );
+        for w in &report.warnings {
+            println!("warning: {w}");
+        }
+    }
+    Ok(EXIT_OK)
+}

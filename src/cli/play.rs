@@ -1,0 +1,270 @@
+//! `fbakit play FACE STREAM -o OUT`: plays a FAP stream on a face into an animated glTF or an
+//! OBJ sequence.
+
+use std::io::IsTerminal;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use fbakit::error::{Error, Result};
+use fbakit::fap::{read_stream_file, ReadOptions};
+use fbakit::player::gltf::export_face;
+use fbakit::player::obj::ObjSequence;
+use fbakit::player::{load_face, PlayOptions, Player};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+use super::{print_json, EXIT_OK};
+
+/// Output formats of `play`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PlayFormat {
+    /// Binary glTF (one file).
+    Glb,
+    /// Text glTF with the buffer embedded (one file).
+    Gltf,
+    /// One OBJ per frame in a directory, plus `frames.json`.
+    Obj,
+}
+
+/// Arguments of `play`.
+#[derive(Debug, Args)]
+pub struct PlayArgs {
+    /// Face: a VRML face file, or `alma` / `bruno` for the built-in faces.
+    pub face: PathBuf,
+    /// FAP stream (`.fap` or `.json`).
+    pub stream: PathBuf,
+    /// Output: `.glb` / `.gltf` file, or a directory for an OBJ sequence.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Output frame rate (the stream is resampled, values interpolated); default: the
+    /// stream's.
+    #[arg(long, value_name = "N")]
+    pub fps: Option<f64>,
+    /// Output frames to play, `a..b` (end exclusive; `a..` and `..b` too).
+    #[arg(long, value_name = "a..b", value_parser = parse_range)]
+    pub frames: Option<Range<usize>>,
+    /// Output format (default: from OUT's extension; a directory or no extension means obj).
+    #[arg(long)]
+    pub format: Option<PlayFormat>,
+    /// Read the stream strictly.
+    #[arg(long)]
+    pub strict: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Parses `a..b`, `a..` or `..b`.
+pub fn parse_range(s: &str) -> std::result::Result<Range<usize>, String> {
+    let (a, b) = s
+        .split_once("..")
+        .ok_or_else(|| format!("`{s}` is not a range like 10..50"))?;
+    let num = |t: &str, default: usize| -> std::result::Result<usize, String> {
+        if t.is_empty() {
+            Ok(default)
+        } else {
+            t.trim()
+                .parse()
+                .map_err(|_| format!("`{t}` is not a frame number"))
+        }
+    };
+    let r = num(a, 0)?..num(b, usize::MAX)?;
+    if r.start >= r.end {
+        return Err(format!("range `{s}` is empty"));
+    }
+    Ok(r)
+}
+
+#[derive(Debug, Serialize)]
+struct MissingRecord {
+    key: String,
+    frames: usize,
+}
+
+#[derive(Debug, Serialize)]
+struct PlayReport {
+    face: String,
+    stream: String,
+    output: String,
+    format: PlayFormat,
+    frames: usize,
+    first_frame: usize,
+    fps: f64,
+    duration_seconds: f64,
+    files_written: usize,
+    missing_tables: Vec<MissingRecord>,
+    warnings: Vec<String>,
+}
+
+/// Picks the output format from `--format` or OUT.
+pub fn output_format(out: &Path, format: Option<PlayFormat>) -> Result<PlayFormat> {
+    if let Some(f) = format {
+        return Ok(f);
+    }
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("glb") => Ok(PlayFormat::Glb),
+        Some("gltf") => Ok(PlayFormat::Gltf),
+        Some("png") => Err(Error::Unsupported(
+            "PNG output arrives with the renderer; write .glb, .gltf or an OBJ directory".into(),
+        )),
+        _ if out.is_dir() => Ok(PlayFormat::Obj),
+        None => Ok(PlayFormat::Obj),
+        Some(e) => Err(Error::Unsupported(format!(
+            "unknown output extension `.{e}` (use .glb, .gltf, a directory or --format)"
+        ))),
+    }
+}
+
+/// A progress bar on stderr, hidden when stderr is not a terminal.
+pub fn progress(len: u64, what: &str) -> ProgressBar {
+    let target = if std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(len), target);
+    if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} frames") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(what.to_string());
+    bar
+}
+
+/// Runs `play`.
+pub fn run(a: PlayArgs) -> Result<u8> {
+    let format = output_format(&a.output, a.format)?;
+    let face = load_face(&a.face)?;
+    let opts = if a.strict {
+        ReadOptions::strict()
+    } else {
+        ReadOptions::lenient()
+    };
+    let (stream, stream_warnings) = read_stream_file(&a.stream, &opts)?;
+    let mut warnings: Vec<String> = stream_warnings.iter().map(|d| d.to_string()).collect();
+    let mut player = Player::new(
+        &face,
+        &stream,
+        PlayOptions {
+            fps: a.fps,
+            frames: a.frames.clone(),
+        },
+    )?;
+    let bar = progress(player.frame_count() as u64, "playing");
+    let files_written = match format {
+        PlayFormat::Glb | PlayFormat::Gltf => {
+            let anim = player.animation()?;
+            bar.set_position(anim.len() as u64);
+            let export = export_face(&face, Some(&anim))?;
+            warnings.extend(export.warnings);
+            match format {
+                PlayFormat::Glb => export.document.write_glb(&a.output)?,
+                _ => export.document.write_gltf(&a.output)?,
+            }
+            1
+        }
+        PlayFormat::Obj => {
+            let mut seq = ObjSequence::new(&face, &a.output, player.fps())?;
+            let mut frame = player.new_frame();
+            let mut n = 0;
+            while player.next_frame(&mut frame) {
+                seq.write_frame(&frame)?;
+                n += 1;
+                bar.inc(1);
+            }
+            seq.finish()?;
+            n + 1
+        }
+    };
+    bar.finish_and_clear();
+    let report = PlayReport {
+        face: face.name.clone(),
+        stream: a.stream.display().to_string(),
+        output: a.output.display().to_string(),
+        format,
+        frames: player.frame_count(),
+        first_frame: player.frame_range().start,
+        fps: player.fps(),
+        duration_seconds: player.duration(),
+        files_written,
+        missing_tables: player
+            .missing_tables()
+            .into_iter()
+            .map(|(k, frames)| MissingRecord {
+                key: k.to_string(),
+                frames,
+            })
+            .collect(),
+        warnings,
+    };
+    if a.json {
+        print_json(&report)?;
+    } else {
+        print!("{}", report_text(&report));
+    }
+    Ok(EXIT_OK)
+}
+
+fn report_text(r: &PlayReport) -> String {
+    use std::fmt::Write as _;
+    let mut o = String::new();
+    let what = match r.format {
+        PlayFormat::Obj => format!("{} files (OBJ frames + frames.json)", r.files_written),
+        _ => "animated glTF".to_string(),
+    };
+    let _ = writeln!(o, "wrote {}: {what}", r.output);
+    let _ = writeln!(
+        o,
+        "played {} frames from {} of `{}` on `{}` at {} fps ({:.3} s)",
+        r.frames, r.first_frame, r.stream, r.face, r.fps, r.duration_seconds
+    );
+    if r.missing_tables.is_empty() {
+        let _ = writeln!(o, "missing tables: none");
+    } else {
+        let _ = writeln!(
+            o,
+            "missing tables (used by the stream, no table in the face):"
+        );
+        for m in &r.missing_tables {
+            let _ = writeln!(o, "  {} in {} frames", m.key, m.frames);
+        }
+    }
+    for w in &r.warnings {
+        let _ = writeln!(o, "warning: {w}");
+    }
+    o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges() {
+        assert_eq!(parse_range("3..10"), Ok(3..10));
+        assert_eq!(parse_range("3.."), Ok(3..usize::MAX));
+        assert_eq!(parse_range("..10"), Ok(0..10));
+        assert!(parse_range("10..3").is_err());
+        assert!(parse_range("5").is_err());
+        assert!(parse_range("a..b").is_err());
+    }
+
+    #[test]
+    fn formats() {
+        let f = |p: &str| output_format(Path::new(p), None);
+        assert_eq!(f("x.glb").unwrap(), PlayFormat::Glb);
+        assert_eq!(f("x.GLTF").unwrap(), PlayFormat::Gltf);
+        assert_eq!(f("frames").unwrap(), PlayFormat::Obj);
+        assert!(f("x.png").unwrap_err().to_string().contains("renderer"));
+        assert!(f("x.txt").is_err());
+        assert_eq!(
+            output_format(Path::new("x.txt"), Some(PlayFormat::Obj)).unwrap(),
+            PlayFormat::Obj
+        );
+    }
+}

@@ -1,0 +1,481 @@
+//! The FAP player: a face and a FAP stream in, one deformed face per frame out.
+//!
+//! [`Player`] walks a stream frame by frame with the standard's hold rule
+//! ([`crate::fap::FapTimeline`]): a FAP a frame does not transmit keeps its last value. Each
+//! frame becomes a list of [`Activation`]s — every low-level FAP 3..=68 at its value, the viseme
+//! pair (`select1` at `blend`, `select2` at `63 − blend`) and the expression pair — which the
+//! face's [`FatEvaluator`] turns into vertex displacements and transform changes.
+//!
+//! A [`PlayerFrame`] holds the result: mesh positions in each mesh's local frame (neutral +
+//! displacement), each transform's animated local matrix and the world (face-frame) matrices.
+//! [`Player::next_frame`] refills one frame's buffers in place, so playing allocates nothing
+//! after the first frame.
+//!
+//! ## Transforms
+//! A `FaceDefTransform` changes a field of a VRML `Transform` relative to its neutral value:
+//! the rotation delta is composed *before* the neutral rotation in the parent's frame
+//! (`R = ΔR · R₀`, so the delta axis is read in the parent's axes, like the `rotation` field
+//! itself), translation and scale deltas are added. The animated local matrix is the VRML
+//! matrix `T · C · R · SR · S · SR⁻¹ · C⁻¹` of those fields, so rotations turn about the
+//! transform's `center` (eyeball centres, FP 7.1 for the head in the synthetic faces).
+//!
+//! ## Timing
+//! Output frame `n` is at `n / fps`. Without `--fps` the stream's own frame rate is used and
+//! frames `0..=last frame number` are played (skipped frame numbers hold). With another rate
+//! the stream is first resampled with [`crate::fap::resample`], which interpolates the
+//! low-level values and the viseme blend / expression intensities.
+//!
+//! ## Missing tables
+//! A FAP, viseme or expression with a non-zero value that the face has no table for cannot
+//! move anything; [`Player::missing_tables`] lists each such key once with the number of
+//! played frames that used it.
+
+pub mod gltf;
+pub mod obj;
+
+use std::ops::Range;
+
+use glam::{Affine3A, Vec3};
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::face::{local_matrix, FaceFrames, FaceModel};
+use crate::fap::{resample, DenseFrame, FapStream, FapTimeline};
+use crate::fat::eval::{
+    expression_activations, viseme_activations, Activation, FatEvaluator, FatOutput, TransformDelta,
+};
+use crate::fat::{Fat, TableKey};
+use crate::spec::FapId;
+
+/// How to play a stream.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlayOptions {
+    /// Output frame rate; `None` plays at the stream's own rate.
+    pub fps: Option<f64>,
+    /// Which output frames to play (clamped to the stream's end); `None` plays all.
+    pub frames: Option<Range<usize>>,
+}
+
+/// A key used by the stream that the face has no table for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct MissingTable {
+    /// The FAP, viseme or expression.
+    pub key: TableKey,
+    /// Number of played frames in which it had a non-zero value.
+    pub frames: usize,
+}
+
+/// One played frame. Create it with [`PlayerFrame::default`] (buffers are sized on first use)
+/// or [`Player::new_frame`], then let [`Player::next_frame`] refill it.
+#[derive(Clone, Debug)]
+pub struct PlayerFrame {
+    /// Output frame number.
+    pub index: usize,
+    /// Time in seconds (`index / fps`).
+    pub time: f64,
+    /// Per mesh, per vertex: neutral position + FAT displacement, in the mesh's local frame.
+    pub positions: Vec<Vec<Vec3>>,
+    /// Per transform: its animated local matrix (see the module docs).
+    pub transform_locals: Vec<Affine3A>,
+    /// Per transform: the change from neutral the FAT produced.
+    pub transform_deltas: Vec<TransformDelta>,
+    /// World (face-frame) matrices of transforms and meshes for this frame.
+    pub world: FaceFrames,
+    /// The activations the frame was evaluated with (keys without a table included).
+    pub activations: Vec<Activation>,
+}
+
+impl Default for PlayerFrame {
+    fn default() -> Self {
+        PlayerFrame {
+            index: 0,
+            time: 0.0,
+            positions: Vec::new(),
+            transform_locals: Vec::new(),
+            transform_deltas: Vec::new(),
+            world: FaceFrames {
+                transforms: Vec::new(),
+                meshes: Vec::new(),
+            },
+            activations: Vec::new(),
+        }
+    }
+}
+
+impl PlayerFrame {
+    /// Face-frame position of every vertex of mesh `mesh` (empty for an unknown mesh).
+    pub fn world_positions(&self, mesh: usize) -> impl ExactSizeIterator<Item = Vec3> + '_ {
+        let m = self
+            .world
+            .meshes
+            .get(mesh)
+            .copied()
+            .unwrap_or(Affine3A::IDENTITY);
+        self.positions
+            .get(mesh)
+            .map_or(&[][..], |p| p.as_slice())
+            .iter()
+            .map(move |&p| m.transform_point3(p))
+    }
+
+    /// Face-frame positions of all meshes, written into `out` (resized, buffers reused).
+    pub fn world_positions_into(&self, out: &mut Vec<Vec<Vec3>>) {
+        out.resize_with(self.positions.len(), Vec::new);
+        for (i, o) in out.iter_mut().enumerate() {
+            o.clear();
+            o.extend(self.world_positions(i));
+        }
+    }
+
+    /// What a glTF animation needs from this frame (no vertex data).
+    pub fn animation_frame(&self) -> AnimationFrame {
+        AnimationFrame {
+            index: self.index,
+            time: self.time,
+            activations: self.activations.clone(),
+            transform_deltas: self.transform_deltas.clone(),
+        }
+    }
+}
+
+/// The per-frame data a glTF animation is made of: activations (for morph weights) and
+/// transform changes (for node channels), without vertex positions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnimationFrame {
+    /// Output frame number.
+    pub index: usize,
+    /// Time in seconds.
+    pub time: f64,
+    /// Activations of the frame.
+    pub activations: Vec<Activation>,
+    /// Per transform: the change from neutral.
+    pub transform_deltas: Vec<TransformDelta>,
+}
+
+/// Plays a FAP stream on a face; see the module docs.
+#[derive(Debug)]
+pub struct Player<'a> {
+    face: &'a FaceModel,
+    evaluator: FatEvaluator,
+    timeline: FapTimeline,
+    fps: f64,
+    range: Range<usize>,
+    next: usize,
+    missing: Vec<MissingTable>,
+    output: FatOutput,
+}
+
+impl<'a> Player<'a> {
+    /// Prepares `stream` for playing on `face`.
+    ///
+    /// Errors: the face's FAT refers to unknown meshes/transforms, the stream's frame rate
+    /// (or `opts.fps`) is not finite and positive, resampling would be too long, or the
+    /// requested frame range is empty or starts after the last frame.
+    pub fn new(face: &'a FaceModel, stream: &FapStream, opts: PlayOptions) -> Result<Player<'a>> {
+        face.check_structure()?;
+        let evaluator = face.evaluator()?;
+        if !(stream.frame_rate.is_finite() && stream.frame_rate > 0.0) {
+            return Err(Error::Invalid(format!(
+                "stream frame rate {} is not a finite positive number",
+                stream.frame_rate
+            )));
+        }
+        let (timeline, fps) = match opts.fps {
+            Some(f) if f != stream.frame_rate => (FapTimeline::new(&resample(stream, f)?), f),
+            _ => (FapTimeline::new(stream), stream.frame_rate),
+        };
+        let total = match timeline.last_number() {
+            Some(n) => usize::try_from(n)
+                .ok()
+                .and_then(|n| n.checked_add(1))
+                .filter(|&n| n as u64 <= crate::fap::MAX_RESAMPLED_FRAMES)
+                .ok_or_else(|| {
+                    Error::Invalid(format!(
+                        "stream has frame number {n}, more than {} frames",
+                        crate::fap::MAX_RESAMPLED_FRAMES
+                    ))
+                })?,
+            None => 0,
+        };
+        let range = match opts.frames {
+            None => 0..total,
+            Some(r) => {
+                if r.start >= r.end || r.start >= total {
+                    return Err(Error::Invalid(format!(
+                        "frame range {}..{} selects nothing of the {total} frames",
+                        r.start, r.end
+                    )));
+                }
+                r.start..r.end.min(total)
+            }
+        };
+        let missing = missing_tables(&evaluator, &timeline, range.clone());
+        let output = evaluator.output();
+        Ok(Player {
+            face,
+            evaluator,
+            timeline,
+            fps,
+            next: range.start,
+            range,
+            missing,
+            output,
+        })
+    }
+
+    /// Output frame rate.
+    pub fn fps(&self) -> f64 {
+        self.fps
+    }
+
+    /// The output frames that are played.
+    pub fn frame_range(&self) -> Range<usize> {
+        self.range.clone()
+    }
+
+    /// Number of frames played in all.
+    pub fn frame_count(&self) -> usize {
+        self.range.len()
+    }
+
+    /// Duration in seconds covered by the played frames (`frames / fps`).
+    pub fn duration(&self) -> f64 {
+        self.range.len() as f64 / self.fps
+    }
+
+    /// Keys used by the played frames that the face has no table for, each once, in
+    /// [`TableKey`] order.
+    pub fn missing_tables(&self) -> Vec<(TableKey, usize)> {
+        self.missing.iter().map(|m| (m.key, m.frames)).collect()
+    }
+
+    /// Same as [`Player::missing_tables`], as serialisable records.
+    pub fn missing_table_records(&self) -> &[MissingTable] {
+        &self.missing
+    }
+
+    /// A frame with buffers sized for this face.
+    pub fn new_frame(&self) -> PlayerFrame {
+        let mut f = PlayerFrame::default();
+        self.size_frame(&mut f);
+        f
+    }
+
+    fn size_frame(&self, f: &mut PlayerFrame) {
+        let face = self.face;
+        if f.positions.len() != face.meshes.len() {
+            f.positions.resize_with(face.meshes.len(), Vec::new);
+        }
+        for (p, m) in f.positions.iter_mut().zip(&face.meshes) {
+            if p.len() != m.mesh.positions.len() {
+                p.clear();
+                p.extend_from_slice(&m.mesh.positions);
+            }
+        }
+        let nt = face.transforms.len();
+        f.transform_locals.resize(nt, Affine3A::IDENTITY);
+        f.transform_deltas.resize(nt, TransformDelta::IDENTITY);
+        // `reserve` counts from the current length, which is the full size after a frame.
+        reserve_total(&mut f.world.transforms, nt);
+        reserve_total(&mut f.world.meshes, face.meshes.len());
+        reserve_total(&mut f.activations, ACTIVATIONS_PER_FRAME);
+    }
+
+    /// Evaluates the next frame into `frame` and returns true, or returns false after the
+    /// last one. Reuses `frame`'s buffers: no allocation after they were sized once.
+    pub fn next_frame(&mut self, frame: &mut PlayerFrame) -> bool {
+        if self.next >= self.range.end {
+            return false;
+        }
+        let n = self.next;
+        self.next += 1;
+        self.frame_at(n, frame);
+        true
+    }
+
+    /// Evaluates output frame `index` (any frame, also outside the played range) into
+    /// `frame`.
+    pub fn frame_at(&mut self, index: usize, frame: &mut PlayerFrame) {
+        self.size_frame(frame);
+        let state = self.timeline.at_frame(index as u64);
+        frame.index = index;
+        frame.time = index as f64 / self.fps;
+        fill_activations(state, &mut frame.activations);
+        self.evaluator
+            .evaluate(&frame.activations, &mut self.output);
+        let face = self.face;
+        for ((pos, m), d) in frame
+            .positions
+            .iter_mut()
+            .zip(&face.meshes)
+            .zip(&self.output.displacements)
+        {
+            for ((p, n), d) in pos.iter_mut().zip(&m.mesh.positions).zip(d) {
+                *p = *n + *d;
+            }
+        }
+        frame
+            .transform_deltas
+            .copy_from_slice(&self.output.transforms);
+        for ((local, t), d) in frame
+            .transform_locals
+            .iter_mut()
+            .zip(&face.transforms)
+            .zip(&self.output.transforms)
+        {
+            *local = animated_local(t, d);
+        }
+        world_frames_into(face, &frame.transform_locals, &mut frame.world);
+    }
+
+    /// Restarts at the first frame of the range.
+    pub fn rewind(&mut self) {
+        self.next = self.range.start;
+    }
+
+    /// The per-frame data of every played frame for a glTF animation, computed without
+    /// evaluating vertex motion (only transform entries), so it is cheap even for big faces.
+    pub fn animation(&self) -> Result<Vec<AnimationFrame>> {
+        let face = self.face;
+        let transform_fat = Fat {
+            tables: face
+                .fat
+                .tables
+                .iter()
+                .map(|t| crate::fat::FaceDefTable {
+                    key: t.key,
+                    meshes: Vec::new(),
+                    transforms: t.transforms.clone(),
+                })
+                .collect(),
+        };
+        let mut eval = FatEvaluator::new(&transform_fat, &[], &face.transform_names())?;
+        let mut out = eval.output();
+        let mut frames = Vec::with_capacity(self.range.len());
+        for index in self.range.clone() {
+            let mut activations = Vec::with_capacity(ACTIVATIONS_PER_FRAME);
+            fill_activations(self.timeline.at_frame(index as u64), &mut activations);
+            eval.evaluate(&activations, &mut out);
+            frames.push(AnimationFrame {
+                index,
+                time: index as f64 / self.fps,
+                activations,
+                transform_deltas: out.transforms.clone(),
+            });
+        }
+        Ok(frames)
+    }
+}
+
+fn reserve_total<T>(v: &mut Vec<T>, total: usize) {
+    if v.capacity() < total {
+        v.reserve(total - v.len());
+    }
+}
+
+/// Names accepted by [`load_face`] for the built-in procedural faces.
+pub const BUILTIN_FACES: [&str; 2] = ["alma", "bruno"];
+
+/// A face from a VRML face file, or one of the built-in faces by name (`alma`, `bruno`) when
+/// no file of that name exists.
+pub fn load_face(spec: &std::path::Path) -> Result<FaceModel> {
+    if !spec.exists() {
+        match spec.to_str() {
+            Some("alma") => return Ok(FaceModel::from_synth(&crate::synth::alma())),
+            Some("bruno") => return Ok(FaceModel::from_synth(&crate::synth::bruno())),
+            _ => {}
+        }
+    }
+    crate::face::vrml_io::read_face_file(spec).map(|(face, _)| face)
+}
+
+/// 66 low-level FAPs, two viseme and two expression activations.
+const ACTIVATIONS_PER_FRAME: usize = 66 + 4;
+
+/// The activations of one held state: every low-level FAP, then the viseme and expression
+/// pairs.
+pub fn fill_activations(state: &DenseFrame, out: &mut Vec<Activation>) {
+    out.clear();
+    for id in FapId::low_level() {
+        out.push(Activation {
+            key: TableKey::LowLevel(id),
+            value: state.value(id),
+        });
+    }
+    let v = &state.viseme;
+    out.extend(viseme_activations(v.select1, v.select2, f64::from(v.blend)));
+    let e = &state.expression;
+    out.extend(expression_activations(
+        e.select1,
+        f64::from(e.intensity1),
+        e.select2,
+        f64::from(e.intensity2),
+    ));
+}
+
+/// The local matrix of `t` with the FAT change `d` applied (see the module docs).
+pub fn animated_local(t: &crate::face::FaceTransform, d: &TransformDelta) -> Affine3A {
+    if *d == TransformDelta::IDENTITY {
+        return t.local_matrix();
+    }
+    local_matrix(
+        t.translation + d.translation,
+        d.rotation * t.rotation,
+        t.scale + d.scale,
+        t.scale_orientation,
+        t.center,
+    )
+}
+
+/// [`FaceModel::frames_with`] into existing buffers (no allocation once they have capacity).
+fn world_frames_into(face: &FaceModel, locals: &[Affine3A], out: &mut FaceFrames) {
+    out.transforms.clear();
+    for (i, t) in face.transforms.iter().enumerate() {
+        let parent = t
+            .parent
+            .filter(|&p| p < i)
+            .map_or(Affine3A::IDENTITY, |p| out.transforms[p]);
+        out.transforms.push(parent * locals[i]);
+    }
+    out.meshes.clear();
+    for m in &face.meshes {
+        let w = m
+            .transform
+            .and_then(|t| out.transforms.get(t).copied())
+            .unwrap_or(Affine3A::IDENTITY);
+        out.meshes.push(w);
+    }
+}
+
+fn missing_tables(
+    evaluator: &FatEvaluator,
+    timeline: &FapTimeline,
+    range: Range<usize>,
+) -> Vec<MissingTable> {
+    let mut counts = vec![0usize; TableKey::SLOTS];
+    let mut keys: Vec<Option<TableKey>> = vec![None; TableKey::SLOTS];
+    let mut activations = Vec::with_capacity(ACTIVATIONS_PER_FRAME);
+    for n in range {
+        fill_activations(timeline.at_frame(n as u64), &mut activations);
+        // A key counts once per frame even when both halves of a pair select it.
+        let mut seen = [false; TableKey::SLOTS];
+        for a in &activations {
+            let Some(slot) = a.key.slot() else { continue };
+            if a.value != 0.0 && !seen[slot] && !evaluator.has_table(a.key) {
+                seen[slot] = true;
+                counts[slot] += 1;
+                keys[slot] = Some(a.key);
+            }
+        }
+    }
+    let mut out: Vec<MissingTable> = keys
+        .into_iter()
+        .zip(counts)
+        .filter_map(|(k, frames)| k.map(|key| MissingTable { key, frames }))
+        .collect();
+    out.sort_by_key(|m| m.key);
+    out
+}
+
+#[cfg(test)]
+mod tests;
