@@ -9,6 +9,9 @@
 //! `Coordinate` node); [`FaceModel::mesh_world`] places them in the face frame (MPEG-4: +x the
 //! face's own left, +y up, +z forward), where feature points and FAPUs live.
 
+pub mod morphs;
+pub mod obj_io;
+pub mod summary;
 pub mod validate;
 pub mod vrml_io;
 
