@@ -268,6 +268,15 @@ pub fn summarize(face: &FaceModel, report: Option<&FaceReadReport>) -> FaceSumma
     }
 }
 
+/// `v` with `digits` significant digits in plain decimal notation.
+fn significant(v: f64, digits: i32) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return v.to_string();
+    }
+    let decimals = (digits - 1 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}")
+}
+
 /// Compresses sorted numbers into ranges: `3-5, 7, 9-12`.
 fn ranges(v: &[u8]) -> String {
     let mut out: Vec<String> = Vec::new();
@@ -360,7 +369,10 @@ impl FaceSummary {
                     .iter()
                     .filter_map(|k| {
                         let a = k.abbreviation();
-                        u.get(a).map(|v| format!("{a} {v}"))
+                        u.get(a).map(|v| match k {
+                            FapuKind::Au => format!("{a} {v:e} rad"),
+                            _ => format!("{a} {}", significant(*v, 6)),
+                        })
                     })
                     .collect();
                 let _ = writeln!(s, "\nFAPU: {}", list.join(", "));
@@ -424,6 +436,9 @@ mod tests {
     fn ranges_compress() {
         assert_eq!(ranges(&[3, 4, 5, 7, 9, 10]), "3-5, 7, 9-10");
         assert_eq!(ranges(&[]), "none");
+        assert_eq!(significant(0.012345012, 6), "0.0123450");
+        assert_eq!(significant(0.00001, 6), "0.0000100000");
+        assert_eq!(significant(512.25, 6), "512.250");
     }
 
     #[test]
