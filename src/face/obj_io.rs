@@ -469,4 +469,28 @@ mod tests {
         let off = face.meshes[0].mesh.vertex_count();
         assert_eq!(m.positions[off], face.vertex_world(&frames, 1, 0).unwrap());
     }
+
+    #[test]
+    fn writers_round_trip_by_extension() {
+        let dir = tempfile::tempdir().unwrap();
+        let face = FaceModel::from_synth(&crate::synth::alma());
+        for name in ["a.wrl", "a.wrl.gz", "a.wrz"] {
+            let p = dir.path().join(name);
+            write_face(&p, &face).unwrap();
+            let (back, report) = read_face(&p, None).unwrap();
+            assert!(report.diagnostics.is_empty(), "{name}");
+            assert!(back == face, "{name}");
+        }
+        // OBJ: geometry only, read → write → read equal.
+        let p = dir.path().join("a.obj");
+        write_face(&p, &face).unwrap();
+        let (obj, _) = read_face(&p, None).unwrap();
+        let q = dir.path().join("b.obj");
+        write_face(&q, &obj).unwrap();
+        let (again, _) = read_face(&q, None).unwrap();
+        assert_eq!(again.meshes[0].mesh.positions, obj.meshes[0].mesh.positions);
+        assert_eq!(again.meshes[0].mesh.polygons, obj.meshes[0].mesh.polygons);
+        assert_eq!(obj.vertex_count(), face.vertex_count());
+        assert!(write_face(&dir.path().join("a.txt"), &face).is_err());
+    }
 }
