@@ -1,4 +1,4 @@
-//! Played frame data (snapshot) and `fbakit play` / `fbakit export-face` through the binary.
+//! Played frame data (snapshot) and `fbakit play` / `fbakit face export` through the binary.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -176,7 +176,14 @@ fn play_usage_errors_exit_2() {
 fn export_face_writes_morph_targets() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("alma.gltf");
-    let o = fbakit(&["export-face", "alma", "-o", out.to_str().unwrap(), "--json"]);
+    let o = fbakit(&[
+        "face",
+        "export",
+        "alma",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -193,6 +200,6 @@ fn export_face_writes_morph_targets() {
         names.as_array().unwrap().iter().any(|n| n == "open_jaw#1"),
         "{names}"
     );
-    let o = fbakit(&["export-face", "alma", "-o", "alma.obj"]);
+    let o = fbakit(&["face", "export", "alma", "-o", "alma.obj"]);
     assert_eq!(o.status.code(), Some(2));
 }

@@ -1,5 +1,5 @@
-//! `fbakit export-face FACE -o OUT.glb|.gltf`: a face with its FAT as morph targets (no
-//! animation). Kept as one small function so it can move under a `face` command group.
+//! `fbakit face export FACE -o OUT.glb|.gltf [--gltf]`: a face with its FAT as morph targets
+//! (no animation).
 
 use std::path::PathBuf;
 
@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::{print_json, EXIT_OK};
 
-/// Arguments of `export-face`.
+/// Arguments of `face export`.
 #[derive(Debug, Args)]
 pub struct FaceExportArgs {
     /// Face: a VRML face file, or `alma` / `bruno` for the built-in faces.
@@ -19,6 +19,9 @@ pub struct FaceExportArgs {
     /// Output `.glb` or `.gltf` file.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
+    /// Export as glTF 2.0 (the export format; binary or text by OUT's extension).
+    #[arg(long)]
+    pub gltf: bool,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -33,7 +36,7 @@ struct Report {
     warnings: Vec<String>,
 }
 
-/// Runs `export-face`.
+/// Runs `face export`.
 pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
     let ext = a
         .output

@@ -8,7 +8,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-mod face_export;
+mod candide;
+pub mod face;
+pub mod face_export;
 pub mod fap;
 mod fapu;
 pub mod play;
@@ -73,9 +75,28 @@ pub enum Command {
                       fbakit play bruno samples/lowlevel.fap -o frames/ --fps 50 --frames 0..25"
     )]
     Play(play::PlayArgs),
-    /// Export a face with its FAT as glTF morph targets (no animation).
-    #[command(after_help = "Example:\n  fbakit export-face alma -o alma.glb")]
-    ExportFace(face_export::FaceExportArgs),
+    /// Inspect, validate and convert face models; build them from morph sets and back.
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  fbakit face info samples/faces/alma.wrl.gz\n  \
+                      fbakit face validate face.wrl\n  \
+                      fbakit face convert head.obj head.wrl --fp head.csv\n  \
+                      fbakit face from-morphs neutral.obj morphs/ --fp neutral.csv -o face.wrl\n  \
+                      fbakit face to-morphs face.wrl morphs/"
+    )]
+    Face(face::FaceCommand),
+    /// Build an MPEG-4 face with a FAT from the CANDIDE-3 model (.wfm) and its feature-point table.
+    #[command(
+        long_about = "Build an MPEG-4 face with a FAT from the CANDIDE-3 model: one mesh `candide`, feature points bound to its vertices, FAPU measured on the shaped face, and one table per FAP unit of the model (rate = the unit's direction × the face's FAPU, borders 0 1024, linear beyond). FAPs 23-30 (eyeballs, pupils: translations without a FAPU in the model) and the action unit vectors get no table.",
+        after_help = "Example:\n  fbakit candide candide3.wfm --fp feature-points.csv \
+                      --shape \"Mouth width=0.3,Eyes, width=0.2\" -o candide.wrl"
+    )]
+    Candide(candide::CandideArgs),
+    /// Write a bundled procedural face (alma or bruno) with its full FAT.
+    #[command(
+        after_help = "Examples:\n  fbakit sample alma -o alma.wrl\n  fbakit sample bruno -o bruno.wrl.gz"
+    )]
+    Sample(candide::SampleArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -95,7 +116,9 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Fapu(args) => fapu::run(args),
         Command::Fap(cmd) => fap::run(cmd),
         Command::Play(args) => play::run(args),
-        Command::ExportFace(args) => face_export::run_face_export(args),
+        Command::Face(cmd) => face::run(cmd),
+        Command::Candide(args) => candide::run(args),
+        Command::Sample(args) => candide::sample(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

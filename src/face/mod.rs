@@ -2,13 +2,17 @@
 //! and Facial Animation Tables (FAT).
 //!
 //! [`FaceModel`] is what cloning and playing work on. It is read from and written to VRML97
-//! face files ([`vrml_io`]), built from OBJ morph sets, from CANDIDE-3 or from the procedural
-//! generator ([`FaceModel::from_synth`]).
+//! face files ([`vrml_io`]; any face file by extension, gzip and OBJ included: [`obj_io`]),
+//! built from OBJ morph sets ([`morphs`]), from CANDIDE-3 ([`crate::candide::face`]) or from
+//! the procedural generator ([`FaceModel::from_synth`]); [`summary`] describes one.
 //!
 //! Frames: mesh positions and FAT displacements are in each mesh's local frame (its
-//! `Coordinate` node); [`FaceModel::mesh_world`] places them in the face frame (MPEG-4: +x the
+//! `Coordinate` node); [`FaceModel::frames`] places them in the face frame (MPEG-4: +x the
 //! face's own left, +y up, +z forward), where feature points and FAPUs live.
 
+pub mod morphs;
+pub mod obj_io;
+pub mod summary;
 pub mod validate;
 pub mod vrml_io;
 

@@ -1,0 +1,77 @@
+//! `fbakit candide WFM --fp CSV [--shape ...] -o FACE` and `fbakit sample NAME -o FACE`.
+
+use std::path::PathBuf;
+
+use fbakit::candide::face::candide_face_with_notes;
+use fbakit::candide::{parse_shape_spec, read_wfm_file};
+use fbakit::error::Result;
+use fbakit::face::obj_io::write_face;
+use fbakit::face::FaceModel;
+
+use super::EXIT_OK;
+
+/// Arguments of `candide`.
+#[derive(Debug, clap::Args)]
+pub struct CandideArgs {
+    /// CANDIDE-3 model (.wfm).
+    pub wfm: PathBuf,
+    /// Feature-point table binding MPEG-4 points to CANDIDE vertices (.csv).
+    #[arg(long, value_name = "CSV")]
+    pub fp: PathBuf,
+    /// Shape units to apply, `name=value,...` (names may contain commas: `Eyes, width=0.2`).
+    #[arg(long, value_name = "SPEC", allow_hyphen_values = true)]
+    pub shape: Option<String>,
+    /// Output face (.wrl, .wrl.gz, .obj).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+}
+
+/// Writes a CANDIDE face.
+pub fn run(a: CandideArgs) -> Result<u8> {
+    let model = read_wfm_file(&a.wfm)?;
+    let fp = fbakit::fdp::read_feature_points(&a.fp)?.points;
+    let shape = match &a.shape {
+        Some(s) => parse_shape_spec(s)?,
+        None => Vec::new(),
+    };
+    let c = candide_face_with_notes(&model, &fp, &shape)?;
+    write_face(&a.output, &c.face)?;
+    for n in &c.notes {
+        eprintln!("note: {n}");
+    }
+    eprintln!(
+        "wrote {} ({} vertices, {} FAT tables)",
+        a.output.display(),
+        c.face.vertex_count(),
+        c.face.fat.tables.len()
+    );
+    Ok(EXIT_OK)
+}
+
+/// Arguments of `sample`.
+#[derive(Debug, clap::Args)]
+pub struct SampleArgs {
+    /// Which procedural face.
+    #[arg(value_parser = ["alma", "bruno"])]
+    pub name: String,
+    /// Output face (.wrl, .wrl.gz, .obj).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+}
+
+/// Writes a bundled procedural face.
+pub fn sample(a: SampleArgs) -> Result<u8> {
+    let synth = match a.name.as_str() {
+        "alma" => fbakit::synth::alma(),
+        _ => fbakit::synth::bruno(),
+    };
+    let face = FaceModel::from_synth(&synth);
+    write_face(&a.output, &face)?;
+    eprintln!(
+        "wrote {} ({} vertices, {} FAT tables)",
+        a.output.display(),
+        face.vertex_count(),
+        face.fat.tables.len()
+    );
+    Ok(EXIT_OK)
+}

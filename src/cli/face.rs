@@ -1,0 +1,247 @@
+//! `fbakit face info|validate|convert|from-morphs|to-morphs`: face model commands.
+
+use std::path::PathBuf;
+
+use fbakit::error::{Result, Severity};
+use fbakit::face::morphs::{face_from_morph_set, write_morph_set, MorphSetOptions};
+use fbakit::face::obj_io::{read_face, write_face};
+use fbakit::face::summary::summarize;
+use fbakit::face::validate::validate_face;
+
+use super::{print_json, EXIT_FAILURE, EXIT_OK};
+
+/// Face subcommands.
+#[derive(Debug, clap::Subcommand)]
+pub enum FaceCommand {
+    /// Summarise a face: meshes, feature points, FAPU, FAT coverage.
+    #[command(after_help = "Examples:\n  fbakit face info face.wrl\n  \
+                            fbakit face info head.obj --fp head.fdp --json")]
+    Info(InfoArgs),
+    /// Check a face file and list every problem with its scene path and line.
+    /// Exit code 0 when valid, 1 when problems were found, 2 when unreadable.
+    #[command(after_help = "Example:\n  fbakit face validate face.wrl")]
+    Validate(ValidateArgs),
+    /// Convert a face between .wrl, .wrl.gz (.wrz) and .obj (OBJ keeps geometry only: all
+    /// meshes merged in face coordinates).
+    #[command(
+        after_help = "Examples:\n  fbakit face convert face.wrl face.wrl.gz\n  \
+                            fbakit face convert head.obj head.wrl --fp head.csv"
+    )]
+    Convert(ConvertArgs),
+    /// Build a face with a FAT from a neutral OBJ and a folder of morph OBJs.
+    #[command(
+        long_about = "Build a face with a FAT from a neutral OBJ and a folder of morph OBJs, \
+                      each with the neutral's topology and named after what it shows: a FAP \
+                      (open_jaw.obj), a viseme (viseme_7.obj) or an expression (joy.obj), \
+                      optionally with the FAP value it shows after @ (open_jaw@-512.obj).\n\n\
+                      The value of a morph is taken from its name, else from the manifest \
+                      (JSON: {\"open_jaw\": 1024}), else the default: 63 for visemes and \
+                      expressions (full strength), 20000 (0.2 rad) for rotation FAPs, 512 for \
+                      the other FAPs. Several morphs of one key at different values make a \
+                      multi-interval table. Vertices that moved no more than the tolerance are \
+                      left out. Files that are not .obj, and neutral.obj, are ignored.",
+        after_help = "Example:\n  fbakit face from-morphs neutral.obj morphs/ --fp neutral.csv -o face.wrl"
+    )]
+    FromMorphs(FromMorphsArgs),
+    /// Write a face's FAT as morph OBJs (plus neutral.obj and feature-points.csv).
+    #[command(
+        long_about = "Write one OBJ per table of the face's FAT: by default at each of the \
+                      table's non-zero interval borders, or at --value. Each OBJ is the whole \
+                      face (meshes merged in face coordinates) with the table's vertex motion \
+                      and the motion of the transforms it drives. Files are named like \
+                      from-morphs reads them (open_jaw.obj at the default value, \
+                      open_jaw@1024.obj otherwise); neutral.obj and feature-points.csv are \
+                      written too, so `face from-morphs DIR/neutral.obj DIR --fp \
+                      DIR/feature-points.csv` reads the set back.",
+        after_help = "Example:\n  fbakit face to-morphs face.wrl morphs/"
+    )]
+    ToMorphs(ToMorphsArgs),
+    /// Export a face with its FAT as glTF 2.0 morph targets (no animation).
+    #[command(
+        long_about = "Export a face as glTF 2.0: its transforms as nodes, each mesh with its \
+                      colour, and the FAT as morph targets (one per table, or one per interval \
+                      of a multi-interval table) named in extras.targetNames. OUT's extension \
+                      picks binary .glb or text .gltf (buffer embedded).",
+        after_help = "Examples:\n  fbakit face export alma -o alma.glb --gltf\n  \
+                      fbakit face export samples/faces/bruno.wrl.gz -o bruno.gltf"
+    )]
+    Export(super::face_export::FaceExportArgs),
+}
+
+/// Arguments of `face info`.
+#[derive(Debug, clap::Args)]
+pub struct InfoArgs {
+    /// Face file (.wrl, .wrl.gz, .wrz, .obj).
+    pub file: PathBuf,
+    /// Feature-point file (.xml, .fdp, .csv) whose points replace the face's.
+    #[arg(long, value_name = "FILE")]
+    pub fp: Option<PathBuf>,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `face validate`.
+#[derive(Debug, clap::Args)]
+pub struct ValidateArgs {
+    /// Face file.
+    pub file: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `face convert`.
+#[derive(Debug, clap::Args)]
+pub struct ConvertArgs {
+    /// Input face file.
+    pub input: PathBuf,
+    /// Output face file; the format follows its extension.
+    pub output: PathBuf,
+    /// Feature-point file for the input (needed to give an OBJ face feature points).
+    #[arg(long, value_name = "FILE")]
+    pub fp: Option<PathBuf>,
+}
+
+/// Arguments of `face from-morphs`.
+#[derive(Debug, clap::Args)]
+pub struct FromMorphsArgs {
+    /// The neutral face (.obj).
+    pub neutral: PathBuf,
+    /// Folder of morph OBJs.
+    pub morph_dir: PathBuf,
+    /// Feature points of the neutral (.xml, .fdp, .csv).
+    #[arg(long, value_name = "FILE")]
+    pub fp: PathBuf,
+    /// Output face (.wrl, .wrl.gz).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// JSON object of morph file stem → FAP value.
+    #[arg(long, value_name = "FILE")]
+    pub manifest: Option<PathBuf>,
+    /// Vertices that moved no more than this are left out (default: 1e-6 × the neutral's
+    /// bounding-box diagonal).
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+}
+
+/// Arguments of `face to-morphs`.
+#[derive(Debug, clap::Args)]
+pub struct ToMorphsArgs {
+    /// Face file with a FAT.
+    pub face: PathBuf,
+    /// Output folder (created if needed).
+    pub dir: PathBuf,
+    /// Evaluate every table at this value instead of its reference values.
+    #[arg(long, value_name = "P", allow_negative_numbers = true)]
+    pub value: Option<f64>,
+}
+
+/// Runs a face subcommand.
+pub fn run(cmd: FaceCommand) -> Result<u8> {
+    match cmd {
+        FaceCommand::Info(a) => info(a),
+        FaceCommand::Validate(a) => validate(a),
+        FaceCommand::Convert(a) => convert(a),
+        FaceCommand::FromMorphs(a) => from_morphs(a),
+        FaceCommand::ToMorphs(a) => to_morphs(a),
+        FaceCommand::Export(a) => super::face_export::run_face_export(a),
+    }
+}
+
+fn info(a: InfoArgs) -> Result<u8> {
+    let (face, report) = read_face(&a.file, a.fp.as_deref())?;
+    let summary = summarize(&face, Some(&report));
+    if a.json {
+        print_json(&summary)?;
+    } else {
+        print!("{}", summary.to_text());
+    }
+    Ok(EXIT_OK)
+}
+
+fn validate(a: ValidateArgs) -> Result<u8> {
+    let (face, report) = read_face(&a.file, None)?;
+    let findings = validate_face(&face, &report);
+    let errors = findings
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .count();
+    if a.json {
+        print_json(&serde_json::json!({
+            "file": a.file.display().to_string(),
+            "valid": errors == 0,
+            "problems": findings,
+        }))?;
+    } else {
+        for d in &findings {
+            println!("{d}");
+        }
+        if errors == 0 {
+            println!("{}: valid", a.file.display());
+        } else {
+            println!(
+                "{}: {} problem(s), {} warning(s)",
+                a.file.display(),
+                errors,
+                findings.len() - errors
+            );
+        }
+    }
+    Ok(if errors == 0 { EXIT_OK } else { EXIT_FAILURE })
+}
+
+fn convert(a: ConvertArgs) -> Result<u8> {
+    let (face, _) = read_face(&a.input, a.fp.as_deref())?;
+    write_face(&a.output, &face)?;
+    eprintln!(
+        "wrote {} ({} meshes, {} vertices, {} FAT tables)",
+        a.output.display(),
+        face.meshes.len(),
+        face.vertex_count(),
+        face.fat.tables.len()
+    );
+    Ok(EXIT_OK)
+}
+
+fn from_morphs(a: FromMorphsArgs) -> Result<u8> {
+    let options = MorphSetOptions {
+        feature_points: Some(a.fp),
+        manifest: a.manifest,
+        tolerance: a.tolerance,
+    };
+    let (face, report) = face_from_morph_set(&a.neutral, &a.morph_dir, &options)?;
+    write_face(&a.output, &face)?;
+    for m in &report.morphs {
+        eprintln!(
+            "{}: {} at {} ({:?}), {} vertices",
+            m.file.display(),
+            m.key,
+            m.value,
+            m.value_source,
+            m.moved_vertices
+        );
+    }
+    for f in &report.ignored {
+        eprintln!("ignored {}", f.display());
+    }
+    eprintln!(
+        "wrote {} ({} tables from {} morphs, tolerance {})",
+        a.output.display(),
+        face.fat.tables.len(),
+        report.morphs.len(),
+        report.tolerance
+    );
+    Ok(EXIT_OK)
+}
+
+fn to_morphs(a: ToMorphsArgs) -> Result<u8> {
+    let (face, _) = read_face(&a.face, None)?;
+    let written = write_morph_set(&face, &a.dir, a.value)?;
+    eprintln!(
+        "wrote {} morph OBJs, neutral.obj and feature-points.csv to {}",
+        written.len(),
+        a.dir.display()
+    );
+    Ok(EXIT_OK)
+}
