@@ -71,3 +71,72 @@ fn measure_full_size() {
     let c = compliance(&b).unwrap();
     println!("bruno own compliance worst {} mean {}", c.worst, c.mean);
 }
+
+fn faces() -> &'static (FaceModel, FaceModel) {
+    static F: std::sync::OnceLock<(FaceModel, FaceModel)> = std::sync::OnceLock::new();
+    F.get_or_init(|| (alma(), bruno()))
+}
+
+fn opts(method: Method) -> CloneOptions {
+    CloneOptions {
+        method,
+        ..CloneOptions::default()
+    }
+}
+
+// Bounds are the release-build measurements (in comments) with a margin.
+
+#[test]
+fn self_clone_of_alma_stays_small() {
+    let (a, _) = faces();
+    let fmc = self_clone_error(a, Method::Fmc).unwrap(); // measured 0.578 %
+    let rbf = self_clone_error(a, Method::Rbf).unwrap(); // measured 0.271 %
+    assert!(fmc < 0.8, "fmc {fmc} %");
+    assert!(rbf < 0.4, "rbf {rbf} %");
+}
+
+#[test]
+fn alma_to_bruno_against_ground_truth_and_compliance() {
+    let (a, b) = faces();
+    let rbf = clone_face(a, b, &opts(Method::Rbf)).unwrap();
+    let gt = ground_truth_error(&rbf.face, b).unwrap();
+    assert!(gt.mean_all < 40.0, "rbf ground truth {} %", gt.mean_all); // measured 33.3 %
+    let c = compliance(&rbf.face).unwrap();
+    assert!(c.worst < 0.05, "rbf compliance worst {}", c.worst); // measured 0.027
+    assert!(c.mean < 0.015, "rbf compliance mean {}", c.mean); // measured 0.0074
+    assert_eq!(c.faps.len(), compliance(b).unwrap().faps.len());
+    // Rigid parts: the eye, head and jaw transforms are driven on the clone.
+    for key in [
+        "yaw_l_eyeball",
+        "head_pitch",
+        "open_jaw",
+        "thrust_l_eyeball",
+    ] {
+        let t = rbf
+            .face
+            .fat
+            .tables
+            .iter()
+            .find(|t| t.key.name() == key)
+            .unwrap();
+        assert!(!t.transforms.is_empty(), "{key} has no transform entry");
+    }
+    let fmc = clone_face(a, b, &opts(Method::Fmc)).unwrap();
+    let gt = ground_truth_error(&fmc.face, b).unwrap();
+    assert!(gt.mean_all < 85.0, "fmc ground truth {} %", gt.mean_all); // measured 76.8 %
+    let c = compliance(&fmc.face).unwrap();
+    assert!(c.mean < 0.06, "fmc compliance mean {}", c.mean); // measured 0.038
+}
+
+#[test]
+fn rbf_paper_mode_is_less_compliant() {
+    let (a, b) = faces();
+    let paper = CloneOptions {
+        rbf_fapu_rescale: false,
+        ..opts(Method::Rbf)
+    };
+    let out = clone_face(a, b, &paper).unwrap();
+    assert!(out.report.fapu_rescale.is_empty());
+    let c = compliance(&out.face).unwrap();
+    assert!(c.worst > 0.3, "paper worst {}", c.worst); // measured 0.50
+}
