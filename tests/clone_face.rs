@@ -140,3 +140,16 @@ fn rbf_paper_mode_is_less_compliant() {
     let c = compliance(&out.face).unwrap();
     assert!(c.worst > 0.3, "paper worst {}", c.worst); // measured 0.50
 }
+
+#[test]
+#[ignore = "writes alma.wrl and bruno.wrl to $FBAKIT_SYNTH_DIR for manual runs"]
+fn write_synth_faces() {
+    let Ok(dir) = std::env::var("FBAKIT_SYNTH_DIR") else {
+        return;
+    };
+    let (a, b) = faces();
+    fbakit::face::vrml_io::write_face_file(&std::path::Path::new(&dir).join("alma.wrl"), a)
+        .unwrap();
+    fbakit::face::vrml_io::write_face_file(&std::path::Path::new(&dir).join("bruno.wrl"), b)
+        .unwrap();
+}
