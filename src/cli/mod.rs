@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod candide;
+mod clone;
 pub mod face;
 pub mod face_export;
 pub mod fap;
@@ -97,6 +98,26 @@ pub enum Command {
         after_help = "Examples:\n  fbakit sample alma -o alma.wrl\n  fbakit sample bruno -o bruno.wrl.gz"
     )]
     Sample(candide::SampleArgs),
+    /// Clone the facial animation (FAT) of a source face onto a target face.
+    #[command(
+        long_about = "Clone the Facial Animation Tables of SOURCE onto TARGET: the skin by \
+                      facial motion cloning (fmc, Pandzic 2003) or RBF cloning (rbf, \
+                      Fratarcangeli & Schaerf 2005), eyes, teeth, tongue and head by their \
+                      transforms. Faces are VRML face files, or OBJ meshes with a \
+                      feature-point file. Exit codes: 0 ok, 2 bad usage or input (including \
+                      missing feature points), 1 other failures.",
+        after_help = "Examples:\n  fbakit clone alma.wrl bruno.wrl -o bruno-animated.wrl\n  \
+                      fbakit clone alma.wrl head.obj --fp-target head.fdp -o head.wrl --method rbf --report\n  \
+                      fbakit clone alma.wrl bruno.wrl -o out.wrl --json > report.json"
+    )]
+    Clone(clone::CloneArgs),
+    /// Quality figures of a face's FAT (compliance, self-cloning error).
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  fbakit eval compliance bruno-animated.wrl\n  \
+                      fbakit eval self-clone alma.wrl --method rbf --json"
+    )]
+    Eval(clone::EvalCommand),
 }
 
 #[derive(Debug, clap::Args)]
@@ -119,6 +140,8 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Face(cmd) => face::run(cmd),
         Command::Candide(args) => candide::run(args),
         Command::Sample(args) => candide::sample(args),
+        Command::Clone(args) => clone::run(args),
+        Command::Eval(cmd) => clone::run_eval(cmd),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -1,0 +1,295 @@
+//! `fbakit clone` (FAT cloning of whole faces) and `fbakit eval` (quality figures).
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use fbakit::clone::eval::{compliance, self_clone_error_with, ComplianceReport};
+use fbakit::clone::face::{clone_face, CloneOptions, CloneReport, Method};
+use fbakit::error::{Error, Result};
+use fbakit::face::{FaceMesh, FaceModel};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+use super::{print_json, EXIT_BAD_INPUT, EXIT_OK};
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Pandžić 2003 facial motion cloning.
+    Fmc,
+    /// Fratarcangeli & Schaerf 2005 RBF cloning.
+    Rbf,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Method {
+        match m {
+            MethodArg::Fmc => Method::Fmc,
+            MethodArg::Rbf => Method::Rbf,
+        }
+    }
+}
+
+#[derive(Debug, clap::Args)]
+pub struct CloneArgs {
+    /// Source face with a FAT: VRML (`.wrl`), or `.obj` with --fp-source.
+    pub source: PathBuf,
+    /// Target face: VRML (`.wrl`), or `.obj` with --fp-target.
+    pub target: PathBuf,
+    /// Output face (`.wrl`).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Surface method.
+    #[arg(long, value_enum, default_value = "fmc")]
+    pub method: MethodArg,
+    /// RBF as in the paper: no FAPU rescaling of the cloned motions.
+    #[arg(long)]
+    pub rbf_paper: bool,
+    /// Do not align the target onto the source (use when both are in the MPEG-4 frame and
+    /// the feature points disagree a lot).
+    #[arg(long)]
+    pub no_align: bool,
+    /// Feature points of an OBJ source.
+    #[arg(long, value_name = "FILE")]
+    pub fp_source: Option<PathBuf>,
+    /// Feature points of an OBJ target.
+    #[arg(long, value_name = "FILE")]
+    pub fp_target: Option<PathBuf>,
+    /// Print the cloning report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Also measure quality: self-clone error of the source, compliance of the output.
+    #[arg(long)]
+    pub report: bool,
+}
+
+#[derive(Debug, clap::Subcommand)]
+pub enum EvalCommand {
+    /// FAP compliance of a face's FAT: each translation FAP's feature point at ±512 against
+    /// value × FAPU × direction.
+    #[command(after_help = "Example:\n  fbakit eval compliance cloned.wrl --json")]
+    Compliance(EvalFaceArgs),
+    /// Clone a face onto itself and report formula (1) of Fratarcangeli & Schaerf 2005 (%).
+    #[command(after_help = "Example:\n  fbakit eval self-clone alma.wrl --method rbf")]
+    SelfClone(SelfCloneArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct EvalFaceArgs {
+    /// Face file (`.wrl`, or `.obj` with --fp).
+    pub face: PathBuf,
+    /// Feature points of an OBJ face.
+    #[arg(long, value_name = "FILE")]
+    pub fp: Option<PathBuf>,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct SelfCloneArgs {
+    #[command(flatten)]
+    pub face: EvalFaceArgs,
+    /// Surface method.
+    #[arg(long, value_enum, default_value = "fmc")]
+    pub method: MethodArg,
+}
+
+/// Reads a face: VRML, or OBJ plus feature points (a small local loader: one mesh, no FAT).
+fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
+    let is_obj = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if !is_obj {
+        return Ok(fbakit::face::vrml_io::read_face_file(path)?.0);
+    }
+    let Some(fp) = fp else {
+        return Err(Error::Invalid(format!(
+            "{}: an OBJ face needs its feature points (--fp-source / --fp-target / --fp FILE)",
+            path.display()
+        )));
+    };
+    let (scene, _) = fbakit::mesh::obj::read_obj_file(path)?;
+    let name = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("face")
+        .to_string();
+    let mut face = FaceModel::new(name.clone());
+    face.meshes.push(FaceMesh {
+        name,
+        transform: None,
+        mesh: scene.mesh,
+        color: None,
+    });
+    face.feature_points = fbakit::fdp::read_feature_points(fp)?.points;
+    face.resolve_feature_points()?;
+    Ok(face)
+}
+
+fn bar(steps: u64) -> ProgressBar {
+    let pb = ProgressBar::with_draw_target(
+        Some(steps),
+        if std::io::stderr().is_terminal() {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        },
+    );
+    if let Ok(style) = ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}") {
+        pb.set_style(style);
+    }
+    pb
+}
+
+#[derive(Serialize)]
+struct Quality {
+    self_clone_error_percent: f64,
+    compliance: ComplianceReport,
+}
+
+#[derive(Serialize)]
+struct Output<'a> {
+    output: String,
+    report: &'a CloneReport,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    quality: Option<Quality>,
+}
+
+pub fn run(args: CloneArgs) -> Result<u8> {
+    let ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("wrl" | "vrml")) {
+        eprintln!(
+            "error: {}: only .wrl output is supported (glTF output: not yet)",
+            args.output.display()
+        );
+        return Ok(EXIT_BAD_INPUT);
+    }
+    let pb = bar(if args.report { 5 } else { 4 });
+    pb.set_message("reading source");
+    let source = read_face(&args.source, args.fp_source.as_deref())?;
+    pb.inc(1);
+    pb.set_message("reading target");
+    let target = read_face(&args.target, args.fp_target.as_deref())?;
+    pb.inc(1);
+    pb.set_message("cloning");
+    let opts = CloneOptions {
+        method: args.method.into(),
+        rbf_fapu_rescale: !args.rbf_paper,
+        align: !args.no_align,
+        ..CloneOptions::default()
+    };
+    let outcome = clone_face(&source, &target, &opts)?;
+    pb.inc(1);
+    pb.set_message("writing");
+    fbakit::face::vrml_io::write_face_file(&args.output, &outcome.face)?;
+    pb.inc(1);
+    let quality = if args.report {
+        pb.set_message("measuring quality");
+        let q = Quality {
+            self_clone_error_percent: self_clone_error_with(&source, &opts)?,
+            compliance: compliance(&outcome.face)?,
+        };
+        pb.inc(1);
+        Some(q)
+    } else {
+        None
+    };
+    pb.finish_and_clear();
+    let r = &outcome.report;
+    if args.json {
+        print_json(&Output {
+            output: args.output.display().to_string(),
+            report: r,
+            quality,
+        })?;
+        return Ok(EXIT_OK);
+    }
+    for w in &r.warnings {
+        eprintln!("warning: {w}");
+    }
+    println!(
+        "cloned {} morph targets ({} tables) with {} onto {} skin vertices in {:.3} s -> {}",
+        r.motions,
+        r.tables,
+        r.method.name(),
+        r.surface_vertices[1],
+        r.timings.total(),
+        args.output.display()
+    );
+    println!(
+        "alignment: scale {:.4}, rotation {:.2} deg, rms {:.4}",
+        r.alignment.scale,
+        r.alignment.angle_degrees(),
+        r.alignment_rms
+    );
+    for (step, s) in &r.timings.steps {
+        println!("  {step:<20} {:>8.1} ms", s * 1000.0);
+    }
+    if let Some(q) = quality {
+        println!(
+            "self-clone error of the source: {:.3e} %",
+            q.self_clone_error_percent
+        );
+        print_compliance(&q.compliance);
+    }
+    Ok(EXIT_OK)
+}
+
+fn print_compliance(c: &ComplianceReport) {
+    println!(
+        "compliance: {} FAPs, worst {:.3} %, mean {:.3} % (error along the FAP direction)",
+        c.faps.len(),
+        c.worst * 100.0,
+        c.mean * 100.0
+    );
+}
+
+pub fn run_eval(cmd: EvalCommand) -> Result<u8> {
+    match cmd {
+        EvalCommand::Compliance(a) => {
+            let face = read_face(&a.face, a.fp.as_deref())?;
+            let c = compliance(&face)?;
+            if a.json {
+                print_json(&c)?;
+            } else {
+                print_compliance(&c);
+                for f in &c.faps {
+                    println!(
+                        "  {:<24} {:<5} along {:>8.3} %  vector {:>8.3} %",
+                        f.fap,
+                        f.feature_point,
+                        f.along_error * 100.0,
+                        f.vector_error * 100.0
+                    );
+                }
+                if !c.skipped.is_empty() {
+                    println!(
+                        "  not measured (no feature point): {}",
+                        c.skipped.join(", ")
+                    );
+                }
+            }
+        }
+        EvalCommand::SelfClone(a) => {
+            let face = read_face(&a.face.face, a.face.fp.as_deref())?;
+            let opts = CloneOptions {
+                method: a.method.into(),
+                ..CloneOptions::default()
+            };
+            let e = self_clone_error_with(&face, &opts)?;
+            if a.face.json {
+                print_json(
+                    &serde_json::json!({ "method": opts.method, "self_clone_error_percent": e }),
+                )?;
+            } else {
+                println!("self-clone error ({}): {e:.3e} %", opts.method.name());
+            }
+        }
+    }
+    Ok(EXIT_OK)
+}

@@ -1,0 +1,63 @@
+//! `fbakit clone` and `fbakit eval` end to end on the synthetic faces.
+
+use std::process::Command;
+
+use fbakit::face::vrml_io::write_face_file;
+use fbakit::face::FaceModel;
+
+fn fbakit() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_fbakit"))
+}
+
+#[test]
+fn clone_writes_a_face_and_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("alma.wrl"), dir.path().join("bruno.wrl"));
+    write_face_file(&a, &FaceModel::from_synth(&fbakit::synth::alma())).unwrap();
+    let mut plain = FaceModel::from_synth(&fbakit::synth::bruno());
+    plain.fat = Default::default();
+    write_face_file(&b, &plain).unwrap();
+    let out = dir.path().join("out.wrl");
+    let o = fbakit()
+        .args(["clone", a.to_str().unwrap(), b.to_str().unwrap(), "-o"])
+        .arg(&out)
+        .args(["--method", "rbf", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(json["report"]["method"], "rbf");
+    assert!(json["report"]["tables"].as_u64().unwrap() >= 80);
+    let (face, _) = fbakit::face::vrml_io::read_face_file(&out).unwrap();
+    assert!(face.fat.tables.len() >= 80);
+    let o = fbakit()
+        .args(["eval", "compliance"])
+        .arg(&out)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let c: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(c["worst"].as_f64().unwrap() < 0.05);
+    // Unsupported output and an OBJ without feature points are usage errors (exit 2).
+    let o = fbakit()
+        .args([
+            "clone",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "-o",
+            "x.glb",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not yet"));
+    let o = fbakit()
+        .args(["clone", a.to_str().unwrap(), "head.obj", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let o = fbakit().args(["clone", "--help"]).output().unwrap();
+    assert!(String::from_utf8_lossy(&o.stdout).contains("Examples"));
+}
