@@ -24,7 +24,7 @@
 //! as f32). The left half is computed and mirrored, so the faces are exactly symmetric.
 //!
 //! ## FAT
-//! See [`fat`](self::fat) for how each FAP is defined. Every low-level FAP 3..=68 has a table;
+//! The private `fat` submodule documents how each FAP is defined. Every low-level FAP 3..=68 has a table;
 //! translation FAPs move their feature point by exactly `P × FAPU × direction`.
 
 mod fat;
