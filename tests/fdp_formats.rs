@@ -248,6 +248,40 @@ fn cli_fapu_on_sample() {
 }
 
 #[test]
+fn cli_fapu_places_vertex_bound_points_on_a_mesh() {
+    // A square "face" whose vertices carry the five FAPU point pairs at known distances.
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("face.obj");
+    std::fs::write(
+        &obj,
+        "v 0.3 1 0\nv -0.3 1 0\nv 0.3 0.9 0\nv 0 0.5 0\nv 0 0.2 0\nv 0.25 0.2 0\nv -0.25 0.2 0\nf 1 2 3\nf 4 5 6\nf 4 7 5\n",
+    )
+    .unwrap();
+    // 3.5/3.6 pupils (1, 2), 3.1/3.3 lids (1, 3), 9.15 nose (4), 2.2 lip (5), 8.3/8.4 corners (6, 7).
+    let csv = dir.path().join("fp.csv");
+    std::fs::write(
+        &csv,
+        "fp,vertices\n3.5,0\n3.6,1\n3.1,0\n3.3,2\n9.15,3\n2.2,4\n8.3,5\n8.4,6\n",
+    )
+    .unwrap();
+    let (code, out, err) = fbakit(&[
+        "fapu",
+        csv.to_str().unwrap(),
+        "--mesh",
+        obj.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["source"], "feature-points");
+    let d = |i: usize| v["units"][i]["distance"].as_f64().unwrap();
+    // IRISD0 0.1, ES0 0.6, ENS0 0.5, MNS0 0.3, MW0 0.5 (f32 coordinates).
+    for (i, want) in [(0, 0.1), (1, 0.6), (2, 0.5), (3, 0.3), (4, 0.5)] {
+        assert!((d(i) - want).abs() < 1e-6, "unit {i}: {} vs {want}", d(i));
+    }
+}
+
+#[test]
 fn cli_fapu_failures_exit_2_with_a_reason() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("fp.csv");
@@ -256,8 +290,8 @@ fn cli_fapu_failures_exit_2_with_a_reason() {
     assert_eq!((code, out.as_str()), (2, ""));
     assert!(err.contains("pass --mesh MESH"), "{err}");
     let (code, _, err) = fbakit(&["fapu", csv.to_str().unwrap(), "--mesh", "face.obj"]);
-    assert_eq!(code, 2);
-    assert!(err.contains("not yet supported"), "{err}");
+    assert_eq!(code, 2, "a missing mesh is bad input");
+    assert!(err.contains("face.obj"), "{err}");
     let xml = dir.path().join("fp.xml");
     std::fs::write(&xml, "<featurePoints version=\"1\">\n<point id=\"3.5\" x=\"1\" y=\"0\" z=\"0\"/>\n</featurePoints>\n").unwrap();
     let (code, _, err) = fbakit(&["fapu", xml.to_str().unwrap()]);

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use fbakit::error::{Error, Result};
-use fbakit::fdp::{read_feature_points, FapuSource};
+use fbakit::fdp::{read_feature_points, Fapu, FapuSource};
 use fbakit::spec::{FapuKind, FAPU_DIVISOR};
 use serde::Serialize;
 
@@ -13,8 +13,8 @@ use super::{print_json, EXIT_OK};
 pub struct FapuArgs {
     /// Feature-point file: fbakit `.xml`, Xface `.fdp` or `.csv` (fp,vertices,combine,description).
     pub file: PathBuf,
-    /// Neutral mesh whose vertices the feature points are bound to (for files that carry
-    /// vertex indices but no positions).
+    /// Neutral mesh (.obj, .wrl, .wrl.gz) whose vertices the feature points are bound to; the
+    /// points are placed on it and the FAPUs measured there.
     #[arg(long, value_name = "PATH")]
     pub mesh: Option<PathBuf>,
     /// Print JSON instead of a text table.
@@ -40,21 +40,27 @@ struct Report {
 }
 
 pub fn run(args: FapuArgs) -> Result<u8> {
-    let file = read_feature_points(&args.file)?;
-    if let Some(mesh) = &args.mesh {
-        // The mesh readers live elsewhere; until they are wired here, say so plainly.
-        return Err(Error::Unsupported(format!(
-            "--mesh {}: placing feature points on a mesh is not yet supported for this file type",
-            mesh.display()
-        )));
-    }
-    if file.fapu.is_none() && file.points.needs_mesh() {
-        return Err(Error::Invalid(format!(
-            "{}: the feature points are mesh-vertex indices without positions and the file has no FAPU distances; pass --mesh MESH with the neutral mesh they index",
-            args.file.display()
-        )));
-    }
-    let (source, measured) = file.fapu()?;
+    let (source, measured) = match &args.mesh {
+        // With a mesh, the points are placed on its vertices and the FAPUs measured there,
+        // even when the file also states FAPU distances.
+        Some(mesh) => {
+            let (face, _) = fbakit::face::obj_io::read_face(mesh, Some(&args.file))?;
+            (
+                FapuSource::FeaturePoints,
+                Fapu::measure(&face.feature_points)?,
+            )
+        }
+        None => {
+            let file = read_feature_points(&args.file)?;
+            if file.fapu.is_none() && file.points.needs_mesh() {
+                return Err(Error::Invalid(format!(
+                    "{}: the feature points are mesh-vertex indices without positions and the file has no FAPU distances; pass --mesh MESH with the neutral mesh they index",
+                    args.file.display()
+                )));
+            }
+            file.fapu()?
+        }
+    };
     let units = FapuKind::ALL
         .into_iter()
         .map(|k| Row {
