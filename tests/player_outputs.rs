@@ -203,3 +203,40 @@ fn export_face_writes_morph_targets() {
     let o = fbakit(&["face", "export", "alma", "-o", "alma.obj"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn bundled_gzipped_faces_export_and_play() {
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("alma.glb");
+    let o = fbakit(&[
+        "face",
+        "export",
+        "samples/faces/alma.wrl.gz",
+        "-o",
+        glb.to_str().unwrap(),
+        "--gltf",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let bytes = std::fs::read(&glb).unwrap();
+    assert!(fbakit::gltf::parse_glb(&bytes).is_ok());
+    let anim = dir.path().join("speech.glb");
+    let o = fbakit(&[
+        "play",
+        "samples/faces/alma.wrl.gz",
+        "samples/speech.fap",
+        "-o",
+        anim.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(std::fs::metadata(&anim).unwrap().len() > 1000);
+}

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use fbakit::clone::eval::{compliance, self_clone_error_with, ComplianceReport};
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport, Method};
 use fbakit::error::{Error, Result};
-use fbakit::face::{FaceMesh, FaceModel};
+use fbakit::face::FaceModel;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
@@ -94,37 +94,23 @@ pub struct SelfCloneArgs {
     pub method: MethodArg,
 }
 
-/// Reads a face: VRML, or OBJ plus feature points (a small local loader: one mesh, no FAT).
+/// Reads a face: VRML (plain or gzip), or OBJ plus its feature points, or a built-in face
+/// name (`alma`, `bruno`) when no such file exists.
 fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
     let is_obj = path
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if !is_obj {
-        return Ok(fbakit::face::vrml_io::read_face_file(path)?.0);
-    }
-    let Some(fp) = fp else {
+    if is_obj && fp.is_none() {
         return Err(Error::Invalid(format!(
             "{}: an OBJ face needs its feature points (--fp-source / --fp-target / --fp FILE)",
             path.display()
         )));
-    };
-    let (scene, _) = fbakit::mesh::obj::read_obj_file(path)?;
-    let name = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("face")
-        .to_string();
-    let mut face = FaceModel::new(name.clone());
-    face.meshes.push(FaceMesh {
-        name,
-        transform: None,
-        mesh: scene.mesh,
-        color: None,
-    });
-    face.feature_points = fbakit::fdp::read_feature_points(fp)?.points;
-    face.resolve_feature_points()?;
-    Ok(face)
+    }
+    if fp.is_none() {
+        return fbakit::player::load_face(path);
+    }
+    Ok(fbakit::face::obj_io::read_face(path, fp)?.0)
 }
 
 fn bar(steps: u64) -> ProgressBar {

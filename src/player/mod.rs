@@ -386,7 +386,7 @@ pub fn load_face(spec: &std::path::Path) -> Result<FaceModel> {
             _ => {}
         }
     }
-    crate::face::vrml_io::read_face_file(spec).map(|(face, _)| face)
+    crate::face::obj_io::read_face(spec, None).map(|(face, _)| face)
 }
 
 /// 66 low-level FAPs, two viseme and two expression activations.
