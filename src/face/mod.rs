@@ -61,6 +61,23 @@ impl FaceTransform {
         }
     }
 
+    /// The local matrix with a FAT change applied: the FAT rotation turns the neutral
+    /// rotation further in the parent's axes (`ΔR · R`), translation and scale changes add, and
+    /// the whole turns about `center`. Every consumer (player, morph export, cloning
+    /// evaluation) poses transforms through this one rule.
+    pub fn animated_matrix(&self, d: &crate::fat::eval::TransformDelta) -> Affine3A {
+        if *d == crate::fat::eval::TransformDelta::IDENTITY {
+            return self.local_matrix();
+        }
+        local_matrix(
+            self.translation + d.translation,
+            d.rotation * self.rotation,
+            self.scale + d.scale,
+            self.scale_orientation,
+            self.center,
+        )
+    }
+
     /// The VRML97 local matrix `T · C · R · SR · S · SR⁻¹ · C⁻¹`.
     pub fn local_matrix(&self) -> Affine3A {
         local_matrix(

@@ -31,7 +31,7 @@ use glam::{Affine3A, DVec3, Vec3};
 use serde::Serialize;
 
 use super::obj_io::{attach_feature_points, merged_mesh};
-use super::{local_matrix, FaceMesh, FaceModel};
+use super::{FaceMesh, FaceModel};
 use crate::error::{Error, Result};
 use crate::fat::eval::Activation;
 use crate::fat::morph::{default_value, fat_from_morph_targets, MorphMesh, MorphTarget};
@@ -452,15 +452,7 @@ pub fn write_morph_set(
                 .transforms
                 .iter()
                 .zip(&out.transforms)
-                .map(|(t, d)| {
-                    local_matrix(
-                        t.translation + d.translation,
-                        d.rotation * t.rotation,
-                        t.scale + d.scale,
-                        t.scale_orientation,
-                        t.center,
-                    )
-                })
+                .map(|(t, d)| t.animated_matrix(d))
                 .collect();
             let frames = face.frames_with(&locals);
             let mut mesh = merged_mesh(face, &frames.meshes, Some(&out.displacements))?;

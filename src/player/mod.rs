@@ -39,7 +39,7 @@ use glam::{Affine3A, Vec3};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::face::{local_matrix, FaceFrames, FaceModel};
+use crate::face::{FaceFrames, FaceModel};
 use crate::fap::{resample, DenseFrame, FapStream, FapTimeline};
 use crate::fat::eval::{
     expression_activations, viseme_activations, Activation, FatEvaluator, FatOutput, TransformDelta,
@@ -323,7 +323,7 @@ impl<'a> Player<'a> {
             .zip(&face.transforms)
             .zip(&self.output.transforms)
         {
-            *local = animated_local(t, d);
+            *local = t.animated_matrix(d);
         }
         world_frames_into(face, &frame.transform_locals, &mut frame.world);
     }
@@ -411,20 +411,6 @@ pub fn fill_activations(state: &DenseFrame, out: &mut Vec<Activation>) {
         e.select2,
         f64::from(e.intensity2),
     ));
-}
-
-/// The local matrix of `t` with the FAT change `d` applied (see the module docs).
-pub fn animated_local(t: &crate::face::FaceTransform, d: &TransformDelta) -> Affine3A {
-    if *d == TransformDelta::IDENTITY {
-        return t.local_matrix();
-    }
-    local_matrix(
-        t.translation + d.translation,
-        d.rotation * t.rotation,
-        t.scale + d.scale,
-        t.scale_orientation,
-        t.center,
-    )
 }
 
 /// [`FaceModel::frames_with`] into existing buffers (no allocation once they have capacity).
