@@ -17,6 +17,8 @@
 //! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
 //! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
 //!   cloning grid.
+//! - [`showcase`]: rendered playback frames, contact sheets, the cloning grid and the
+//!   end-to-end demo (`fbakit demo`).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -33,6 +35,7 @@ pub mod io;
 pub mod mesh;
 pub mod player;
 pub mod render;
+pub mod showcase;
 pub mod spec;
 pub mod synth;
 pub mod vrml;

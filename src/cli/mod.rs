@@ -15,6 +15,7 @@ pub mod face_export;
 pub mod fap;
 mod fapu;
 pub mod play;
+mod show;
 
 /// Exit code for success.
 pub const EXIT_OK: u8 = 0;
@@ -63,17 +64,23 @@ pub enum Command {
                                         fbakit fap convert samples/speech.fap speech.json"
     )]
     Fap(fap::FapCommand),
-    /// Play a FAP stream on a face: animated glTF (.glb/.gltf) or an OBJ sequence.
+    /// Play a FAP stream on a face: animated glTF (.glb/.gltf), OBJ or PNG frames, a PNG sheet.
     #[command(
         long_about = "Play a FAP stream on a face with its Facial Animation Tables and write \
                       the result: OUT ending in .glb or .gltf gives an animated glTF (morph \
                       targets + node rotations); a directory (or --format obj) gives one OBJ \
-                      per frame (frame_00000.obj, ...) and frames.json. FAPs not sent in a \
+                      per frame (frame_00000.obj, ...) and frames.json; OUT ending in .png \
+                      gives a contact sheet of --sheet-frames frames (or, with --turntable K, \
+                      K views around the first frame); a directory with --format png gives \
+                      one PNG per frame (frame_00000.png, ...). FAPs not sent in a \
                       frame hold their last value. FACE is a VRML face file or `alma` / \
                       `bruno` (built-in faces). FAPs, visemes and expressions the face has no \
                       table for are reported.",
         after_help = "Examples:\n  fbakit play alma samples/speech.fap -o speech.glb\n  \
-                      fbakit play bruno samples/lowlevel.fap -o frames/ --fps 50 --frames 0..25"
+                      fbakit play bruno samples/lowlevel.fap -o frames/ --fps 50 --frames 0..25\n  \
+                      fbakit play alma samples/speech.fap -o sheet.png --sheet-frames 6 --size 256x256\n  \
+                      fbakit play bruno samples/speech.fap -o turn.png --turntable 8\n  \
+                      fbakit play alma samples/speech.fap -o pngs/ --format png --frames 0..10"
     )]
     Play(play::PlayArgs),
     /// Inspect, validate and convert face models; build them from morph sets and back.
@@ -118,6 +125,30 @@ pub enum Command {
                       fbakit eval self-clone alma.wrl --method rbf --json"
     )]
     Eval(clone::EvalCommand),
+    /// Render the cloning grid: every face's FAT cloned onto every other face, one pose.
+    #[command(
+        long_about = "Render the cloning grid (Pandzic 2003, Figure 11): rows are source faces, \
+                      columns target faces; cell (i, j) is face j without its FAT, animated \
+                      with the FAT cloned from face i, showing --key at --value. The diagonal \
+                      shows each face with its own FAT. FACE is a VRML face file (.wrl, \
+                      .wrl.gz) or `alma` / `bruno`.",
+        after_help = "Examples:\n  fbakit grid alma bruno -o grid.png\n  \
+                      fbakit grid alma bruno --key open_jaw --value 400 --method rbf -o jaw.png\n  \
+                      fbakit grid alma.wrl bruno.wrl --key viseme_7 -o v7.png"
+    )]
+    Grid(show::GridArgs),
+    /// Run the end-to-end demo on the bundled samples (clone, play, render, measure).
+    #[command(
+        long_about = "Run the end-to-end demo on the bundled samples: clone alma's FAT onto \
+                      bruno (stripped to meshes and feature points), play samples/speech.fap \
+                      on both, and write bruno-cloned.wrl, alma-speech.glb, bruno-speech.glb, \
+                      contact-sheet.png and cloning-grid.png into --out (default \
+                      ./fbakit-demo), then print quality figures (self-clone error, FAP \
+                      compliance, error against bruno's true FAT) and timings. Run it from \
+                      the fbakit checkout (it finds samples/ there, or beside the sources).",
+        after_help = "Examples:\n  fbakit demo\n  fbakit demo --out /tmp/demo --method rbf --json"
+    )]
+    Demo(show::DemoArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -142,6 +173,8 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Sample(args) => candide::sample(args),
         Command::Clone(args) => clone::run(args),
         Command::Eval(cmd) => clone::run_eval(cmd),
+        Command::Grid(args) => show::grid(args),
+        Command::Demo(args) => show::demo(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

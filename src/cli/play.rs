@@ -1,5 +1,5 @@
-//! `fbakit play FACE STREAM -o OUT`: plays a FAP stream on a face into an animated glTF or an
-//! OBJ sequence.
+//! `fbakit play FACE STREAM -o OUT`: plays a FAP stream on a face into an animated glTF, an
+//! OBJ sequence, a PNG contact sheet / turntable or one PNG per frame.
 
 use std::io::IsTerminal;
 use std::ops::Range;
@@ -11,6 +11,8 @@ use fbakit::fap::{read_stream_file, ReadOptions};
 use fbakit::player::gltf::export_face;
 use fbakit::player::obj::ObjSequence;
 use fbakit::player::{load_face, PlayOptions, Player};
+use fbakit::render::RenderOptions;
+use fbakit::showcase::{contact_sheet_for_player, turntable_sheet, FaceView};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
@@ -26,6 +28,8 @@ pub enum PlayFormat {
     Gltf,
     /// One OBJ per frame in a directory, plus `frames.json`.
     Obj,
+    /// PNG: OUT.png is a contact sheet (or turntable); a directory gets one PNG per frame.
+    Png,
 }
 
 /// Arguments of `play`.
@@ -35,7 +39,8 @@ pub struct PlayArgs {
     pub face: PathBuf,
     /// FAP stream (`.fap` or `.json`).
     pub stream: PathBuf,
-    /// Output: `.glb` / `.gltf` file, or a directory for an OBJ sequence.
+    /// Output: `.glb` / `.gltf` file, `.png` contact sheet, or a directory for an OBJ or PNG
+    /// sequence.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Output frame rate (the stream is resampled, values interpolated); default: the
@@ -48,12 +53,40 @@ pub struct PlayArgs {
     /// Output format (default: from OUT's extension; a directory or no extension means obj).
     #[arg(long)]
     pub format: Option<PlayFormat>,
+    /// PNG contact sheet: number of frames, spread over the played range.
+    #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub sheet_frames: u32,
+    /// PNG: image (or sheet cell) size in pixels, `WxH`.
+    #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// PNG sheet: instead of frames, K views of the first played frame turning around the head.
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=72))]
+    pub turntable: Option<u32>,
     /// Read the stream strictly.
     #[arg(long)]
     pub strict: bool,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Largest image side `--size` accepts.
+const MAX_SIZE: u32 = 4096;
+
+/// Parses `WxH` (each 16..=4096).
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}` is not a size like 512x512"))?;
+    let side = |t: &str| -> std::result::Result<u32, String> {
+        match t.trim().parse::<u32>() {
+            Ok(v) if (16..=MAX_SIZE).contains(&v) => Ok(v),
+            _ => Err(format!(
+                "`{t}` is not a side between 16 and {MAX_SIZE} pixels"
+            )),
+        }
+    };
+    Ok((side(w)?, side(h)?))
 }
 
 /// Parses `a..b`, `a..` or `..b`.
@@ -110,13 +143,11 @@ pub fn output_format(out: &Path, format: Option<PlayFormat>) -> Result<PlayForma
     match ext.as_deref() {
         Some("glb") => Ok(PlayFormat::Glb),
         Some("gltf") => Ok(PlayFormat::Gltf),
-        Some("png") => Err(Error::Unsupported(
-            "PNG output arrives with the renderer; write .glb, .gltf or an OBJ directory".into(),
-        )),
+        Some("png") => Ok(PlayFormat::Png),
         _ if out.is_dir() => Ok(PlayFormat::Obj),
         None => Ok(PlayFormat::Obj),
         Some(e) => Err(Error::Unsupported(format!(
-            "unknown output extension `.{e}` (use .glb, .gltf, a directory or --format)"
+            "unknown output extension `.{e}` (use .glb, .gltf, .png, a directory or --format)"
         ))),
     }
 }
@@ -180,6 +211,11 @@ pub fn run(a: PlayArgs) -> Result<u8> {
             seq.finish()?;
             n + 1
         }
+        PlayFormat::Png => {
+            let n = write_pngs(&a, &face, &mut player, &bar)?;
+            bar.set_position(player.frame_count() as u64);
+            n
+        }
     };
     bar.finish_and_clear();
     let report = PlayReport {
@@ -210,11 +246,53 @@ pub fn run(a: PlayArgs) -> Result<u8> {
     Ok(EXIT_OK)
 }
 
+/// Whether OUT names a single PNG file (a sheet) rather than a directory of frames.
+fn is_png_file(out: &Path) -> bool {
+    out.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+}
+
+/// PNG output: a contact sheet or turntable when OUT ends in `.png`, else one PNG per
+/// frame in the directory OUT. Returns the number of files written.
+fn write_pngs(
+    a: &PlayArgs,
+    face: &fbakit::face::FaceModel,
+    player: &mut Player,
+    bar: &ProgressBar,
+) -> Result<usize> {
+    if is_png_file(&a.output) {
+        let image = match a.turntable {
+            Some(k) => turntable_sheet(face, player, k as usize, a.size)?,
+            None => contact_sheet_for_player(face, player, a.sheet_frames as usize, a.size)?,
+        };
+        image.write_png(&a.output)?;
+        return Ok(1);
+    }
+    std::fs::create_dir_all(&a.output).map_err(|e| Error::io(&a.output, e))?;
+    let view = FaceView::new(face)?;
+    let camera = view.front_camera();
+    let opts = RenderOptions::sized(a.size.0, a.size.1);
+    let mut frame = player.new_frame();
+    let mut positions = Vec::new();
+    let mut n = 0;
+    while player.next_frame(&mut frame) {
+        frame.world_positions_into(&mut positions);
+        let image = view.render(&positions, &camera, &opts);
+        image.write_png(&a.output.join(format!("frame_{:05}.png", frame.index)))?;
+        n += 1;
+        bar.inc(1);
+    }
+    Ok(n)
+}
+
 fn report_text(r: &PlayReport) -> String {
     use std::fmt::Write as _;
     let mut o = String::new();
     let what = match r.format {
         PlayFormat::Obj => format!("{} files (OBJ frames + frames.json)", r.files_written),
+        PlayFormat::Png if r.files_written == 1 => "PNG sheet".to_string(),
+        PlayFormat::Png => format!("{} PNG frames", r.files_written),
         _ => "animated glTF".to_string(),
     };
     let _ = writeln!(o, "wrote {}: {what}", r.output);
@@ -255,12 +333,22 @@ mod tests {
     }
 
     #[test]
+    fn sizes() {
+        assert_eq!(parse_size("512x256"), Ok((512, 256)));
+        assert_eq!(parse_size("64X64"), Ok((64, 64)));
+        assert!(parse_size("0x10").is_err());
+        assert!(parse_size("512").is_err());
+        assert!(parse_size("99999x10").is_err());
+        assert!(parse_size("ax10").is_err());
+    }
+
+    #[test]
     fn formats() {
         let f = |p: &str| output_format(Path::new(p), None);
         assert_eq!(f("x.glb").unwrap(), PlayFormat::Glb);
         assert_eq!(f("x.GLTF").unwrap(), PlayFormat::Gltf);
         assert_eq!(f("frames").unwrap(), PlayFormat::Obj);
-        assert!(f("x.png").unwrap_err().to_string().contains("renderer"));
+        assert_eq!(f("x.png").unwrap(), PlayFormat::Png);
         assert!(f("x.txt").is_err());
         assert_eq!(
             output_format(Path::new("x.txt"), Some(PlayFormat::Obj)).unwrap(),

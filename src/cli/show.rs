@@ -1,0 +1,152 @@
+//! `fbakit grid` (the cloning grid) and `fbakit demo` (the end-to-end demo).
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use fbakit::clone::face::Method;
+use fbakit::error::{Error, Result};
+use fbakit::face::FaceModel;
+use fbakit::fat::TableKey;
+use fbakit::showcase::{cloning_grid, run_demo, DemoOptions};
+
+use super::{print_json, EXIT_OK};
+
+/// Cloning method on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Facial motion cloning (Pandzic 2003).
+    Fmc,
+    /// RBF cloning (Fratarcangeli & Schaerf 2005).
+    Rbf,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Method {
+        match m {
+            MethodArg::Fmc => Method::Fmc,
+            MethodArg::Rbf => Method::Rbf,
+        }
+    }
+}
+
+/// Arguments of `grid`.
+#[derive(Debug, Args)]
+pub struct GridArgs {
+    /// Faces: VRML face files (.wrl, .wrl.gz) or `alma` / `bruno`; each is a source (row)
+    /// and a target (column).
+    #[arg(required = true, num_args = 1..)]
+    pub faces: Vec<PathBuf>,
+    /// What to show: a FAP name (`open_jaw`), `viseme_N` or an expression (`joy`).
+    #[arg(long, default_value = "joy", value_parser = parse_key)]
+    pub key: TableKey,
+    /// Its value (expressions 0..63, FAPs in FAP units).
+    #[arg(long, default_value_t = 63.0)]
+    pub value: f64,
+    /// Cloning method.
+    #[arg(long, value_enum, default_value = "fmc")]
+    pub method: MethodArg,
+    /// Cell side in pixels.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=2048))]
+    pub cell: u32,
+    /// Output PNG.
+    #[arg(short, long, value_name = "OUT.png")]
+    pub output: PathBuf,
+}
+
+fn parse_key(s: &str) -> std::result::Result<TableKey, String> {
+    TableKey::from_name(s).ok_or_else(|| {
+        format!("`{s}` is not a FAP name, viseme_N (1..14) or expression (joy, sadness, ...)")
+    })
+}
+
+/// A face file, or a built-in face by name when no such file exists.
+pub fn load_any_face(spec: &Path) -> Result<FaceModel> {
+    if !spec.exists() {
+        match spec.to_str() {
+            Some("alma") => return Ok(FaceModel::from_synth(&fbakit::synth::alma())),
+            Some("bruno") => return Ok(FaceModel::from_synth(&fbakit::synth::bruno())),
+            _ => {}
+        }
+    }
+    fbakit::face::obj_io::read_face(spec, None).map(|(face, _)| face)
+}
+
+/// Short display name of a face argument (`bruno` for `faces/bruno.wrl.gz`).
+fn short_name(spec: &Path) -> String {
+    let name = spec.file_name().map_or_else(
+        || spec.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    name.split('.').next().unwrap_or(&name).to_string()
+}
+
+/// Runs `grid`.
+pub fn grid(a: GridArgs) -> Result<u8> {
+    if a.output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        != Some("png".into())
+    {
+        return Err(Error::Unsupported(format!(
+            "grid writes a PNG; `{}` does not end in .png",
+            a.output.display()
+        )));
+    }
+    if !a.value.is_finite() {
+        return Err(Error::Unsupported("--value must be a finite number".into()));
+    }
+    let faces: Vec<FaceModel> = a
+        .faces
+        .iter()
+        .map(|p| load_any_face(p))
+        .collect::<Result<_>>()?;
+    let names: Vec<String> = a.faces.iter().map(|p| short_name(p)).collect();
+    let pairs: Vec<(&str, &FaceModel)> = names.iter().map(String::as_str).zip(&faces).collect();
+    let image = cloning_grid(&pairs, a.key, a.value, a.method.into(), a.cell)?;
+    image.write_png(&a.output)?;
+    println!(
+        "wrote {}: {}×{} cloning grid of {} ({} at {}, {})",
+        a.output.display(),
+        names.len(),
+        names.len(),
+        names.join(", "),
+        a.key.name(),
+        a.value,
+        Method::from(a.method).name()
+    );
+    Ok(EXIT_OK)
+}
+
+/// Arguments of `demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Output directory (created).
+    #[arg(long, default_value = "fbakit-demo", value_name = "DIR")]
+    pub out: PathBuf,
+    /// Cloning method for the outputs (the other one is measured too unless --single).
+    #[arg(long, value_enum, default_value = "fmc")]
+    pub method: MethodArg,
+    /// Only run the chosen method (skip the comparison with the other one).
+    #[arg(long)]
+    pub single: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `demo`.
+pub fn demo(a: DemoArgs) -> Result<u8> {
+    let opts = DemoOptions {
+        method: a.method.into(),
+        compare_methods: !a.single,
+        ..DemoOptions::default()
+    };
+    let report = run_demo(&a.out, &opts)?;
+    if a.json {
+        print_json(&report)?;
+    } else {
+        print!("{report}");
+    }
+    Ok(EXIT_OK)
+}
