@@ -62,7 +62,7 @@ use std::time::Instant;
 use glam::{Affine3A, DMat3, DVec3, Mat3, Vec3};
 use serde::Serialize;
 
-use super::fmc::{clone_fmc, FmcOptions};
+use super::fmc::{clone_fmc, FmcOptions, NormalisationMode, OverlapRule};
 use super::rbf::{clone_rbf, RbfOptions};
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::{Error, Result};
@@ -100,7 +100,7 @@ impl Method {
 pub struct CloneOptions {
     /// Surface method.
     pub method: Method,
-    /// FMC settings.
+    /// FMC settings (default: [`face_fmc_options`]).
     pub fmc: FmcOptions,
     /// RBF settings.
     pub rbf: RbfOptions,
@@ -115,11 +115,22 @@ impl Default for CloneOptions {
     fn default() -> Self {
         CloneOptions {
             method: Method::Fmc,
-            fmc: FmcOptions::default(),
+            fmc: face_fmc_options(),
             rbf: RbfOptions::default(),
             rbf_fapu_rescale: true,
             align: true,
         }
+    }
+}
+
+/// The FMC settings whole faces clone with (module docs, "FMC settings"): `Global` position
+/// normalisation, nearest-depth overlap resolution and no anti-aliasing filter.
+pub fn face_fmc_options() -> FmcOptions {
+    FmcOptions {
+        normalisation: NormalisationMode::Global,
+        overlap: OverlapRule::NearestDepth,
+        filter_support: 0.0,
+        ..FmcOptions::default()
     }
 }
 
