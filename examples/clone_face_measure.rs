@@ -1,7 +1,7 @@
 //! Release-mode measurement of whole-face cloning on the synthetic faces (alma → bruno, ground
 //! truth = bruno's own FAT): self-clone error per method, ground-truth error per key, FAP
 //! compliance, alignment. Run with `cargo run --release --example clone_face_measure`
-//! (`-- keys` also prints every key's error).
+//! (`-- keys` also prints every key's error, `-- no-align` turns the alignment off).
 
 use fbakit::clone::eval::{compliance, ground_truth_error, self_clone_error};
 use fbakit::clone::face::{clone_face, CloneOptions, Method};
@@ -9,6 +9,7 @@ use fbakit::face::FaceModel;
 
 fn main() {
     let all_keys = std::env::args().any(|a| a == "keys");
+    let align = !std::env::args().any(|a| a == "no-align");
     let a = FaceModel::from_synth(&fbakit::synth::alma());
     let b = FaceModel::from_synth(&fbakit::synth::bruno());
     for method in [Method::Fmc, Method::Rbf] {
@@ -18,6 +19,7 @@ fn main() {
         }
         let opts = CloneOptions {
             method,
+            align,
             ..CloneOptions::default()
         };
         let out = clone_face(&a, &b, &opts).unwrap();
