@@ -22,8 +22,14 @@ pub fn dense(motion: &SurfaceMotion, vertex_count: usize) -> Vec<Vec3> {
     d
 }
 
+/// Whether two motions are the same morph target (key and value).
+fn same_target(a: &SurfaceMotion, b: &SurfaceMotion) -> bool {
+    a.key == b.key && a.value.to_bits() == b.value.to_bits()
+}
+
 /// Formula (1) of seed 002, in percent: `neutral` is the face both motion sets live on.
-/// Motions are paired by key; a key missing from `actual` counts as a zero motion.
+/// Motions are paired by key *and value* (a multi-interval table gives several motions of one
+/// key); a motion missing from `actual` counts as a zero motion.
 pub fn morph_target_error(
     neutral: &[Vec3],
     expected: &[SurfaceMotion],
@@ -37,7 +43,7 @@ pub fn morph_target_error(
         let de = dense(e, neutral.len());
         let da = actual
             .iter()
-            .find(|a| a.key == e.key)
+            .find(|a| same_target(a, e))
             .map(|a| dense(a, neutral.len()))
             .unwrap_or_else(|| vec![Vec3::ZERO; neutral.len()]);
         let (mut num, mut den) = (0.0f64, 0.0f64);
@@ -54,8 +60,9 @@ pub fn morph_target_error(
     sum / expected.len() as f64 * 100.0
 }
 
-/// Per-key relative displacement error `Σ‖dE − dA‖ / Σ‖dE‖` in percent (keys of `expected`
-/// whose displacements are all zero are skipped).
+/// Per-motion relative displacement error `Σ‖dE − dA‖ / Σ‖dE‖` in percent, paired by key and
+/// value like [`morph_target_error`] (motions of `expected` whose displacements are all zero
+/// are skipped).
 pub fn displacement_errors(
     vertex_count: usize,
     expected: &[SurfaceMotion],
@@ -66,7 +73,7 @@ pub fn displacement_errors(
         let de = dense(e, vertex_count);
         let da = actual
             .iter()
-            .find(|a| a.key == e.key)
+            .find(|a| same_target(a, e))
             .map(|a| dense(a, vertex_count))
             .unwrap_or_else(|| vec![Vec3::ZERO; vertex_count]);
         let den: f64 = de.iter().map(|d| d.length() as f64).sum();
@@ -128,6 +135,13 @@ mod tests {
         // Formula (1): 0.25 / (1 + 0.5) = 16.67 %.
         let e = morph_target_error(&neutral, std::slice::from_ref(&m), &[half]);
         assert!((e - 100.0 / 6.0).abs() < 1e-4, "{e}");
+        // Two motions of one key (a multi-interval table) pair by value, not by key alone.
+        let mut neg = m.clone();
+        neg.value = -100.0;
+        neg.offsets[0].1 = -neg.offsets[0].1;
+        let both = [m.clone(), neg];
+        assert_eq!(morph_target_error(&neutral, &both, &both), 0.0);
+        assert_eq!(displacement_error(2, &both, &both), 0.0);
         // A missing key counts as no motion at all.
         assert!((displacement_error(2, &[m], &[]) - 100.0).abs() < 1e-9);
     }

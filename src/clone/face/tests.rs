@@ -182,8 +182,11 @@ fn rotated_scaled_target_clones_like_the_plain_one() {
         translation: DVec3::new(100.0, -20.0, 7.0),
     };
     for method in [Method::Fmc, Method::Rbf] {
+        // No rotation snap: the plain target's small spurious tilt would be dropped while the
+        // turned one keeps it, and this test is about the fit's equivariance.
         let opts = CloneOptions {
             method,
+            align_snap_degrees: 0.0,
             ..CloneOptions::default()
         };
         let plain = clone_face(&a, &transformed(&b, &Similarity::IDENTITY), &opts).unwrap();
@@ -231,4 +234,37 @@ fn missing_feature_points_are_listed() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("8.3"), "{e}");
+}
+
+#[test]
+fn small_alignment_rotations_snap_to_none() {
+    let from: Vec<DVec3> = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 2.0, 0.0],
+        [0.0, 0.0, 3.0],
+        [1.0, 1.0, 1.0],
+    ]
+    .iter()
+    .map(|&a| DVec3::from_array(a))
+    .collect();
+    let moved = |deg: f64| -> Vec<DVec3> {
+        let q = glam::DQuat::from_axis_angle(DVec3::X, deg.to_radians());
+        from.iter()
+            .map(|&p| q * p * 2.0 + DVec3::new(5.0, 0.0, 0.0))
+            .collect()
+    };
+    let small = Similarity::fit_snapped(&from, &moved(1.0), 3.0).unwrap();
+    assert_eq!(small.rotation, glam::DQuat::IDENTITY);
+    assert!((small.scale - 2.0).abs() < 1e-3, "{}", small.scale);
+    let large = Similarity::fit_snapped(&from, &moved(10.0), 3.0).unwrap();
+    assert!(
+        (large.angle_degrees() - 10.0).abs() < 1e-6,
+        "{}",
+        large.angle_degrees()
+    );
+    assert!((large.scale - 2.0).abs() < 1e-9);
+    // Without snapping the small rotation is kept.
+    let kept = Similarity::fit_snapped(&from, &moved(1.0), 0.0).unwrap();
+    assert!((kept.angle_degrees() - 1.0).abs() < 1e-6);
 }
