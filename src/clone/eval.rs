@@ -25,7 +25,7 @@ use super::face::{
 use super::quality::morph_target_error;
 use super::SurfaceMotion;
 use crate::error::{Error, Result};
-use crate::face::{local_matrix, FaceModel};
+use crate::face::FaceModel;
 use crate::fat::eval::{Activation, FatEvaluator, FatOutput};
 use crate::fat::morph::fat_to_morph_targets;
 use crate::fat::TableKey;
@@ -43,15 +43,7 @@ pub fn pose(
         .transforms
         .iter()
         .zip(&out.transforms)
-        .map(|(t, d)| {
-            local_matrix(
-                t.translation + d.translation,
-                t.rotation * d.rotation,
-                t.scale + d.scale,
-                t.scale_orientation,
-                t.center,
-            )
-        })
+        .map(|(t, d)| t.animated_matrix(d))
         .collect();
     let frames = face.frames_with(&locals);
     face.meshes
