@@ -4,30 +4,13 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use fbakit::clone::eval::{compliance, self_clone_error_with, ComplianceReport};
-use fbakit::clone::face::{clone_face, CloneOptions, CloneReport, Method};
+use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
 use fbakit::error::{Error, Result};
 use fbakit::face::FaceModel;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use super::{print_json, EXIT_BAD_INPUT, EXIT_OK};
-
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum MethodArg {
-    /// Pandžić 2003 facial motion cloning.
-    Fmc,
-    /// Fratarcangeli & Schaerf 2005 RBF cloning.
-    Rbf,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Method {
-        match m {
-            MethodArg::Fmc => Method::Fmc,
-            MethodArg::Rbf => Method::Rbf,
-        }
-    }
-}
+use super::{print_json, MethodArg, EXIT_BAD_INPUT, EXIT_OK};
 
 #[derive(Debug, clap::Args)]
 pub struct CloneArgs {

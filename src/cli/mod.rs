@@ -17,6 +17,24 @@ mod fapu;
 pub mod play;
 mod show;
 
+/// A cloning method on the command line (`--method fmc|rbf`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Facial motion cloning (Pandzic 2003).
+    Fmc,
+    /// RBF cloning (Fratarcangeli & Schaerf 2005).
+    Rbf,
+}
+
+impl From<MethodArg> for fbakit::clone::face::Method {
+    fn from(m: MethodArg) -> fbakit::clone::face::Method {
+        match m {
+            MethodArg::Fmc => fbakit::clone::face::Method::Fmc,
+            MethodArg::Rbf => fbakit::clone::face::Method::Rbf,
+        }
+    }
+}
+
 /// Exit code for success.
 pub const EXIT_OK: u8 = 0;
 /// Exit code for a failed operation.

@@ -2,32 +2,14 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use fbakit::clone::face::Method;
 use fbakit::error::{Error, Result};
 use fbakit::face::FaceModel;
 use fbakit::fat::TableKey;
 use fbakit::showcase::{cloning_grid, run_demo, DemoOptions};
 
-use super::{print_json, EXIT_OK};
-
-/// Cloning method on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum MethodArg {
-    /// Facial motion cloning (Pandzic 2003).
-    Fmc,
-    /// RBF cloning (Fratarcangeli & Schaerf 2005).
-    Rbf,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Method {
-        match m {
-            MethodArg::Fmc => Method::Fmc,
-            MethodArg::Rbf => Method::Rbf,
-        }
-    }
-}
+use super::{print_json, MethodArg, EXIT_OK};
 
 /// Arguments of `grid`.
 #[derive(Debug, Args)]
