@@ -161,3 +161,33 @@ fn write_synth_faces() {
     fbakit::face::vrml_io::write_face_file(&std::path::Path::new(&dir).join("bruno.wrl"), b)
         .unwrap();
 }
+
+#[test]
+fn cli_clone_writes_gltf_and_refuses_unknown_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("self.glb");
+    let run = |out: &std::path::Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_fbakit"))
+            .args(["clone", "alma", "alma", "--method", "fmc", "-o"])
+            .arg(out)
+            .output()
+            .unwrap()
+    };
+    let o = run(&glb);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let bytes = std::fs::read(&glb).unwrap();
+    let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&chunks.json).unwrap();
+    let targets = json["meshes"][0]["extras"]["targetNames"]
+        .as_array()
+        .unwrap();
+    assert!(targets.len() >= 86, "{} targets", targets.len());
+    let o = run(&dir.path().join("out.txt"));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!dir.path().join("out.txt").exists());
+}

@@ -18,7 +18,8 @@ pub struct CloneArgs {
     pub source: PathBuf,
     /// Target face: VRML (`.wrl`), or `.obj` with --fp-target.
     pub target: PathBuf,
-    /// Output face (`.wrl`).
+    /// Output: a face file (`.wrl`, `.wrl.gz`, `.obj`) or glTF (`.glb`, `.gltf`: the cloned FAT as
+    /// morph targets).
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Surface method.
@@ -131,9 +132,16 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    if !matches!(ext.as_deref(), Some("wrl" | "vrml")) {
+    let name = args.output.to_string_lossy().to_ascii_lowercase();
+    let gltf = matches!(ext.as_deref(), Some("glb" | "gltf"));
+    let face_file = name.ends_with(".wrl")
+        || name.ends_with(".vrml")
+        || name.ends_with(".wrl.gz")
+        || name.ends_with(".wrz")
+        || name.ends_with(".obj");
+    if !gltf && !face_file {
         eprintln!(
-            "error: {}: only .wrl output is supported (glTF output: not yet)",
+            "error: {}: the output must be a face file (.wrl, .wrl.gz, .wrz, .obj) or glTF (.glb, .gltf)",
             args.output.display()
         );
         return Ok(EXIT_BAD_INPUT);
@@ -155,7 +163,12 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     let outcome = clone_face(&source, &target, &opts)?;
     pb.inc(1);
     pb.set_message("writing");
-    fbakit::face::vrml_io::write_face_file(&args.output, &outcome.face)?;
+    if gltf {
+        // The cloned FAT as glTF morph targets (static; `fbakit play` animates it).
+        fbakit::player::gltf::face_to_gltf(&outcome.face, None)?.write(&args.output)?;
+    } else {
+        fbakit::face::obj_io::write_face(&args.output, &outcome.face)?;
+    }
     pb.inc(1);
     let quality = if args.report {
         pb.set_message("measuring quality");
