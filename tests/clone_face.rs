@@ -182,7 +182,7 @@ fn cli_clone_writes_gltf_and_refuses_unknown_outputs() {
     );
     let bytes = std::fs::read(&glb).unwrap();
     let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
-    let json: serde_json::Value = serde_json::from_slice(&chunks.json).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(chunks.json).unwrap();
     let targets = json["meshes"][0]["extras"]["targetNames"]
         .as_array()
         .unwrap();
