@@ -40,18 +40,15 @@ fn clone_writes_a_face_and_reports() {
     let c: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(c["worst"].as_f64().unwrap() < 0.05);
     // Unsupported output and an OBJ without feature points are usage errors (exit 2).
+    let bad = dir.path().join("x.txt");
     let o = fbakit()
-        .args([
-            "clone",
-            a.to_str().unwrap(),
-            b.to_str().unwrap(),
-            "-o",
-            "x.glb",
-        ])
+        .args(["clone", a.to_str().unwrap(), b.to_str().unwrap(), "-o"])
+        .arg(&bad)
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("not yet"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("must be a face file"));
+    assert!(!bad.exists());
     let o = fbakit()
         .args(["clone", a.to_str().unwrap(), "head.obj", "-o"])
         .arg(&out)
