@@ -13,19 +13,22 @@
 //! - [`mesh`]: polygon meshes, their geometry (triangulation, normals, nearest vertex) and
 //!   Wavefront OBJ reading/writing.
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
-//! - [`player`]: plays FAP streams on faces (FAT evaluation per frame), glTF and OBJ output.
+//! - [`player`]: plays FAP streams on faces (FAT evaluation per frame, one frame at a time).
 //! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
 //! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
 //!   cloning grid.
-//! - [`showcase`]: rendered playback frames, contact sheets, the cloning grid and the
-//!   end-to-end demo (`fbakit demo`).
+//! - [`export`]: outputs — glTF with morph targets and animation, OBJ frame sequences,
+//!   rendered pictures (contact sheets, turntables, the cloning grid).
+//! - [`demo`]: the end-to-end demo application (`fbakit demo`).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
 
 pub mod candide;
 pub mod clone;
+pub mod demo;
 pub mod error;
+pub mod export;
 pub mod face;
 pub mod fap;
 pub mod fat;
@@ -35,7 +38,6 @@ pub mod io;
 pub mod mesh;
 pub mod player;
 pub mod render;
-pub mod showcase;
 pub mod spec;
 pub mod synth;
 pub mod vrml;

@@ -1,4 +1,4 @@
-//! The end-to-end demo (`showcase::run_demo`), the showcase pictures (pinned statistics) and
+//! The end-to-end demo (`demo::run_demo`), the showcase pictures (pinned statistics) and
 //! the `play … -o x.png`, `grid` and `demo` commands through the binary.
 
 use std::path::{Path, PathBuf};
@@ -6,10 +6,11 @@ use std::process::{Command, Output};
 use std::sync::OnceLock;
 
 use fbakit::clone::face::Method;
+use fbakit::demo::{run_demo, DemoOptions, DemoReport};
+use fbakit::export::picture::{cloning_grid, strip_fat, FaceView};
 use fbakit::face::FaceModel;
 use fbakit::fat::TableKey;
 use fbakit::render::{Image, ImageStats, PixelRect, RenderOptions};
-use fbakit::showcase::{cloning_grid, run_demo, strip_fat, DemoOptions, DemoReport, FaceView};
 use fbakit::spec::Expression;
 
 fn fbakit(args: &[&str]) -> Output {
@@ -258,7 +259,7 @@ fn cloned_bruno_joy_frame_snapshot() {
     let opts = RenderOptions::sized(128, 128);
     let img = view.render(&posed, &view.front_camera(), &opts);
     let neutral = view.render(
-        &fbakit::showcase::neutral_positions(&cloned),
+        &fbakit::export::picture::neutral_positions(&cloned),
         &view.front_camera(),
         &opts,
     );

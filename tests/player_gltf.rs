@@ -5,12 +5,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
+use fbakit::export::gltf::{export_face, face_to_gltf, FaceMorphs};
 use fbakit::face::{FaceMesh, FaceModel, FaceTransform};
 use fbakit::fap::{read_fap_file, FapFrame, FapStream, ReadOptions};
 use fbakit::fat::{FaceDefMesh, FaceDefTable, FaceDefTransform, TableKey};
 use fbakit::gltf::GltfDocument;
 use fbakit::mesh::Mesh;
-use fbakit::player::gltf::{export_face, face_to_gltf, FaceMorphs};
 use fbakit::player::{PlayOptions, Player, PlayerFrame};
 use fbakit::spec::FapId;
 use glam::{Affine3A, Quat, Vec3};

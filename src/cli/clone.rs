@@ -165,7 +165,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     pb.set_message("writing");
     if gltf {
         // The cloned FAT as glTF morph targets (static; `fbakit play` animates it).
-        fbakit::player::gltf::face_to_gltf(&outcome.face, None)?.write(&args.output)?;
+        fbakit::export::gltf::face_to_gltf(&outcome.face, None)?.write(&args.output)?;
     } else {
         fbakit::face::obj_io::write_face(&args.output, &outcome.face)?;
     }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use fbakit::error::{Error, Result};
-use fbakit::player::gltf::export_face;
+use fbakit::export::gltf::export_face;
 use fbakit::player::load_face;
 use serde::Serialize;
 

@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use fbakit::error::{Error, Result};
+use fbakit::export::gltf::export_face;
+use fbakit::export::obj_sequence::ObjSequence;
+use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
 use fbakit::fap::{read_stream_file, ReadOptions};
-use fbakit::player::gltf::export_face;
-use fbakit::player::obj::ObjSequence;
 use fbakit::player::{load_face, PlayOptions, Player};
 use fbakit::render::RenderOptions;
-use fbakit::showcase::{contact_sheet_for_player, turntable_sheet, FaceView};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 

@@ -4,10 +4,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use fbakit::clone::face::Method;
+use fbakit::demo::{run_demo, DemoOptions};
 use fbakit::error::{Error, Result};
+use fbakit::export::picture::cloning_grid;
 use fbakit::face::FaceModel;
 use fbakit::fat::TableKey;
-use fbakit::showcase::{cloning_grid, run_demo, DemoOptions};
 
 use super::{print_json, MethodArg, EXIT_OK};
 

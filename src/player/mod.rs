@@ -30,9 +30,6 @@
 //! move anything; [`Player::missing_tables`] lists each such key once with the number of
 //! played frames that used it.
 
-pub mod gltf;
-pub mod obj;
-
 use std::ops::Range;
 
 use glam::{Affine3A, Vec3};

@@ -40,7 +40,6 @@ use std::collections::BTreeMap;
 
 use glam::{Quat, Vec3};
 
-use super::AnimationFrame;
 use crate::error::{Error, Result};
 use crate::face::FaceModel;
 use crate::fat::eval::Activation;
@@ -50,6 +49,7 @@ use crate::gltf::{
     AnimationData, ChannelData, ChannelValues, GltfDocument, Interpolation, MaterialData, MeshData,
     NodeData, NodeId, SceneBuilder,
 };
+use crate::player::AnimationFrame;
 
 /// One morph target of one mesh: one interval of one `FaceDefMesh` entry, shown at its span.
 #[derive(Clone, Debug, PartialEq)]

@@ -9,11 +9,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::PlayerFrame;
 use crate::error::{Error, Result};
 use crate::face::FaceModel;
 use crate::mesh::obj::{write_obj_file, ObjScene};
 use crate::mesh::{FaceGroup, Mesh, Polygons};
+use crate::player::PlayerFrame;
 
 /// One entry of `frames.json`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
