@@ -13,8 +13,8 @@ fn faces() -> &'static (FaceModel, FaceModel) {
     static F: std::sync::OnceLock<(FaceModel, FaceModel)> = std::sync::OnceLock::new();
     F.get_or_init(|| {
         (
-            FaceModel::from_synth(&fbakit::synth::alma()),
-            FaceModel::from_synth(&fbakit::synth::bruno()),
+            fbakit::synth::alma().to_face_model(),
+            fbakit::synth::bruno().to_face_model(),
         )
     })
 }

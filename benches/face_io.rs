@@ -12,10 +12,10 @@ use std::sync::LazyLock;
 
 use divan::counter::BytesCount;
 use divan::{black_box, Bencher};
-use fbakit::face::obj_io::{gunzip_bounded, gzip};
 use fbakit::face::vrml_io::{face_from_scene, write_face_string};
 use fbakit::face::FaceModel;
 use fbakit::fat::eval::Activation;
+use fbakit::io::{gunzip_bounded, gzip};
 use fbakit::synth::{generate, HeadParams};
 
 fn main() {
@@ -49,7 +49,7 @@ static FACE: LazyLock<Fixture> = LazyLock::new(|| {
         rows: 160,
         ..HeadParams::bruno()
     };
-    let face = FaceModel::from_synth(&generate(&params));
+    let face = generate(&params).to_face_model();
     let text = write_face_string(&face).expect("writes");
     let mut gz = Vec::new();
     gzip(text.as_bytes(), &mut gz).expect("compresses");

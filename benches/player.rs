@@ -19,7 +19,7 @@ fn main() {
 }
 
 fn bruno() -> FaceModel {
-    FaceModel::from_synth(&fbakit::synth::bruno())
+    fbakit::synth::bruno().to_face_model()
 }
 
 /// Frame `n` of a busy stream: every low-level FAP moving, visemes and expressions changing.

@@ -5,13 +5,12 @@
 
 use fbakit::clone::eval::{compliance, ground_truth_error, self_clone_error};
 use fbakit::clone::face::{clone_face, CloneOptions, Method};
-use fbakit::face::FaceModel;
 
 fn main() {
     let all_keys = std::env::args().any(|a| a == "keys");
     let align = !std::env::args().any(|a| a == "no-align");
-    let a = FaceModel::from_synth(&fbakit::synth::alma());
-    let b = FaceModel::from_synth(&fbakit::synth::bruno());
+    let a = fbakit::synth::alma().to_face_model();
+    let b = fbakit::synth::bruno().to_face_model();
     for method in [Method::Fmc, Method::Rbf] {
         for (name, face) in [("alma", &a), ("bruno", &b)] {
             let e = self_clone_error(face, method).unwrap();

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use fbakit::fat::eval::{Activation, FatEvaluator, FatOutput};
+use fbakit::fat::eval::Activation;
 use fbakit::fat::TableKey;
 use fbakit::render::{
     bounds, contact_sheet, fan_triangulate, grid, render, turntable, Camera, Image, RenderMesh,
@@ -41,38 +41,13 @@ impl PosedFace {
     }
 }
 
-/// Evaluates `activations` on `face` and applies the result: displacement, then each
-/// transform delta from the mesh's own up to the root, about the transform centres (the
-/// neutral transforms of synthetic faces are the identity).
+/// `face` posed by `activations` with the library's one posing rule
+/// ([`fbakit::face::FaceModel::pose`]).
 pub fn pose(face: &SynthFace, activations: &[Activation]) -> PosedFace {
-    let mut eval = FatEvaluator::new(&face.fat, &face.mesh_sizes(), &face.transform_names())
-        .expect("synthetic FATs are valid");
-    let mut out: FatOutput = eval.output();
-    eval.evaluate(activations, &mut out);
     let positions = face
-        .meshes
-        .iter()
-        .enumerate()
-        .map(|(mi, m)| {
-            m.positions
-                .iter()
-                .zip(&out.displacements[mi])
-                .map(|(&p, &d)| {
-                    let mut p = p + d;
-                    let mut tf = Some(m.transform);
-                    while let Some(t) = tf {
-                        let delta = &out.transforms[t];
-                        let c = face.transforms[t].center;
-                        p = c
-                            + delta.rotation * ((p - c) * (Vec3::ONE + delta.scale))
-                            + delta.translation;
-                        tf = face.transforms[t].parent;
-                    }
-                    p
-                })
-                .collect()
-        })
-        .collect();
+        .to_face_model()
+        .pose(activations)
+        .expect("synthetic FATs are valid");
     PosedFace {
         positions,
         triangles: face

@@ -14,7 +14,7 @@ use crate::clone::face::{clone_face, CloneOptions, Method};
 use crate::error::{Error, Result};
 use crate::export::gltf::export_face;
 use crate::export::picture::{cloning_grid_with, contact_sheet_rows, strip_fat};
-use crate::face::FaceModel;
+use crate::face::{BundledFace, FaceModel};
 use crate::fap::{read_stream_file, ReadOptions};
 use crate::fat::TableKey;
 use crate::player::{PlayOptions, Player};
@@ -141,20 +141,18 @@ pub fn find_samples_dir() -> Option<PathBuf> {
         .find(|d| d.join("speech.fap").is_file())
 }
 
-/// A bundled face: `samples/faces/NAME.wrl.gz` when present, else the generator (the file is
-/// made from it, so both are the same face).
-fn bundled_face(samples: &Path, name: &str) -> Result<(FaceModel, String)> {
-    let path = samples.join("faces").join(format!("{name}.wrl.gz"));
+/// A bundled face: `samples/faces/NAME.wrl.gz` when present (the user may have changed it),
+/// else the copy embedded in the library.
+fn bundled_face(samples: &Path, face: BundledFace) -> Result<(FaceModel, String)> {
+    let path = samples
+        .join("faces")
+        .join(format!("{}.wrl.gz", face.name()));
     if path.is_file() {
-        let (mut face, _) = crate::face::obj_io::read_face(&path, None)?;
-        face.name = name.to_string();
-        return Ok((face, path.display().to_string()));
+        let mut model = crate::face::read(&path)?;
+        model.name = face.name().to_string();
+        return Ok((model, path.display().to_string()));
     }
-    let synth = match name {
-        "alma" => crate::synth::alma(),
-        _ => crate::synth::bruno(),
-    };
-    Ok((FaceModel::from_synth(&synth), "built-in generator".into()))
+    Ok((face.read()?.0, "embedded sample".into()))
 }
 
 struct Clock {
@@ -252,8 +250,8 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     let stream_path = samples.join("speech.fap");
     let (stream, stream_warnings) = read_stream_file(&stream_path, &ReadOptions::lenient())?;
     let mut warnings: Vec<String> = stream_warnings.iter().map(|d| d.to_string()).collect();
-    let (alma, source_face) = bundled_face(&samples, "alma")?;
-    let (truth, target_face) = bundled_face(&samples, "bruno")?;
+    let (alma, source_face) = bundled_face(&samples, BundledFace::Alma)?;
+    let (truth, target_face) = bundled_face(&samples, BundledFace::Bruno)?;
     let target = strip_fat(&truth);
     clock.lap("load");
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;

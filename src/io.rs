@@ -4,6 +4,10 @@
 //! never leaves a half-written file behind.
 
 use std::io::{Read, Write};
+
+use flate2::read::MultiGzDecoder;
+use flate2::write::GzEncoder;
+use flate2::Compression;
 use std::path::Path;
 
 use crate::error::{Error, Result};
@@ -102,6 +106,30 @@ fn set_default_permissions(_file: &std::fs::File) -> std::io::Result<()> {
     Ok(())
 }
 
+/// Decompresses gzip data, refusing output larger than `max_bytes`.
+pub fn gunzip_bounded(data: &[u8], max_bytes: u64) -> std::io::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    MultiGzDecoder::new(data)
+        .take(max_bytes.saturating_add(1))
+        .read_to_end(&mut out)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
+    if out.len() as u64 > max_bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::FileTooLarge,
+            format!("decompresses to more than the {max_bytes}-byte input limit"),
+        ));
+    }
+    Ok(out)
+}
+
+/// Gzip-compresses `data` (best level, zero timestamp: equal input gives equal bytes).
+pub fn gzip(data: &[u8], w: &mut dyn Write) -> std::io::Result<()> {
+    let mut enc = GzEncoder::new(w, Compression::best());
+    enc.write_all(data)?;
+    enc.finish()?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,5 +188,25 @@ mod tests {
             e.contains("bad.fap:2:1: expected UTF-8 text, found `byte 0xFF`"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn gzip_round_trip_and_bomb_refused() {
+        let mut z = Vec::new();
+        gzip(b"hello hello hello", &mut z).unwrap();
+        assert_eq!(gunzip_bounded(&z, 100).unwrap(), b"hello hello hello");
+        // Deterministic output.
+        let mut z2 = Vec::new();
+        gzip(b"hello hello hello", &mut z2).unwrap();
+        assert_eq!(z, z2);
+        // 1 MB of zeros compresses to ~1 kB; a 64 kB limit refuses it.
+        let mut bomb = Vec::new();
+        gzip(&vec![0u8; 1 << 20], &mut bomb).unwrap();
+        assert!(bomb.len() < 4096);
+        let e = gunzip_bounded(&bomb, 1 << 16).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::FileTooLarge);
+        // Garbage is an error, not a panic.
+        assert!(gunzip_bounded(b"\x1f\x8b\x08garbage", 100).is_err());
+        assert!(gunzip_bounded(&bomb[..bomb.len() / 2], 1 << 30).is_err());
     }
 }

@@ -21,7 +21,8 @@
 //!   rendered pictures (contact sheets, turntables, the cloning grid).
 //! - [`demo`]: the end-to-end demo application (`fbakit demo`).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
-//! - [`io`]: bounded reads and atomic writes.
+//! - [`io`]: bounded reads (plain and gzip) and atomic writes.
+//! - [`format`]: output formats resolved once from a path; refusing to overwrite inputs.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
 
 pub mod candide;
@@ -33,6 +34,7 @@ pub mod face;
 pub mod fap;
 pub mod fat;
 pub mod fdp;
+pub mod format;
 pub mod gltf;
 pub mod io;
 pub mod mesh;

@@ -7,10 +7,10 @@ use fbakit::clone::face::{clone_face, CloneOptions, Method};
 use fbakit::face::FaceModel;
 
 fn alma() -> FaceModel {
-    FaceModel::from_synth(&fbakit::synth::alma())
+    fbakit::synth::alma().to_face_model()
 }
 fn bruno() -> FaceModel {
-    FaceModel::from_synth(&fbakit::synth::bruno())
+    fbakit::synth::bruno().to_face_model()
 }
 
 #[test]

@@ -3,7 +3,6 @@
 use std::process::Command;
 
 use fbakit::face::vrml_io::write_face_file;
-use fbakit::face::FaceModel;
 
 fn fbakit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_fbakit"))
@@ -13,8 +12,8 @@ fn fbakit() -> Command {
 fn clone_writes_a_face_and_reports() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("alma.wrl"), dir.path().join("bruno.wrl"));
-    write_face_file(&a, &FaceModel::from_synth(&fbakit::synth::alma())).unwrap();
-    let mut plain = FaceModel::from_synth(&fbakit::synth::bruno());
+    write_face_file(&a, &fbakit::synth::alma().to_face_model()).unwrap();
+    let mut plain = fbakit::synth::bruno().to_face_model();
     plain.fat = Default::default();
     write_face_file(&b, &plain).unwrap();
     let out = dir.path().join("out.wrl");

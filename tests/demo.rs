@@ -43,8 +43,8 @@ fn faces() -> &'static (FaceModel, FaceModel) {
     static F: OnceLock<(FaceModel, FaceModel)> = OnceLock::new();
     F.get_or_init(|| {
         (
-            FaceModel::from_synth(&fbakit::synth::alma()),
-            FaceModel::from_synth(&fbakit::synth::bruno()),
+            fbakit::synth::alma().to_face_model(),
+            fbakit::synth::bruno().to_face_model(),
         )
     })
 }
@@ -255,11 +255,11 @@ fn cloned_bruno_joy_frame_snapshot() {
         key: TableKey::Expression(Expression::Joy),
         value: 63.0,
     };
-    let posed = fbakit::clone::eval::pose(&cloned, &mut eval, &mut out, &[joy]);
+    let posed = cloned.pose_with(&mut eval, &mut out, &[joy]);
     let opts = RenderOptions::sized(128, 128);
     let img = view.render(&posed, &view.front_camera(), &opts);
     let neutral = view.render(
-        &fbakit::export::picture::neutral_positions(&cloned),
+        &cloned.neutral_world_positions(),
         &view.front_camera(),
         &opts,
     );

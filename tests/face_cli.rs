@@ -5,8 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use fbakit::face::obj_io::read_face;
-use fbakit::face::FaceModel;
+use fbakit::face::read_with;
 use fbakit::fat::{Fat, TableKey};
 
 fn fbakit(args: &[&str]) -> Output {
@@ -49,13 +48,17 @@ fn committed_sample_faces_match_the_generator() {
         ("alma.wrl.gz", fbakit::synth::alma as fn() -> _),
         ("bruno.wrl.gz", fbakit::synth::bruno),
     ] {
-        let (read, report) = read_face(&root().join("samples/faces").join(file), None).unwrap();
+        let (read, report) = read_with(
+            &root().join("samples/faces").join(file),
+            &Default::default(),
+        )
+        .unwrap();
         assert!(
             report.diagnostics.is_empty(),
             "{file}: {:?}",
             report.diagnostics
         );
-        let fresh = FaceModel::from_synth(&synth());
+        let fresh = synth().to_face_model();
         assert!(
             read == fresh,
             "samples/faces/{file} differs from the generator; regenerate it (see samples/faces/README.md)"
@@ -164,8 +167,8 @@ fn convert_between_formats() {
     let wrl = dir.path().join("alma.wrl");
     let o = fbakit(&["face", "convert", "samples/faces/alma.wrl.gz", s(&wrl)]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let (a, _) = read_face(&wrl, None).unwrap();
-    assert!(a == FaceModel::from_synth(&fbakit::synth::alma()));
+    let (a, _) = read_with(&wrl, &Default::default()).unwrap();
+    assert!(a == fbakit::synth::alma().to_face_model());
 
     // To OBJ (merged, face coordinates) plus the merged feature points, and back.
     let obj = dir.path().join("alma.obj");
@@ -182,7 +185,7 @@ fn convert_between_formats() {
     let back = dir.path().join("back.wrl");
     let o = fbakit(&["face", "convert", s(&obj), s(&back), "--fp", s(&csv)]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let (b, _) = read_face(&back, None).unwrap();
+    let (b, _) = read_with(&back, &Default::default()).unwrap();
     assert_eq!(b.meshes.len(), 1);
     assert_eq!(b.vertex_count(), a.vertex_count());
     // Same feature-point positions (up to float rounding of the transforms), same FAPU.
@@ -281,8 +284,8 @@ fn morph_set_round_trip_on_candide() {
         s(&rebuilt),
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let (a, _) = read_face(&face, None).unwrap();
-    let (b, _) = read_face(&rebuilt, None).unwrap();
+    let (a, _) = read_with(&face, &Default::default()).unwrap();
+    let (b, _) = read_with(&rebuilt, &Default::default()).unwrap();
     assert_fat_close(&a.fat, &b.fat, 1e-5);
     assert_eq!(a.fapu().unwrap(), b.fapu().unwrap());
 }
@@ -291,7 +294,7 @@ fn morph_set_round_trip_on_candide() {
 fn morph_set_round_trip_on_a_skin_only_synthetic_face() {
     // alma's skin with its skin-only FAPs (no transforms): bidirectional tables come back as
     // two morphs (-1024, 1024) and rebuild the same two-interval tables.
-    let mut face = FaceModel::from_synth(&fbakit::synth::alma());
+    let mut face = fbakit::synth::alma().to_face_model();
     face.meshes.truncate(1);
     face.meshes[0].transform = None;
     face.transforms.clear();
@@ -314,7 +317,7 @@ fn morph_set_round_trip_on_a_skin_only_synthetic_face() {
     assert!(face.fat.tables.len() > 30);
     let dir = tempfile::tempdir().unwrap();
     let wrl = dir.path().join("skin.wrl");
-    fbakit::face::obj_io::write_face(&wrl, &face).unwrap();
+    fbakit::face::write(&wrl, &face).unwrap();
     let morphs = dir.path().join("m");
     let o = fbakit(&["face", "to-morphs", s(&wrl), s(&morphs)]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
@@ -332,7 +335,7 @@ fn morph_set_round_trip_on_a_skin_only_synthetic_face() {
         s(&out),
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let (b, _) = read_face(&out, None).unwrap();
+    let (b, _) = read_with(&out, &Default::default()).unwrap();
     // Vertices whose motion is below float resolution at the reference value cannot come
     // back; compare on evaluation instead of structure for those tables.
     let mut ea = face.evaluator().unwrap();
@@ -412,7 +415,7 @@ fn hostile_inputs_are_clear_errors() {
     let o = run();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(stderr(&o).contains("ignored"), "{}", stderr(&o));
-    let (f, _) = read_face(&p("out.wrl"), None).unwrap();
+    let (f, _) = read_with(&p("out.wrl"), &Default::default()).unwrap();
     assert_eq!(f.fat.tables[0].meshes[0].coord_index, vec![0]);
 
     std::fs::write(m.join("open_jaws.obj"), "v 0 0 0\n").unwrap();
@@ -494,7 +497,7 @@ fn hostile_inputs_are_clear_errors() {
     std::fs::write(p("m.json"), r#"{"open_jaw": 1024}"#).unwrap();
     let o = fbakit(&args);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let (f, _) = read_face(&p("out.wrl"), None).unwrap();
+    let (f, _) = read_with(&p("out.wrl"), &Default::default()).unwrap();
     assert_eq!(
         f.fat.tables[0].meshes[0].interval_borders,
         vec![0.0, 1024.0]

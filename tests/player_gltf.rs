@@ -17,7 +17,7 @@ use glam::{Affine3A, Quat, Vec3};
 
 fn alma() -> &'static FaceModel {
     static FACE: OnceLock<FaceModel> = OnceLock::new();
-    FACE.get_or_init(|| FaceModel::from_synth(&fbakit::synth::alma()))
+    FACE.get_or_init(|| fbakit::synth::alma().to_face_model())
 }
 
 fn sample(name: &str) -> FapStream {
@@ -95,7 +95,7 @@ fn animation_weights_reproduce_played_positions() {
                 player.frame_at(fi, &mut frame);
                 let w = &weights[fi * n..(fi + 1) * n];
                 let got = morphs.apply(mi, &face.meshes[mi].mesh.positions, w);
-                assert_close(&face.meshes[mi].name, &got, &frame.positions[mi]);
+                assert_close(&face.meshes[mi].name, &got, &frame.pose.positions[mi]);
             }
         }
         // The head rotation channel matches the player's transform local matrix.
@@ -118,7 +118,7 @@ fn animation_weights_reproduce_played_positions() {
             let q = Quat::from_slice(&rot[fi * 4..fi * 4 + 4]);
             let m = Affine3A::from_rotation_translation(q, c) * Affine3A::from_translation(-c);
             assert!(
-                m.abs_diff_eq(frame.transform_locals[head], 1e-4),
+                m.abs_diff_eq(frame.pose.transform_locals[head], 1e-4),
                 "frame {fi}"
             );
         }
@@ -209,7 +209,7 @@ fn baked_interval_targets_follow_the_piecewise_rule() {
     for mi in 0..2 {
         morphs.weights_into(mi, &frame.activations, &mut w);
         let got = morphs.apply(mi, &face.meshes[mi].mesh.positions, &w);
-        assert_close("tiny", &got, &frame.positions[mi]);
+        assert_close("tiny", &got, &frame.pose.positions[mi]);
     }
 }
 

@@ -4,7 +4,6 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use fbakit::face::FaceModel;
 use fbakit::fap::{read_fap_file, ReadOptions};
 use fbakit::player::{PlayOptions, Player};
 
@@ -20,7 +19,7 @@ fn fbakit(args: &[&str]) -> Output {
 /// angle (degrees) — enough to see speech open the mouth, blink and smile.
 #[test]
 fn speech_on_alma_first_frames() {
-    let face = FaceModel::from_synth(&fbakit::synth::alma());
+    let face = fbakit::synth::alma().to_face_model();
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/speech.fap");
     let stream = read_fap_file(&p, &ReadOptions::strict()).unwrap().0;
     let opts = PlayOptions {
@@ -33,7 +32,7 @@ fn speech_on_alma_first_frames() {
     while player.next_frame(&mut frame) {
         let _ = write!(s, "frame {} t={:.2}:", frame.index, frame.time);
         for (mi, m) in face.meshes.iter().enumerate() {
-            let (sum, max) = frame.positions[mi]
+            let (sum, max) = frame.pose.positions[mi]
                 .iter()
                 .zip(&m.mesh.positions)
                 .map(|(p, n)| (*p - *n).length())
@@ -119,7 +118,7 @@ fn play_writes_an_obj_sequence() {
     assert_eq!(index["frames"][1]["file"], "frame_00021.obj");
     assert_eq!(index["frames"][1]["time"], 0.42);
     // Each OBJ reads back with all vertices of the face.
-    let face = FaceModel::from_synth(&fbakit::synth::alma());
+    let face = fbakit::synth::alma().to_face_model();
     let (obj, _) = fbakit::mesh::obj::read_obj_file(&out.join("frame_00021.obj")).unwrap();
     assert_eq!(obj.mesh.vertex_count(), face.vertex_count());
 }
@@ -128,7 +127,7 @@ fn play_writes_an_obj_sequence() {
 fn play_reports_missing_tables() {
     // A face without a FAT: every FAP used is reported with its frame count.
     let dir = tempfile::tempdir().unwrap();
-    let mut face = FaceModel::from_synth(&fbakit::synth::alma());
+    let mut face = fbakit::synth::alma().to_face_model();
     face.fat.tables.clear();
     let face_path = dir.path().join("bare.wrl");
     fbakit::face::vrml_io::write_face_file(&face_path, &face).unwrap();

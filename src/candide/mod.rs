@@ -7,7 +7,6 @@
 //! face is `g = ḡ + S·σ + A·α`: each unit adds `value × displacement` to its vertices.
 //! Units are in the model's arbitrary length scale (head height ≈ 2).
 
-pub mod face;
 pub mod wfm;
 
 use glam::Vec3;

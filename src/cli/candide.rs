@@ -2,11 +2,10 @@
 
 use std::path::PathBuf;
 
-use fbakit::candide::face::candide_face_with_notes;
 use fbakit::candide::{parse_shape_spec, read_wfm_file};
 use fbakit::error::Result;
-use fbakit::face::obj_io::write_face;
-use fbakit::face::FaceModel;
+use fbakit::face::candide::candide_face_with_notes;
+use fbakit::face::write as write_face;
 
 use super::EXIT_OK;
 
@@ -65,7 +64,7 @@ pub fn sample(a: SampleArgs) -> Result<u8> {
         "alma" => fbakit::synth::alma(),
         _ => fbakit::synth::bruno(),
     };
-    let face = FaceModel::from_synth(&synth);
+    let face = synth.to_face_model();
     write_face(&a.output, &face)?;
     eprintln!(
         "wrote {} ({} vertices, {} FAT tables)",

@@ -6,11 +6,13 @@ use std::path::{Path, PathBuf};
 use fbakit::clone::eval::{compliance, self_clone_error_with, ComplianceReport};
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
 use fbakit::error::{Error, Result};
-use fbakit::face::FaceModel;
+use fbakit::export::write_face;
+use fbakit::face::{FaceFormat, FaceModel, FaceReadOptions};
+use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use super::{print_json, MethodArg, EXIT_BAD_INPUT, EXIT_OK};
+use super::{print_json, MethodArg, EXIT_OK};
 
 #[derive(Debug, clap::Args)]
 pub struct CloneArgs {
@@ -78,23 +80,15 @@ pub struct SelfCloneArgs {
     pub method: MethodArg,
 }
 
-/// Reads a face: VRML (plain or gzip), or OBJ plus its feature points, or a built-in face
-/// name (`alma`, `bruno`) when no such file exists.
+/// Reads a face through the front door; an OBJ face must come with its feature points.
 fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
-    let is_obj = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if is_obj && fp.is_none() {
+    if fp.is_none() && FaceFormat::of_extension(path) == Some(FaceFormat::Obj) {
         return Err(Error::Invalid(format!(
             "{}: an OBJ face needs its feature points (--fp-source / --fp-target / --fp FILE)",
             path.display()
         )));
     }
-    if fp.is_none() {
-        return fbakit::player::load_face(path);
-    }
-    Ok(fbakit::face::obj_io::read_face(path, fp)?.0)
+    Ok(fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp))?.0)
 }
 
 fn bar(steps: u64) -> ProgressBar {
@@ -127,25 +121,8 @@ struct Output<'a> {
 }
 
 pub fn run(args: CloneArgs) -> Result<u8> {
-    let ext = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let name = args.output.to_string_lossy().to_ascii_lowercase();
-    let gltf = matches!(ext.as_deref(), Some("glb" | "gltf"));
-    let face_file = name.ends_with(".wrl")
-        || name.ends_with(".vrml")
-        || name.ends_with(".wrl.gz")
-        || name.ends_with(".wrz")
-        || name.ends_with(".obj");
-    if !gltf && !face_file {
-        eprintln!(
-            "error: {}: the output must be a face file (.wrl, .wrl.gz, .wrz, .obj) or glTF (.glb, .gltf)",
-            args.output.display()
-        );
-        return Ok(EXIT_BAD_INPUT);
-    }
+    OutputFormat::resolve(&args.output, OutputFormat::FACES, "the cloned face")?;
+    refuse_overwriting_input(&args.output, &[&args.source, &args.target])?;
     let pb = bar(if args.report { 5 } else { 4 });
     pb.set_message("reading source");
     let source = read_face(&args.source, args.fp_source.as_deref())?;
@@ -163,11 +140,9 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     let outcome = clone_face(&source, &target, &opts)?;
     pb.inc(1);
     pb.set_message("writing");
-    if gltf {
-        // The cloned FAT as glTF morph targets (static; `fbakit play` animates it).
-        fbakit::export::gltf::face_to_gltf(&outcome.face, None)?.write(&args.output)?;
-    } else {
-        fbakit::face::obj_io::write_face(&args.output, &outcome.face)?;
+    // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it).
+    for w in write_face(&args.output, &outcome.face)? {
+        eprintln!("warning: {w}");
     }
     pb.inc(1);
     let quality = if args.report {

@@ -3,10 +3,12 @@
 use std::path::PathBuf;
 
 use fbakit::error::{Result, Severity};
+use fbakit::export::write_face;
 use fbakit::face::morphs::{face_from_morph_set, write_morph_set, MorphSetOptions};
-use fbakit::face::obj_io::{read_face, write_face};
 use fbakit::face::summary::summarize;
 use fbakit::face::validate::validate_face;
+use fbakit::face::{read_with, FaceReadOptions};
+use fbakit::format::{refuse_overwriting_input, OutputFormat};
 
 use super::{print_json, EXIT_FAILURE, EXIT_OK};
 
@@ -150,7 +152,10 @@ pub fn run(cmd: FaceCommand) -> Result<u8> {
 }
 
 fn info(a: InfoArgs) -> Result<u8> {
-    let (face, report) = read_face(&a.file, a.fp.as_deref())?;
+    let (face, report) = read_with(
+        &a.file,
+        &FaceReadOptions::with_feature_points(a.fp.as_deref()),
+    )?;
     let summary = summarize(&face, Some(&report));
     if a.json {
         print_json(&summary)?;
@@ -161,7 +166,7 @@ fn info(a: InfoArgs) -> Result<u8> {
 }
 
 fn validate(a: ValidateArgs) -> Result<u8> {
-    let (face, report) = read_face(&a.file, None)?;
+    let (face, report) = read_with(&a.file, &FaceReadOptions::default())?;
     let findings = validate_face(&face, &report);
     let errors = findings
         .iter()
@@ -192,8 +197,15 @@ fn validate(a: ValidateArgs) -> Result<u8> {
 }
 
 fn convert(a: ConvertArgs) -> Result<u8> {
-    let (face, _) = read_face(&a.input, a.fp.as_deref())?;
-    write_face(&a.output, &face)?;
+    OutputFormat::resolve(&a.output, OutputFormat::FACES, "`face convert` output")?;
+    refuse_overwriting_input(&a.output, &[&a.input])?;
+    let (face, _) = read_with(
+        &a.input,
+        &FaceReadOptions::with_feature_points(a.fp.as_deref()),
+    )?;
+    for w in write_face(&a.output, &face)? {
+        eprintln!("warning: {w}");
+    }
     eprintln!(
         "wrote {} ({} meshes, {} vertices, {} FAT tables)",
         a.output.display(),
@@ -236,7 +248,7 @@ fn from_morphs(a: FromMorphsArgs) -> Result<u8> {
 }
 
 fn to_morphs(a: ToMorphsArgs) -> Result<u8> {
-    let (face, _) = read_face(&a.face, None)?;
+    let (face, _) = read_with(&a.face, &FaceReadOptions::default())?;
     let written = write_morph_set(&face, &a.dir, a.value)?;
     eprintln!(
         "wrote {} morph OBJs, neutral.obj and feature-points.csv to {}",

@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use fbakit::error::{Error, Result};
+use fbakit::error::Result;
 use fbakit::export::gltf::export_face;
-use fbakit::player::load_face;
+use fbakit::format::OutputFormat;
 use serde::Serialize;
 
 use super::{print_json, EXIT_OK};
@@ -38,24 +38,14 @@ struct Report {
 
 /// Runs `face export`.
 pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
-    let ext = a
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    let glb = match ext.as_deref() {
-        Some("glb") => true,
-        Some("gltf") => false,
-        _ => {
-            return Err(Error::Unsupported(format!(
-                "`{}`: the output must end in .glb or .gltf",
-                a.output.display()
-            )))
-        }
-    };
-    let face = load_face(&a.face)?;
+    let format = OutputFormat::resolve(
+        &a.output,
+        &[OutputFormat::Glb, OutputFormat::Gltf],
+        "`face export` output",
+    )?;
+    let face = fbakit::face::read(&a.face)?;
     let export = export_face(&face, None)?;
-    if glb {
+    if format == OutputFormat::Glb {
         export.document.write_glb(&a.output)?;
     } else {
         export.document.write_gltf(&a.output)?;

@@ -44,7 +44,10 @@ pub fn run(args: FapuArgs) -> Result<u8> {
         // With a mesh, the points are placed on its vertices and the FAPUs measured there,
         // even when the file also states FAPU distances.
         Some(mesh) => {
-            let (face, _) = fbakit::face::obj_io::read_face(mesh, Some(&args.file))?;
+            let (face, _) = fbakit::face::read_with(
+                mesh,
+                &fbakit::face::FaceReadOptions::with_feature_points(Some(&args.file)),
+            )?;
             (
                 FapuSource::FeaturePoints,
                 Fapu::measure(&face.feature_points)?,

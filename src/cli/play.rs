@@ -11,7 +11,7 @@ use fbakit::export::gltf::export_face;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
 use fbakit::fap::{read_stream_file, ReadOptions};
-use fbakit::player::{load_face, PlayOptions, Player};
+use fbakit::player::{PlayOptions, Player};
 use fbakit::render::RenderOptions;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -170,7 +170,7 @@ pub fn progress(len: u64, what: &str) -> ProgressBar {
 /// Runs `play`.
 pub fn run(a: PlayArgs) -> Result<u8> {
     let format = output_format(&a.output, a.format)?;
-    let face = load_face(&a.face)?;
+    let face = fbakit::face::read(&a.face)?;
     let opts = if a.strict {
         ReadOptions::strict()
     } else {
@@ -277,7 +277,7 @@ fn write_pngs(
     let mut positions = Vec::new();
     let mut n = 0;
     while player.next_frame(&mut frame) {
-        frame.world_positions_into(&mut positions);
+        frame.pose.world_positions_into(&mut positions);
         let image = view.render(&positions, &camera, &opts);
         image.write_png(&a.output.join(format!("frame_{:05}.png", frame.index)))?;
         n += 1;

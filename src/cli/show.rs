@@ -9,6 +9,7 @@ use fbakit::error::{Error, Result};
 use fbakit::export::picture::cloning_grid;
 use fbakit::face::FaceModel;
 use fbakit::fat::TableKey;
+use fbakit::format::OutputFormat;
 
 use super::{print_json, MethodArg, EXIT_OK};
 
@@ -42,18 +43,6 @@ fn parse_key(s: &str) -> std::result::Result<TableKey, String> {
     })
 }
 
-/// A face file, or a built-in face by name when no such file exists.
-pub fn load_any_face(spec: &Path) -> Result<FaceModel> {
-    if !spec.exists() {
-        match spec.to_str() {
-            Some("alma") => return Ok(FaceModel::from_synth(&fbakit::synth::alma())),
-            Some("bruno") => return Ok(FaceModel::from_synth(&fbakit::synth::bruno())),
-            _ => {}
-        }
-    }
-    fbakit::face::obj_io::read_face(spec, None).map(|(face, _)| face)
-}
-
 /// Short display name of a face argument (`bruno` for `faces/bruno.wrl.gz`).
 fn short_name(spec: &Path) -> String {
     let name = spec.file_name().map_or_else(
@@ -65,24 +54,14 @@ fn short_name(spec: &Path) -> String {
 
 /// Runs `grid`.
 pub fn grid(a: GridArgs) -> Result<u8> {
-    if a.output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        != Some("png".into())
-    {
-        return Err(Error::Unsupported(format!(
-            "grid writes a PNG; `{}` does not end in .png",
-            a.output.display()
-        )));
-    }
+    OutputFormat::resolve(&a.output, &[OutputFormat::Png], "the cloning grid")?;
     if !a.value.is_finite() {
         return Err(Error::Unsupported("--value must be a finite number".into()));
     }
     let faces: Vec<FaceModel> = a
         .faces
         .iter()
-        .map(|p| load_any_face(p))
+        .map(fbakit::face::read)
         .collect::<Result<_>>()?;
     let names: Vec<String> = a.faces.iter().map(|p| short_name(p)).collect();
     let pairs: Vec<(&str, &FaceModel)> = names.iter().map(String::as_str).zip(&faces).collect();

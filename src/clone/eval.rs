@@ -16,7 +16,7 @@
 
 use std::collections::BTreeMap;
 
-use glam::{Affine3A, Vec3};
+use glam::Vec3;
 use serde::Serialize;
 
 use super::face::{
@@ -26,40 +26,10 @@ use super::quality::morph_target_error;
 use super::SurfaceMotion;
 use crate::error::{Error, Result};
 use crate::face::FaceModel;
-use crate::fat::eval::{Activation, FatEvaluator, FatOutput};
+use crate::fat::eval::Activation;
 use crate::fat::morph::fat_to_morph_targets;
 use crate::fat::TableKey;
 use crate::spec::Directionality;
-
-/// World (face-frame) positions of every vertex of every mesh with `activations` applied.
-pub fn pose(
-    face: &FaceModel,
-    evaluator: &mut FatEvaluator,
-    out: &mut FatOutput,
-    activations: &[Activation],
-) -> Vec<Vec<Vec3>> {
-    evaluator.evaluate(activations, out);
-    let locals: Vec<Affine3A> = face
-        .transforms
-        .iter()
-        .zip(&out.transforms)
-        .map(|(t, d)| t.animated_matrix(d))
-        .collect();
-    let frames = face.frames_with(&locals);
-    face.meshes
-        .iter()
-        .enumerate()
-        .map(|(mi, m)| {
-            let w = frames.meshes[mi];
-            m.mesh
-                .positions
-                .iter()
-                .zip(&out.displacements[mi])
-                .map(|(&p, &d)| w.transform_point3(p + d))
-                .collect()
-        })
-        .collect()
-}
 
 /// Formula (1) of seed 002, in percent, for `face` cloned onto itself with `method` (default
 /// options otherwise).
@@ -154,7 +124,7 @@ pub fn compliance(face: &FaceModel) -> Result<ComplianceReport> {
     let fapu = face.fapu()?;
     let mut evaluator = face.evaluator()?;
     let mut out = evaluator.output();
-    let neutral = pose(face, &mut evaluator, &mut out, &[]);
+    let neutral = face.pose_with(&mut evaluator, &mut out, &[]);
     let mut report = ComplianceReport::default();
     for key in face.fat.keys() {
         let TableKey::LowLevel(fap) = key else {
@@ -179,7 +149,7 @@ pub fn compliance(face: &FaceModel) -> Result<ComplianceReport> {
         };
         let (mut along, mut vector) = (0.0f64, 0.0f64);
         for &value in values {
-            let posed = pose(face, &mut evaluator, &mut out, &[Activation { key, value }]);
+            let posed = face.pose_with(&mut evaluator, &mut out, &[Activation { key, value }]);
             let d = (posed[mi][v as usize] - neutral[mi][v as usize]).as_dvec3();
             let len = value * fapu.unit(kind);
             let expected = dir.as_dvec3() * len;
@@ -246,16 +216,16 @@ pub fn ground_truth_error(cloned: &FaceModel, truth: &FaceModel) -> Result<Groun
     let mut ec = cloned.evaluator()?;
     let mut et = truth.evaluator()?;
     let (mut oc, mut ot) = (ec.output(), et.output());
-    let nc = pose(cloned, &mut ec, &mut oc, &[]);
-    let nt = pose(truth, &mut et, &mut ot, &[]);
+    let nc = cloned.pose_with(&mut ec, &mut oc, &[]);
+    let nt = truth.pose_with(&mut et, &mut ot, &[]);
     let mut per_key: BTreeMap<TableKey, (f64, f64, usize)> = BTreeMap::new();
     for t in fat_to_morph_targets(&truth.fat) {
         let a = [Activation {
             key: t.key,
             value: t.value,
         }];
-        let pc = pose(cloned, &mut ec, &mut oc, &a);
-        let pt = pose(truth, &mut et, &mut ot, &a);
+        let pc = cloned.pose_with(&mut ec, &mut oc, &a);
+        let pt = truth.pose_with(&mut et, &mut ot, &a);
         let (mut num, mut den, mut snum, mut sden) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
         for mi in 0..pt.len() {
             let is_skin = skin.contains(&mi);

@@ -12,3 +12,23 @@
 pub mod gltf;
 pub mod obj_sequence;
 pub mod picture;
+
+use std::path::Path;
+
+use crate::error::Result;
+use crate::face::FaceModel;
+use crate::format::OutputFormat;
+
+/// Writes `face` in the face format `path` names ([`OutputFormat::FACES`]): VRML, gzip VRML
+/// or OBJ through [`crate::face::write`], glTF (`.glb`, `.gltf`) with the FAT as morph
+/// targets through [`gltf::export_face`]. Returns what the format could not hold exactly.
+pub fn write_face(path: &Path, face: &FaceModel) -> Result<Vec<String>> {
+    match OutputFormat::resolve(path, OutputFormat::FACES, "a face file")? {
+        OutputFormat::Glb | OutputFormat::Gltf => {
+            let export = gltf::export_face(face, None)?;
+            export.document.write(path)?;
+            Ok(export.warnings)
+        }
+        _ => crate::face::write(path, face).map(|()| Vec::new()),
+    }
+}

@@ -96,8 +96,8 @@ impl ObjSequence {
     pub fn write_frame(&mut self, frame: &PlayerFrame) -> Result<PathBuf> {
         let positions = &mut self.scene.mesh.positions;
         positions.clear();
-        for m in 0..frame.positions.len() {
-            positions.extend(frame.world_positions(m));
+        for m in 0..frame.pose.positions.len() {
+            positions.extend(frame.pose.world_positions(m));
         }
         let file = format!("frame_{:05}.obj", frame.index);
         let path = self.dir.join(&file);

@@ -8,7 +8,6 @@
 
 use glam::Vec3;
 
-use crate::clone::eval::pose;
 use crate::clone::face::{clone_face, CloneOptions, Method};
 use crate::error::{Error, Result};
 use crate::face::FaceModel;
@@ -48,7 +47,7 @@ impl FaceView {
             .iter()
             .map(|m| m.color.unwrap_or(DEFAULT_COLOUR))
             .collect();
-        let neutral = neutral_positions(face);
+        let neutral = face.neutral_world_positions();
         let meshes = render_meshes(&neutral, &triangles, &colours);
         let neutral_bounds = bounds(&meshes)
             .ok_or_else(|| Error::Invalid(format!("face `{}` has no vertex to draw", face.name)))?;
@@ -69,7 +68,7 @@ impl FaceView {
         Camera::framing(&self.neutral_bounds, 0.0, 0.0)
     }
 
-    /// Draws world positions (one list per mesh, as [`PlayerFrame::world_positions_into`]
+    /// Draws world positions (one list per mesh, as [`crate::face::FacePose::world_positions_into`]
     /// makes them).
     pub fn render(&self, positions: &[Vec<Vec3>], camera: &Camera, opts: &RenderOptions) -> Image {
         render(
@@ -104,23 +103,6 @@ fn render_meshes<'a>(
         .collect()
 }
 
-/// World positions of every mesh of `face` in its neutral pose.
-pub fn neutral_positions(face: &FaceModel) -> Vec<Vec<Vec3>> {
-    let frames = face.frames();
-    face.meshes
-        .iter()
-        .enumerate()
-        .map(|(i, m)| {
-            let w = frames.meshes.get(i).copied().unwrap_or_default();
-            m.mesh
-                .positions
-                .iter()
-                .map(|&p| w.transform_point3(p))
-                .collect()
-        })
-        .collect()
-}
-
 /// One played frame of `face` as an image: world positions per mesh, triangulated polygons,
 /// mesh colours. For many frames build a [`FaceView`] once instead.
 pub fn render_face_frame(
@@ -131,7 +113,7 @@ pub fn render_face_frame(
 ) -> Result<Image> {
     let view = FaceView::new(face)?;
     let mut positions = Vec::new();
-    frame.world_positions_into(&mut positions);
+    frame.pose.world_positions_into(&mut positions);
     Ok(view.render(&positions, camera, opts))
 }
 
@@ -167,7 +149,7 @@ fn played_cells(
     let mut cells = Vec::with_capacity(numbers.len());
     for &k in &numbers {
         player.frame_at(k, &mut frame);
-        frame.world_positions_into(&mut positions);
+        frame.pose.world_positions_into(&mut positions);
         cells.push(view.render(&positions, &camera, &opts));
     }
     Ok((cells, numbers))
@@ -245,7 +227,7 @@ pub fn turntable_sheet(
     let mut frame = player.new_frame();
     player.frame_at(player.frame_range().start, &mut frame);
     let mut positions = Vec::new();
-    frame.world_positions_into(&mut positions);
+    frame.pose.world_positions_into(&mut positions);
     let k = k.clamp(1, 360);
     let angles: Vec<f32> = (0..k)
         .map(|i| i as f32 * std::f32::consts::TAU / k as f32)
@@ -286,7 +268,7 @@ fn posed_cell(
     let view = FaceView::new(face)?;
     let mut eval = face.evaluator()?;
     let mut out = eval.output();
-    let positions = pose(face, &mut eval, &mut out, &[Activation { key, value }]);
+    let positions = face.pose_with(&mut eval, &mut out, &[Activation { key, value }]);
     let mut img = view.render(
         &positions,
         &view.front_camera(),
@@ -375,7 +357,7 @@ mod tests {
 
     #[test]
     fn strip_fat_keeps_geometry() {
-        let face = FaceModel::from_synth(&crate::synth::alma());
+        let face = crate::synth::alma().to_face_model();
         let s = strip_fat(&face);
         assert!(s.fat.tables.is_empty());
         assert_eq!(s.mesh_sizes(), face.mesh_sizes());

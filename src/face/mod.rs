@@ -1,20 +1,34 @@
 //! A complete MPEG-4 face model: scene graph (meshes under transforms), feature points (FDP)
 //! and Facial Animation Tables (FAT).
 //!
-//! [`FaceModel`] is what cloning and playing work on. It is read from and written to VRML97
-//! face files ([`vrml_io`]; any face file by extension, gzip and OBJ included: [`obj_io`]),
-//! built from OBJ morph sets ([`morphs`]), from CANDIDE-3 ([`crate::candide::face`]) or from
-//! the procedural generator ([`FaceModel::from_synth`]); [`summary`] describes one.
+//! [`FaceModel`] is what cloning and playing work on. Every face enters through one front
+//! door, [`read`] (any format, by extension or content, or a bundled face by name), and
+//! leaves through [`write`] (VRML, gzip VRML, OBJ; glTF is [`crate::export::gltf`]). Faces
+//! are also built from OBJ morph sets ([`morphs`]) and from CANDIDE-3 ([`candide`]);
+//! [`summary`] describes one and [`validate`] checks one.
 //!
 //! Frames: mesh positions and FAT displacements are in each mesh's local frame (its
 //! `Coordinate` node); [`FaceModel::frames`] places them in the face frame (MPEG-4: +x the
 //! face's own left, +y up, +z forward), where feature points and FAPUs live.
 
+pub mod attach;
+pub mod bundled;
+pub mod candide;
+pub mod format;
 pub mod morphs;
-pub mod obj_io;
+pub mod pose;
+pub mod read;
 pub mod summary;
 pub mod validate;
 pub mod vrml_io;
+pub mod write;
+
+pub use bundled::BundledFace;
+pub use format::FaceFormat;
+pub use pose::FacePose;
+pub use read::{read, read_bytes, read_with, FaceReadOptions};
+pub use vrml_io::FaceReadReport;
+pub use write::write;
 
 use std::collections::HashMap;
 
@@ -24,8 +38,8 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::fat::eval::FatEvaluator;
 use crate::fat::Fat;
-use crate::fdp::{Fapu, FeaturePoint, FeaturePointSet, VertexBinding};
-use crate::mesh::{Mesh, Polygons};
+use crate::fdp::{Fapu, FeaturePointSet};
+use crate::mesh::Mesh;
 use crate::spec::FeaturePointId;
 
 /// A `Transform` node of the face.
@@ -143,7 +157,7 @@ impl PartialEq for FaceModel {
 }
 
 /// The face frame of each transform and mesh, computed once.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct FaceFrames {
     /// World matrix of each transform.
     pub transforms: Vec<Affine3A>,
@@ -183,23 +197,9 @@ impl FaceModel {
     /// World matrices given each transform's local matrix (e.g. animated ones). Transforms
     /// must come parents first, which readers and builders guarantee.
     pub fn frames_with(&self, locals: &[Affine3A]) -> FaceFrames {
-        let mut world: Vec<Affine3A> = Vec::with_capacity(self.transforms.len());
-        for (i, t) in self.transforms.iter().enumerate() {
-            let parent = t
-                .parent
-                .filter(|&p| p < i)
-                .map_or(Affine3A::IDENTITY, |p| world[p]);
-            world.push(parent * locals[i]);
-        }
-        let meshes = self
-            .meshes
-            .iter()
-            .map(|m| m.transform.map_or(Affine3A::IDENTITY, |t| world[t]))
-            .collect();
-        FaceFrames {
-            transforms: world,
-            meshes,
-        }
+        let mut frames = FaceFrames::default();
+        self.frames_into(locals, &mut frames);
+        frames
     }
 
     /// Face-frame position of vertex `vertex` of mesh `mesh` at neutral.
@@ -295,65 +295,6 @@ impl FaceModel {
             )));
         }
         Ok(())
-    }
-
-    /// The face made by the procedural generator ([`crate::synth`]).
-    pub fn from_synth(face: &crate::synth::SynthFace) -> FaceModel {
-        let transforms = face
-            .transforms
-            .iter()
-            .map(|t| FaceTransform {
-                name: t.name.clone(),
-                parent: t.parent,
-                translation: t.translation,
-                rotation: Quat::from_axis_angle(
-                    t.rotation_axis.try_normalize().unwrap_or(Vec3::Z),
-                    t.rotation_angle,
-                ),
-                scale: t.scale,
-                scale_orientation: Quat::IDENTITY,
-                center: t.center,
-            })
-            .collect();
-        let meshes = face
-            .meshes
-            .iter()
-            .map(|m| {
-                let mut mesh = Mesh {
-                    name: m.name.clone(),
-                    positions: m.positions.clone(),
-                    polygons: Polygons::from_lists(m.polygons.iter().map(|p| p.as_slice())),
-                    ..Mesh::default()
-                };
-                if let Some(uvs) = &m.uvs {
-                    mesh.uvs = uvs.iter().map(|&[u, v]| glam::Vec2::new(u, v)).collect();
-                    mesh.uv_polygons = Some(mesh.polygons.clone());
-                }
-                FaceMesh {
-                    name: m.name.clone(),
-                    transform: Some(m.transform),
-                    mesh,
-                    color: Some(m.colour),
-                }
-            })
-            .collect();
-        let mut feature_points = FeaturePointSet::new();
-        for fp in &face.feature_points {
-            let mut point = FeaturePoint::at(fp.id, fp.position);
-            point.binding = Some(VertexBinding {
-                mesh: Some(face.meshes[fp.mesh].name.clone()),
-                vertices: vec![fp.vertex],
-            });
-            feature_points.insert(point);
-        }
-        FaceModel {
-            name: face.name.clone(),
-            transforms,
-            meshes,
-            feature_points,
-            fat: face.fat.clone(),
-            scene: None,
-        }
     }
 
     /// The mesh and vertex a feature point is bound to (first vertex of its binding).

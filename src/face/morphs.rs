@@ -18,7 +18,7 @@
 //! [`fat_from_morph_targets`].
 //!
 //! **Writing.** [`write_morph_set`] writes `neutral.obj` (all meshes merged in face
-//! coordinates, as [`super::obj_io`] writes OBJ), `feature-points.csv` (the feature points
+//! coordinates, as [`super::write`] writes OBJ), `feature-points.csv` (the feature points
 //! bound to the merged mesh's vertices) and one OBJ per table and value: the table's vertex
 //! motion plus the effect of the transforms it drives on the meshes under them. Files other
 //! than `*.obj` and the file `neutral.obj` are ignored when a set is read, so a written set
@@ -30,7 +30,8 @@ use std::path::{Path, PathBuf};
 use glam::{Affine3A, DVec3, Vec3};
 use serde::Serialize;
 
-use super::obj_io::{attach_feature_points, merged_mesh};
+use super::attach::attach_feature_points;
+use super::write::merged_mesh;
 use super::{FaceMesh, FaceModel};
 use crate::error::{Error, Result};
 use crate::fat::eval::Activation;
@@ -178,9 +179,9 @@ pub fn face_from_morph_set(
     dir: &Path,
     options: &MorphSetOptions,
 ) -> Result<(FaceModel, MorphSetReport)> {
-    let (mut face, _) = super::obj_io::read_face(neutral, None)?;
+    let (mut face, _) = super::read::read_with(neutral, &Default::default())?;
     if face.meshes.len() != 1
-        || super::obj_io::FaceFormat::of_path(neutral)? != super::obj_io::FaceFormat::Obj
+        || super::format::FaceFormat::of_path(neutral)? != super::format::FaceFormat::Obj
     {
         return Err(Error::Unsupported(format!(
             "{}: the neutral face must be an .obj file",

@@ -443,7 +443,7 @@ mod tests {
 
     #[test]
     fn synthetic_face_summary() {
-        let face = FaceModel::from_synth(&crate::synth::alma());
+        let face = crate::synth::alma().to_face_model();
         let s = summarize(&face, None);
         assert_eq!(s.meshes.len(), face.meshes.len());
         assert_eq!(s.fat.visemes, (1..=14).collect::<Vec<_>>());

@@ -21,7 +21,7 @@ fn fp(s: &str) -> FeaturePointId {
 
 #[test]
 fn synthetic_face_round_trips_through_vrml() {
-    let face = FaceModel::from_synth(&crate::synth::alma());
+    let face = crate::synth::alma().to_face_model();
     face.check_structure().unwrap();
     let text = write_face_string(&face).unwrap();
     let (back, report) = read_str(&text);

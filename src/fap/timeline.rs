@@ -46,7 +46,8 @@ impl DenseFrame {
         }
     }
 
-    fn apply(&mut self, f: &FapFrame) {
+    /// Applies a transmitted frame: the FAPs it sends take its values, the others hold.
+    pub fn apply(&mut self, f: &FapFrame) {
         for (id, v) in f.low_level() {
             self.low_level[id.index() - 2] = v;
         }

@@ -8,7 +8,8 @@ use glam::{Quat, Vec3};
 
 use super::{interval_weights, Fat, TableKey, TransformField, HIGH_LEVEL_FULL};
 use crate::error::{Error, Result};
-use crate::spec::{Expression, Viseme};
+use crate::fap::DenseFrame;
+use crate::spec::{Expression, FapId, Viseme};
 
 /// One table to apply at one value (`P` in the module docs of [`crate::fat`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,6 +18,27 @@ pub struct Activation {
     pub key: TableKey,
     /// The value it is evaluated at.
     pub value: f64,
+}
+
+/// The activations of one held FAP state, into `out` (cleared): every low-level FAP at its
+/// value, then the viseme pair and the expression pair — what a frame asks of a FAT.
+pub fn frame_activations(state: &DenseFrame, out: &mut Vec<Activation>) {
+    out.clear();
+    for id in FapId::low_level() {
+        out.push(Activation {
+            key: TableKey::LowLevel(id),
+            value: state.value(id),
+        });
+    }
+    let v = &state.viseme;
+    out.extend(viseme_activations(v.select1, v.select2, f64::from(v.blend)));
+    let e = &state.expression;
+    out.extend(expression_activations(
+        e.select1,
+        f64::from(e.intensity1),
+        e.select2,
+        f64::from(e.intensity2),
+    ));
 }
 
 /// The two activations of a viseme blend: `select1` at `blend`, `select2` at `63 − blend`

@@ -97,17 +97,14 @@ impl GltfDocument {
 
     /// Writes `.glb` or `.gltf` depending on the extension of `path` (case-insensitive).
     pub fn write(&self, path: &Path) -> Result<()> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("glb") => self.write_glb(path),
-            Some("gltf") => self.write_gltf(path),
-            _ => Err(Error::Unsupported(format!(
-                "{}: glTF output needs a .glb or .gltf extension",
-                path.display()
-            ))),
+        use crate::format::OutputFormat;
+        match OutputFormat::resolve(
+            path,
+            &[OutputFormat::Glb, OutputFormat::Gltf],
+            "glTF output",
+        )? {
+            OutputFormat::Glb => self.write_glb(path),
+            _ => self.write_gltf(path),
         }
     }
 }

@@ -32,17 +32,13 @@
 
 use std::ops::Range;
 
-use glam::{Affine3A, Vec3};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::face::{FaceFrames, FaceModel};
-use crate::fap::{resample, DenseFrame, FapStream, FapTimeline};
-use crate::fat::eval::{
-    expression_activations, viseme_activations, Activation, FatEvaluator, FatOutput, TransformDelta,
-};
+use crate::face::{FaceModel, FacePose};
+use crate::fap::{resample, FapStream, FapTimeline};
+use crate::fat::eval::{frame_activations, Activation, FatEvaluator, FatOutput, TransformDelta};
 use crate::fat::{Fat, TableKey};
-use crate::spec::FapId;
 
 /// How to play a stream.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -64,66 +60,21 @@ pub struct MissingTable {
 
 /// One played frame. Create it with [`PlayerFrame::default`] (buffers are sized on first use)
 /// or [`Player::new_frame`], then let [`Player::next_frame`] refill it.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct PlayerFrame {
     /// Output frame number.
     pub index: usize,
     /// Time in seconds (`index / fps`).
     pub time: f64,
-    /// Per mesh, per vertex: neutral position + FAT displacement, in the mesh's local frame.
-    pub positions: Vec<Vec<Vec3>>,
-    /// Per transform: its animated local matrix (see the module docs).
-    pub transform_locals: Vec<Affine3A>,
+    /// The posed face: local positions, animated transform matrices, world frames.
+    pub pose: FacePose,
     /// Per transform: the change from neutral the FAT produced.
     pub transform_deltas: Vec<TransformDelta>,
-    /// World (face-frame) matrices of transforms and meshes for this frame.
-    pub world: FaceFrames,
     /// The activations the frame was evaluated with (keys without a table included).
     pub activations: Vec<Activation>,
 }
 
-impl Default for PlayerFrame {
-    fn default() -> Self {
-        PlayerFrame {
-            index: 0,
-            time: 0.0,
-            positions: Vec::new(),
-            transform_locals: Vec::new(),
-            transform_deltas: Vec::new(),
-            world: FaceFrames {
-                transforms: Vec::new(),
-                meshes: Vec::new(),
-            },
-            activations: Vec::new(),
-        }
-    }
-}
-
 impl PlayerFrame {
-    /// Face-frame position of every vertex of mesh `mesh` (empty for an unknown mesh).
-    pub fn world_positions(&self, mesh: usize) -> impl ExactSizeIterator<Item = Vec3> + '_ {
-        let m = self
-            .world
-            .meshes
-            .get(mesh)
-            .copied()
-            .unwrap_or(Affine3A::IDENTITY);
-        self.positions
-            .get(mesh)
-            .map_or(&[][..], |p| p.as_slice())
-            .iter()
-            .map(move |&p| m.transform_point3(p))
-    }
-
-    /// Face-frame positions of all meshes, written into `out` (resized, buffers reused).
-    pub fn world_positions_into(&self, out: &mut Vec<Vec<Vec3>>) {
-        out.resize_with(self.positions.len(), Vec::new);
-        for (i, o) in out.iter_mut().enumerate() {
-            o.clear();
-            o.extend(self.world_positions(i));
-        }
-    }
-
     /// What a glTF animation needs from this frame (no vertex data).
     pub fn animation_frame(&self) -> AnimationFrame {
         AnimationFrame {
@@ -260,21 +211,17 @@ impl<'a> Player<'a> {
 
     fn size_frame(&self, f: &mut PlayerFrame) {
         let face = self.face;
-        if f.positions.len() != face.meshes.len() {
-            f.positions.resize_with(face.meshes.len(), Vec::new);
-        }
-        for (p, m) in f.positions.iter_mut().zip(&face.meshes) {
-            if p.len() != m.mesh.positions.len() {
-                p.clear();
-                p.extend_from_slice(&m.mesh.positions);
-            }
-        }
         let nt = face.transforms.len();
-        f.transform_locals.resize(nt, Affine3A::IDENTITY);
         f.transform_deltas.resize(nt, TransformDelta::IDENTITY);
         // `reserve` counts from the current length, which is the full size after a frame.
-        reserve_total(&mut f.world.transforms, nt);
-        reserve_total(&mut f.world.meshes, face.meshes.len());
+        let pose = &mut f.pose;
+        pose.positions.resize_with(face.meshes.len(), Vec::new);
+        for (p, m) in pose.positions.iter_mut().zip(&face.meshes) {
+            reserve_total(p, m.mesh.positions.len());
+        }
+        reserve_total(&mut pose.transform_locals, nt);
+        reserve_total(&mut pose.world.transforms, nt);
+        reserve_total(&mut pose.world.meshes, face.meshes.len());
         reserve_total(&mut f.activations, ACTIVATIONS_PER_FRAME);
     }
 
@@ -297,32 +244,13 @@ impl<'a> Player<'a> {
         let state = self.timeline.at_frame(index as u64);
         frame.index = index;
         frame.time = index as f64 / self.fps;
-        fill_activations(state, &mut frame.activations);
+        frame_activations(state, &mut frame.activations);
         self.evaluator
             .evaluate(&frame.activations, &mut self.output);
-        let face = self.face;
-        for ((pos, m), d) in frame
-            .positions
-            .iter_mut()
-            .zip(&face.meshes)
-            .zip(&self.output.displacements)
-        {
-            for ((p, n), d) in pos.iter_mut().zip(&m.mesh.positions).zip(d) {
-                *p = *n + *d;
-            }
-        }
         frame
             .transform_deltas
             .copy_from_slice(&self.output.transforms);
-        for ((local, t), d) in frame
-            .transform_locals
-            .iter_mut()
-            .zip(&face.transforms)
-            .zip(&self.output.transforms)
-        {
-            *local = t.animated_matrix(d);
-        }
-        world_frames_into(face, &frame.transform_locals, &mut frame.world);
+        self.face.pose_into(&self.output, &mut frame.pose);
     }
 
     /// Restarts at the first frame of the range.
@@ -351,7 +279,7 @@ impl<'a> Player<'a> {
         let mut frames = Vec::with_capacity(self.range.len());
         for index in self.range.clone() {
             let mut activations = Vec::with_capacity(ACTIVATIONS_PER_FRAME);
-            fill_activations(self.timeline.at_frame(index as u64), &mut activations);
+            frame_activations(self.timeline.at_frame(index as u64), &mut activations);
             eval.evaluate(&activations, &mut out);
             frames.push(AnimationFrame {
                 index,
@@ -370,65 +298,8 @@ fn reserve_total<T>(v: &mut Vec<T>, total: usize) {
     }
 }
 
-/// Names accepted by [`load_face`] for the built-in procedural faces.
-pub const BUILTIN_FACES: [&str; 2] = ["alma", "bruno"];
-
-/// A face from a VRML face file, or one of the built-in faces by name (`alma`, `bruno`) when
-/// no file of that name exists.
-pub fn load_face(spec: &std::path::Path) -> Result<FaceModel> {
-    if !spec.exists() {
-        match spec.to_str() {
-            Some("alma") => return Ok(FaceModel::from_synth(&crate::synth::alma())),
-            Some("bruno") => return Ok(FaceModel::from_synth(&crate::synth::bruno())),
-            _ => {}
-        }
-    }
-    crate::face::obj_io::read_face(spec, None).map(|(face, _)| face)
-}
-
 /// 66 low-level FAPs, two viseme and two expression activations.
 const ACTIVATIONS_PER_FRAME: usize = 66 + 4;
-
-/// The activations of one held state: every low-level FAP, then the viseme and expression
-/// pairs.
-pub fn fill_activations(state: &DenseFrame, out: &mut Vec<Activation>) {
-    out.clear();
-    for id in FapId::low_level() {
-        out.push(Activation {
-            key: TableKey::LowLevel(id),
-            value: state.value(id),
-        });
-    }
-    let v = &state.viseme;
-    out.extend(viseme_activations(v.select1, v.select2, f64::from(v.blend)));
-    let e = &state.expression;
-    out.extend(expression_activations(
-        e.select1,
-        f64::from(e.intensity1),
-        e.select2,
-        f64::from(e.intensity2),
-    ));
-}
-
-/// [`FaceModel::frames_with`] into existing buffers (no allocation once they have capacity).
-fn world_frames_into(face: &FaceModel, locals: &[Affine3A], out: &mut FaceFrames) {
-    out.transforms.clear();
-    for (i, t) in face.transforms.iter().enumerate() {
-        let parent = t
-            .parent
-            .filter(|&p| p < i)
-            .map_or(Affine3A::IDENTITY, |p| out.transforms[p]);
-        out.transforms.push(parent * locals[i]);
-    }
-    out.meshes.clear();
-    for m in &face.meshes {
-        let w = m
-            .transform
-            .and_then(|t| out.transforms.get(t).copied())
-            .unwrap_or(Affine3A::IDENTITY);
-        out.meshes.push(w);
-    }
-}
 
 fn missing_tables(
     evaluator: &FatEvaluator,
@@ -439,7 +310,7 @@ fn missing_tables(
     let mut keys: Vec<Option<TableKey>> = vec![None; TableKey::SLOTS];
     let mut activations = Vec::with_capacity(ACTIVATIONS_PER_FRAME);
     for n in range {
-        fill_activations(timeline.at_frame(n as u64), &mut activations);
+        frame_activations(timeline.at_frame(n as u64), &mut activations);
         // A key counts once per frame even when both halves of a pair select it.
         let mut seen = [false; TableKey::SLOTS];
         for a in &activations {

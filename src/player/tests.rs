@@ -4,11 +4,11 @@ use glam::{Quat, Vec3};
 
 use super::*;
 use crate::fap::{ExpressionParams, FapFrame, VisemeParams};
-use crate::spec::{Expression, FeaturePointId, Viseme};
+use crate::spec::{Expression, FapId, FeaturePointId, Viseme};
 
 fn alma() -> &'static FaceModel {
     static FACE: OnceLock<FaceModel> = OnceLock::new();
-    FACE.get_or_init(|| FaceModel::from_synth(&crate::synth::alma()))
+    FACE.get_or_init(|| crate::synth::alma().to_face_model())
 }
 
 fn fp(id: &str) -> FeaturePointId {
@@ -24,7 +24,7 @@ fn stream_of(frames: Vec<FapFrame>) -> FapStream {
 
 fn world_fp(face: &FaceModel, frame: &PlayerFrame, id: &str) -> Vec3 {
     let (m, v) = face.fp_vertex(fp(id)).unwrap();
-    frame.world.meshes[m].transform_point3(frame.positions[m][v as usize])
+    frame.pose.world.meshes[m].transform_point3(frame.pose.positions[m][v as usize])
 }
 
 #[test]
@@ -70,7 +70,7 @@ fn eyeball_yaw_turns_about_eye_centre() {
     player.next_frame(&mut frame);
     let ti = face.transform_index("eye_l_tf").unwrap();
     let c = face.transforms[ti].center;
-    let w = frame.world.transforms[ti];
+    let w = frame.pose.world.transforms[ti];
     // The centre stays, a point in front of it turns by 0.3 rad about +y.
     assert!((w.transform_point3(c) - c).length() < 1e-4);
     let p = c + Vec3::Z * 10.0;
@@ -190,7 +190,7 @@ fn viseme_and_expression_activations() {
         &mut out,
     );
     for (mi, m) in face.meshes.iter().enumerate() {
-        for (k, p) in frame.positions[mi].iter().enumerate() {
+        for (k, p) in frame.pose.positions[mi].iter().enumerate() {
             let e = m.mesh.positions[k] + out.displacements[mi][k];
             assert!((*p - e).length() < 1e-3, "mesh {mi} vertex {k}");
         }
@@ -211,18 +211,25 @@ fn next_frame_reuses_buffers() {
     assert!(player.next_frame(&mut frame));
     let ptrs = |f: &PlayerFrame| {
         let mut v: Vec<(usize, usize)> = f
+            .pose
             .positions
             .iter()
             .map(|p| (p.as_ptr() as usize, p.capacity()))
             .collect();
-        v.push((f.positions.as_ptr() as usize, f.positions.capacity()));
-        v.push((f.transform_locals.as_ptr() as usize, 0));
+        v.push((
+            f.pose.positions.as_ptr() as usize,
+            f.pose.positions.capacity(),
+        ));
+        v.push((f.pose.transform_locals.as_ptr() as usize, 0));
         v.push((f.transform_deltas.as_ptr() as usize, 0));
         v.push((
-            f.world.transforms.as_ptr() as usize,
-            f.world.transforms.capacity(),
+            f.pose.world.transforms.as_ptr() as usize,
+            f.pose.world.transforms.capacity(),
         ));
-        v.push((f.world.meshes.as_ptr() as usize, f.world.meshes.capacity()));
+        v.push((
+            f.pose.world.meshes.as_ptr() as usize,
+            f.pose.world.meshes.capacity(),
+        ));
         v.push((f.activations.as_ptr() as usize, f.activations.capacity()));
         v
     };
@@ -231,7 +238,7 @@ fn next_frame_reuses_buffers() {
     let mut moved = false;
     while player.next_frame(&mut frame) {
         assert_eq!(ptrs(&frame), before, "frame {}", frame.index);
-        moved |= frame.positions[0] != face.meshes[0].mesh.positions;
+        moved |= frame.pose.positions[0] != face.meshes[0].mesh.positions;
         count += 1;
     }
     assert_eq!(count, player.frame_count());
@@ -251,9 +258,9 @@ fn world_positions_match_face_frames_at_neutral() {
     player.next_frame(&mut frame);
     let frames = face.frames();
     let mut world = Vec::new();
-    frame.world_positions_into(&mut world);
+    frame.pose.world_positions_into(&mut world);
     for (mi, m) in face.meshes.iter().enumerate() {
-        assert_eq!(frame.positions[mi], m.mesh.positions);
+        assert_eq!(frame.pose.positions[mi], m.mesh.positions);
         let v = m.mesh.vertex_count() as u32 / 2;
         assert_eq!(
             Some(world[mi][v as usize]),

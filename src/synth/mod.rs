@@ -35,8 +35,13 @@ mod skin;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use glam::Quat;
+
+use crate::face::{FaceMesh, FaceModel, FaceTransform};
 use crate::fat::Fat;
 use crate::fdp::fapu::{Fapu, FapuDistances};
+use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
+use crate::mesh::{Mesh, Polygons};
 use crate::spec::FeaturePointId;
 
 pub use highlevel::{expression_faps, viseme_faps};
@@ -348,6 +353,67 @@ pub mod names {
 }
 
 impl SynthFace {
+    /// This face as a [`FaceModel`] (meshes under their transforms, bound feature points,
+    /// the FAT).
+    pub fn to_face_model(&self) -> FaceModel {
+        let face = self;
+        let transforms = face
+            .transforms
+            .iter()
+            .map(|t| FaceTransform {
+                name: t.name.clone(),
+                parent: t.parent,
+                translation: t.translation,
+                rotation: Quat::from_axis_angle(
+                    t.rotation_axis.try_normalize().unwrap_or(Vec3::Z),
+                    t.rotation_angle,
+                ),
+                scale: t.scale,
+                scale_orientation: Quat::IDENTITY,
+                center: t.center,
+            })
+            .collect();
+        let meshes = face
+            .meshes
+            .iter()
+            .map(|m| {
+                let mut mesh = Mesh {
+                    name: m.name.clone(),
+                    positions: m.positions.clone(),
+                    polygons: Polygons::from_lists(m.polygons.iter().map(|p| p.as_slice())),
+                    ..Mesh::default()
+                };
+                if let Some(uvs) = &m.uvs {
+                    mesh.uvs = uvs.iter().map(|&[u, v]| glam::Vec2::new(u, v)).collect();
+                    mesh.uv_polygons = Some(mesh.polygons.clone());
+                }
+                FaceMesh {
+                    name: m.name.clone(),
+                    transform: Some(m.transform),
+                    mesh,
+                    color: Some(m.colour),
+                }
+            })
+            .collect();
+        let mut feature_points = FeaturePointSet::new();
+        for fp in &face.feature_points {
+            let mut point = FeaturePoint::at(fp.id, fp.position);
+            point.binding = Some(VertexBinding {
+                mesh: Some(face.meshes[fp.mesh].name.clone()),
+                vertices: vec![fp.vertex],
+            });
+            feature_points.insert(point);
+        }
+        FaceModel {
+            name: face.name.clone(),
+            transforms,
+            meshes,
+            feature_points,
+            fat: face.fat.clone(),
+            scene: None,
+        }
+    }
+
     /// The feature point `id`, if the face has it.
     pub fn feature_point(&self, id: FeaturePointId) -> Option<&SynthFeaturePoint> {
         self.feature_points.iter().find(|f| f.id == id)

@@ -1,5 +1,4 @@
 use super::*;
-use crate::clone::eval::pose;
 use crate::fat::eval::Activation;
 use crate::spec::FapId;
 use crate::synth::{generate, HeadParams};
@@ -9,8 +8,8 @@ fn small(params: HeadParams) -> FaceModel {
     static FACES: std::sync::OnceLock<(FaceModel, FaceModel)> = std::sync::OnceLock::new();
     let (a, b) = FACES.get_or_init(|| {
         (
-            FaceModel::from_synth(&generate(&HeadParams::alma())),
-            FaceModel::from_synth(&generate(&HeadParams::bruno())),
+            generate(&HeadParams::alma()).to_face_model(),
+            generate(&HeadParams::bruno()).to_face_model(),
         )
     });
     if params.name == "alma" {
@@ -99,14 +98,13 @@ fn rigid_parts_pivot_about_installed_centres() {
     let face = &out.face;
     let mut ev = face.evaluator().unwrap();
     let mut o = ev.output();
-    let neutral = pose(face, &mut ev, &mut o, &[]);
+    let neutral = face.pose_with(&mut ev, &mut o, &[]);
     // Eyeball yaw: every left-eye vertex keeps its distance to the eyeball centre.
     let eye = face.mesh_index("eye_l").unwrap();
     let frames = face.frames();
     let t = face.transform_index("eye_l_tf").unwrap();
     let centre = frames.transforms[t].transform_point3(face.transforms[t].center);
-    let yaw = pose(
-        face,
+    let yaw = face.pose_with(
         &mut ev,
         &mut o,
         &[Activation {
@@ -130,8 +128,7 @@ fn rigid_parts_pivot_about_installed_centres() {
         .feature_points
         .position("7.1".parse().unwrap())
         .unwrap();
-    let pitch = pose(
-        face,
+    let pitch = face.pose_with(
         &mut ev,
         &mut o,
         &[Activation {

@@ -82,23 +82,6 @@ impl VertexTriangles {
     }
 }
 
-/// Area-weighted vertex normals (unit length; zero for isolated or degenerate vertices).
-pub(crate) fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut n = vec![Vec3::ZERO; positions.len()];
-    for t in triangles {
-        let [a, b, c] = t.map(|i| positions[i as usize]);
-        // The cross product's length is twice the area: area weighting comes for free.
-        let face = (b - a).cross(c - a);
-        for &i in t {
-            n[i as usize] += face;
-        }
-    }
-    for v in &mut n {
-        *v = v.normalize_or_zero();
-    }
-    n
-}
-
 /// Barycentric coordinates `(wa, wb, wc)` of `p` with respect to triangle `a b c`, for a
 /// point on (or very near) the triangle. Small negative weights from rounding are clamped and
 /// the weights renormalised; a degenerate triangle gives its vertex nearest to `p` weight 1.
@@ -304,6 +287,7 @@ impl RegionBvh {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::geometry::vertex_normals;
 
     #[test]
     fn barycentric_reproduces_points_and_clamps() {

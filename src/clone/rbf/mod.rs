@@ -89,12 +89,11 @@ use rayon::prelude::*;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::{Error, Result};
+use crate::mesh::geometry::vertex_normals;
 use crate::spec::FeaturePointId;
 
 use interp::Multiquadric;
-use mesh::{
-    adjacency, barycentric, coincidence_classes, vertex_normals, RegionBvh, VertexTriangles,
-};
+use mesh::{adjacency, barycentric, coincidence_classes, RegionBvh, VertexTriangles};
 use regions::{Region, TriRegion};
 
 /// Settings of [`clone_rbf`].

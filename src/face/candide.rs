@@ -22,7 +22,7 @@
 
 use glam::Vec3;
 
-use super::CandideModel;
+use crate::candide::CandideModel;
 use crate::error::{Error, Result};
 use crate::face::{FaceMesh, FaceModel};
 use crate::fat::{FaceDefMesh, FaceDefTable, TableKey};

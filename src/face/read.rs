@@ -1,0 +1,266 @@
+//! The one front door for faces: [`read`] a face from a file of any supported format, from
+//! bytes with a name ([`read_bytes`]), or by the name of a bundled face (`alma`, `bruno`).
+//!
+//! The format comes from the extension ([`FaceFormat::of_extension`]) and, where the
+//! extension says nothing, from the content ([`FaceFormat::sniff`]): gzip is recognised by
+//! its magic bytes whatever the name, so `head.wrl` that is really compressed still reads.
+//! Every input is size-bounded ([`crate::io::DEFAULT_MAX_INPUT_BYTES`], compressed and
+//! decompressed alike).
+//!
+//! **Feature points.** [`FaceReadOptions::feature_points`] names a feature-point file (any
+//! format [`crate::fdp::read_feature_points`] reads) whose points replace the face's own: an
+//! OBJ face has no other source of points; a CANDIDE-3 model needs its table (vertex
+//! bindings) to become a face with a FAT. Points given by position only are bound to the
+//! nearest vertex and reported in [`FaceReadReport::fp_matches`].
+//!
+//! ```
+//! let alma = fbakit::face::read("alma")?; // a bundled face, by name
+//! assert!(alma.fat.tables.len() > 60);
+//! # Ok::<(), fbakit::error::Error>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use super::attach::attach_feature_points;
+use super::bundled::BundledFace;
+use super::format::{face_name, FaceFormat};
+use super::vrml_io::{face_from_scene, FaceReadReport};
+use super::{FaceMesh, FaceModel};
+use crate::error::{Error, Result};
+use crate::io::{gunzip_bounded, DEFAULT_MAX_INPUT_BYTES};
+
+/// How [`read_with`] and [`read_bytes`] read a face.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FaceReadOptions {
+    /// A feature-point file whose points replace the face's own (required for CANDIDE-3).
+    pub feature_points: Option<PathBuf>,
+    /// The format, when neither the name nor the content should decide.
+    pub format: Option<FaceFormat>,
+}
+
+impl FaceReadOptions {
+    /// Options with a feature-point file.
+    pub fn with_feature_points(path: Option<&Path>) -> FaceReadOptions {
+        FaceReadOptions {
+            feature_points: path.map(Path::to_path_buf),
+            ..FaceReadOptions::default()
+        }
+    }
+}
+
+/// Reads a face from a file, or a bundled face by name (`alma`, `bruno`) when no file of
+/// that name exists. See the module docs.
+pub fn read(path: impl AsRef<Path>) -> Result<FaceModel> {
+    read_with(path.as_ref(), &FaceReadOptions::default()).map(|(face, _)| face)
+}
+
+/// [`read`] with options, returning what the reader noticed (diagnostics, feature-point
+/// matches, scene paths).
+pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, FaceReadReport)> {
+    if !path.exists() {
+        if let Some(bundled) = path.to_str().and_then(BundledFace::from_name) {
+            let (mut face, mut report) = bundled.read()?;
+            if let Some(fp) = &opts.feature_points {
+                report.fp_matches = attach_file(&mut face, fp, path)?;
+            }
+            return Ok((face, report));
+        }
+    }
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if meta.is_dir() {
+        return Err(Error::Invalid(format!(
+            "{}: is a directory; expected a face file (.wrl, .wrl.gz, .obj, .wfm) or a \
+             bundled face name ({})",
+            path.display(),
+            BundledFace::NAMES.join(", ")
+        )));
+    }
+    let bytes = crate::io::read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
+    read_bytes_at(path, &bytes, opts)
+}
+
+/// Reads a face held in memory; `name` stands for the file in messages and gives the face
+/// its name (`head.obj` → `head`), and its extension picks the format unless the content or
+/// [`FaceReadOptions::format`] does.
+pub fn read_bytes(
+    name: &str,
+    bytes: &[u8],
+    opts: &FaceReadOptions,
+) -> Result<(FaceModel, FaceReadReport)> {
+    read_bytes_at(Path::new(name), bytes, opts)
+}
+
+fn read_bytes_at(
+    path: &Path,
+    bytes: &[u8],
+    opts: &FaceReadOptions,
+) -> Result<(FaceModel, FaceReadReport)> {
+    let format = detect(path, bytes, opts.format)?;
+    let name = face_name(path);
+    let (mut face, mut report) = match format {
+        FaceFormat::Vrml => vrml_face(path, &text_of(path, bytes, "UTF-8 VRML text")?, &name)?,
+        FaceFormat::VrmlGz => {
+            let inner = gunzip_bounded(bytes, DEFAULT_MAX_INPUT_BYTES).map_err(|e| {
+                Error::io(path, std::io::Error::new(e.kind(), format!("gzip: {e}")))
+            })?;
+            match FaceFormat::sniff(&inner) {
+                Some(FaceFormat::Obj) => obj_face(path, &inner, &name)?,
+                _ => vrml_face(
+                    path,
+                    &text_of(path, &inner, "UTF-8 VRML text (after gzip decompression)")?,
+                    &name,
+                )?,
+            }
+        }
+        FaceFormat::Obj => obj_face(path, bytes, &name)?,
+        FaceFormat::Wfm => return candide(path, bytes, opts),
+    };
+    if let Some(fp) = &opts.feature_points {
+        report.fp_matches = attach_file(&mut face, fp, path)?;
+    }
+    Ok((face, report))
+}
+
+/// The format: forced, else the extension (unless the bytes are gzip, which no text format
+/// can be), else the content.
+fn detect(path: &Path, bytes: &[u8], forced: Option<FaceFormat>) -> Result<FaceFormat> {
+    if let Some(f) = forced {
+        return Ok(f);
+    }
+    let sniffed = FaceFormat::sniff(bytes);
+    if sniffed == Some(FaceFormat::VrmlGz) {
+        return Ok(FaceFormat::VrmlGz);
+    }
+    if let Some(f) = FaceFormat::of_extension(path) {
+        return Ok(f);
+    }
+    sniffed.ok_or_else(|| {
+        Error::Unsupported(format!(
+            "{}: not a face file fbakit recognises (expected VRML97 (#VRML header), gzip, \
+             OBJ or CANDIDE-3 .wfm; or name it .wrl, .wrl.gz, .obj or .wfm)",
+            path.display()
+        ))
+    })
+}
+
+fn text_of(path: &Path, bytes: &[u8], expected: &str) -> Result<String> {
+    String::from_utf8(bytes.to_vec()).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let valid = std::str::from_utf8(&bytes[..at]).unwrap_or_default();
+        Error::Parse(crate::error::ParseError {
+            location: crate::error::Location::from_offset(path, valid, at),
+            expected: expected.to_string(),
+            found: Some(format!("byte 0x{:02X}", bytes[at])),
+        })
+    })
+}
+
+fn vrml_face(path: &Path, text: &str, name: &str) -> Result<(FaceModel, FaceReadReport)> {
+    let scene = crate::vrml::parse_vrml(path, text)?;
+    face_from_scene(scene, name)
+}
+
+fn obj_face(path: &Path, bytes: &[u8], name: &str) -> Result<(FaceModel, FaceReadReport)> {
+    let text = text_of(path, bytes, "UTF-8 OBJ text")?;
+    let (obj, diagnostics) = crate::mesh::obj::read_obj_str(&text, path)?;
+    let mut face = FaceModel::new(name);
+    let mut mesh = obj.mesh;
+    mesh.name = name.to_string();
+    face.meshes.push(FaceMesh {
+        name: name.to_string(),
+        transform: None,
+        mesh,
+        color: None,
+    });
+    let report = FaceReadReport {
+        diagnostics,
+        mesh_paths: vec![format!("OBJ {}", path.display())],
+        ..FaceReadReport::default()
+    };
+    Ok((face, report))
+}
+
+/// A CANDIDE-3 model becomes a face with a FAT once its feature-point table binds the
+/// standard's points to its vertices.
+fn candide(
+    path: &Path,
+    bytes: &[u8],
+    opts: &FaceReadOptions,
+) -> Result<(FaceModel, FaceReadReport)> {
+    let Some(fp) = &opts.feature_points else {
+        return Err(Error::Invalid(format!(
+            "{}: a CANDIDE-3 model needs its feature-point table to become a face; give it \
+             with --fp (e.g. feature-points.csv beside candide3.wfm)",
+            path.display()
+        )));
+    };
+    // CANDIDE files carry Latin-1 author names in comments; only ASCII matters to the model.
+    let text = String::from_utf8_lossy(bytes);
+    let model = crate::candide::read_wfm_str(&text, path)?;
+    let points = crate::fdp::read_feature_points(fp)?.points;
+    let face = super::candide::candide_face(&model, &points, &[])?;
+    Ok((face, FaceReadReport::default()))
+}
+
+fn attach_file(
+    face: &mut FaceModel,
+    fp: &Path,
+    face_path: &Path,
+) -> Result<Vec<super::vrml_io::FeaturePointMatch>> {
+    let file = crate::fdp::read_feature_points(fp)?;
+    let alias = face_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    attach_feature_points(face, file.points, &[&alias])
+        .map_err(|e| Error::Invalid(format!("{}: {e}", fp.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bundled_faces_by_name() {
+        let alma = read("alma").unwrap();
+        assert_eq!(alma.name, "alma");
+        assert!(alma.fat.tables.len() > 60);
+        let e = read("no-such-face").unwrap_err();
+        assert!(e.is_input_error());
+    }
+
+    #[test]
+    fn gzip_and_formats_by_content() {
+        let dir = tempfile::tempdir().unwrap();
+        let alma = read("alma").unwrap();
+        // A compressed face under a plain name, and a VRML face with no extension.
+        let gz = dir.path().join("compressed.wrl");
+        std::fs::write(&gz, BundledFace::Alma.bytes()).unwrap();
+        assert!(
+            read(&gz).unwrap()
+                == FaceModel {
+                    name: "compressed".into(),
+                    ..alma.clone()
+                }
+        );
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        let (face, _) = read_bytes("tri", obj.as_bytes(), &FaceReadOptions::default()).unwrap();
+        assert_eq!(face.vertex_count(), 3);
+        let e = read_bytes("x", b"hello", &FaceReadOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("not a face file"), "{e}");
+        let e = read(dir.path()).unwrap_err();
+        assert!(e.to_string().contains("is a directory"), "{e}");
+        assert!(e.is_input_error());
+    }
+
+    #[test]
+    fn candide_needs_its_table() {
+        let e = read_bytes(
+            "c.wfm",
+            b"# VERTEX LIST:\n0\n# FACE LIST:\n0\n",
+            &FaceReadOptions::default(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("feature-point table"), "{e}");
+    }
+}

@@ -1,0 +1,165 @@
+//! Writing a face in the format its file name asks for: VRML97 (patching the source scene
+//! so other nodes survive), gzip VRML, or OBJ (all meshes merged in face coordinates, each an
+//! `o` span; feature points, transforms and the FAT cannot be held by OBJ and are not
+//! written: use VRML for a complete face). glTF output is [`crate::export::gltf`].
+
+use std::path::Path;
+
+use glam::{Affine3A, Vec3};
+
+use super::vrml_io::face_to_scene;
+use super::FaceModel;
+use crate::error::{Error, Result};
+use crate::format::OutputFormat;
+use crate::io::gzip;
+use crate::mesh::obj::ObjScene;
+use crate::mesh::{FaceGroup, Mesh, Polygons};
+
+/// The formats [`write`] writes.
+pub const WRITABLE: &[OutputFormat] =
+    &[OutputFormat::Vrml, OutputFormat::VrmlGz, OutputFormat::Obj];
+
+/// Writes a face in the format its extension names (see the module docs), atomically.
+pub fn write(path: &Path, face: &FaceModel) -> Result<()> {
+    match OutputFormat::resolve(path, WRITABLE, "a face file")? {
+        OutputFormat::Vrml => super::vrml_io::write_face_file(path, face),
+        OutputFormat::VrmlGz => {
+            let text = crate::vrml::write_vrml_string(&face_to_scene(face)?);
+            crate::io::write_atomic_with(path, |w| gzip(text.as_bytes(), w))
+        }
+        // `resolve` accepted only WRITABLE: this is OBJ.
+        _ => {
+            let scene = ObjScene {
+                mesh: merged_mesh(face, &face.frames().meshes, None)?,
+                material_libraries: Vec::new(),
+            };
+            crate::mesh::obj::write_obj_file(&scene, path)
+        }
+    }
+}
+
+/// All meshes of `face` merged into one in face coordinates, each mesh placed by
+/// `mesh_frames[i]` and, when given, displaced by `displacements[i]` (in its local frame)
+/// first. One `o` span per mesh; uvs / normals only when every mesh has them.
+pub fn merged_mesh(
+    face: &FaceModel,
+    mesh_frames: &[Affine3A],
+    displacements: Option<&[Vec<Vec3>]>,
+) -> Result<Mesh> {
+    let mut out = Mesh {
+        name: face.name.clone(),
+        ..Mesh::default()
+    };
+    let all_uvs = face
+        .meshes
+        .iter()
+        .all(|m| m.mesh.uv_polygons.is_some() && !m.mesh.uvs.is_empty());
+    let all_normals = face
+        .meshes
+        .iter()
+        .all(|m| m.mesh.normal_polygons.is_some() && !m.mesh.normals.is_empty());
+    let mut uv_polys = Polygons::new();
+    let mut normal_polys = Polygons::new();
+    let mut corner = Vec::new();
+    for (mi, fm) in face.meshes.iter().enumerate() {
+        let m = &fm.mesh;
+        let frame = mesh_frames.get(mi).copied().unwrap_or(Affine3A::IDENTITY);
+        let base = u32::try_from(out.positions.len())
+            .map_err(|_| Error::Invalid("too many vertices for one OBJ".into()))?;
+        let uv_base = out.uvs.len() as u32;
+        let n_base = out.normals.len() as u32;
+        out.groups.push(FaceGroup {
+            first_face: out.polygons.len() as u32,
+            object: Some(fm.name.clone()),
+            ..FaceGroup::default()
+        });
+        let disp = displacements.and_then(|d| d.get(mi));
+        for (vi, p) in m.positions.iter().enumerate() {
+            let d = disp.and_then(|d| d.get(vi)).copied().unwrap_or(Vec3::ZERO);
+            out.positions.push(frame.transform_point3(*p + d));
+        }
+        for poly in m.polygons.iter() {
+            corner.clear();
+            corner.extend(poly.iter().map(|&i| i + base));
+            out.polygons.push(&corner);
+        }
+        if all_uvs {
+            out.uvs.extend_from_slice(&m.uvs);
+            if let Some(up) = &m.uv_polygons {
+                for poly in up.iter() {
+                    corner.clear();
+                    corner.extend(poly.iter().map(|&i| i + uv_base));
+                    uv_polys.push(&corner);
+                }
+            }
+        }
+        if all_normals {
+            let nm = glam::Mat3::from(frame.matrix3).inverse().transpose();
+            out.normals.extend(
+                m.normals
+                    .iter()
+                    .map(|n| (nm * *n).try_normalize().unwrap_or(*n)),
+            );
+            if let Some(np) = &m.normal_polygons {
+                for poly in np.iter() {
+                    corner.clear();
+                    corner.extend(poly.iter().map(|&i| i + n_base));
+                    normal_polys.push(&corner);
+                }
+            }
+        }
+    }
+    if all_uvs && !face.meshes.is_empty() {
+        out.uv_polygons = Some(uv_polys);
+    } else {
+        out.uvs.clear();
+    }
+    if all_normals && !face.meshes.is_empty() {
+        out.normal_polygons = Some(normal_polys);
+    } else {
+        out.normals.clear();
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merged_mesh_places_meshes_and_spans() {
+        let face = crate::synth::alma().to_face_model();
+        let frames = face.frames();
+        let m = merged_mesh(&face, &frames.meshes, None).unwrap();
+        assert_eq!(m.vertex_count(), face.vertex_count());
+        assert_eq!(m.groups.len(), face.meshes.len());
+        assert!(m.validate().is_valid());
+        // The second mesh's first vertex sits where the face frame puts it.
+        let off = face.meshes[0].mesh.vertex_count();
+        assert_eq!(m.positions[off], face.vertex_world(&frames, 1, 0).unwrap());
+    }
+
+    #[test]
+    fn writers_round_trip_by_extension() {
+        let dir = tempfile::tempdir().unwrap();
+        let face = crate::synth::alma().to_face_model();
+        for name in ["a.wrl", "a.wrl.gz", "a.wrz"] {
+            let p = dir.path().join(name);
+            write(&p, &face).unwrap();
+            let (back, report) = crate::face::read_with(&p, &Default::default()).unwrap();
+            assert!(report.diagnostics.is_empty(), "{name}");
+            assert!(back == face, "{name}");
+        }
+        // OBJ: geometry only, read → write → read equal.
+        let p = dir.path().join("a.obj");
+        write(&p, &face).unwrap();
+        let (obj, _) = crate::face::read_with(&p, &Default::default()).unwrap();
+        let q = dir.path().join("b.obj");
+        write(&q, &obj).unwrap();
+        let (again, _) = crate::face::read_with(&q, &Default::default()).unwrap();
+        assert_eq!(again.meshes[0].mesh.positions, obj.meshes[0].mesh.positions);
+        assert_eq!(again.meshes[0].mesh.polygons, obj.meshes[0].mesh.polygons);
+        assert_eq!(obj.vertex_count(), face.vertex_count());
+        assert!(write(&dir.path().join("a.txt"), &face).is_err());
+    }
+}
