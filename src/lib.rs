@@ -24,6 +24,9 @@
 //! - [`io`]: bounded reads (plain and gzip) and atomic writes.
 //! - [`format`]: output formats resolved once from a path; refusing to overwrite inputs.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
+//! - [`prelude`]: the names most programs need, in one `use fbakit::prelude::*`.
+//!
+//! `ARCHITECTURE.md` in the repository draws the layers and says where new things go.
 
 pub mod candide;
 pub mod clone;
@@ -39,6 +42,7 @@ pub mod gltf;
 pub mod io;
 pub mod mesh;
 pub mod player;
+pub mod prelude;
 pub mod render;
 pub mod spec;
 pub mod synth;

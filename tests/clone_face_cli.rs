@@ -46,7 +46,7 @@ fn clone_writes_a_face_and_reports() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("must be a face file"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("the cloned face must be .wrl"));
     assert!(!bad.exists());
     let o = fbakit()
         .args(["clone", a.to_str().unwrap(), "head.obj", "-o"])

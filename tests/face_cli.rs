@@ -155,7 +155,7 @@ fn validate_exit_codes() {
     let o = fbakit(&["face", "validate", "samples/speech.fap"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("unknown face file type"),
+        stderr(&o).contains("not a face file fbakit recognises"),
         "{}",
         stderr(&o)
     );

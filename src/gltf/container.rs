@@ -313,6 +313,6 @@ mod tests {
         assert!(parse_glb(&std::fs::read(dir.path().join("a.GLB")).unwrap()).is_ok());
         d.write(&dir.path().join("a.gltf")).unwrap();
         let e = d.write(&dir.path().join("a.obj")).unwrap_err();
-        assert!(e.to_string().contains(".glb or .gltf"), "{e}");
+        assert!(e.to_string().contains("must be .glb, .gltf"), "{e}");
     }
 }

@@ -8,6 +8,7 @@
 //! +y up, +z out of the face towards the viewer (the gaze direction).
 
 mod fap_table;
+mod feature_point_ids;
 mod feature_point_table;
 
 use std::fmt;

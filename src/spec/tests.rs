@@ -239,3 +239,15 @@ fn visemes_and_expressions_lookup() {
     assert_eq!(Expression::basic().count(), 6);
     assert_eq!(Expression::new(7), None);
 }
+
+#[test]
+fn named_feature_point_constants_match_the_table() {
+    let labels: Vec<String> = super::feature_point_ids::NAMED
+        .iter()
+        .map(|id| id.to_string())
+        .collect();
+    let table: Vec<String> = FeaturePointId::all().map(|id| id.to_string()).collect();
+    assert_eq!(labels, table);
+    assert_eq!(FeaturePointId::FP_7_1.to_string(), "7.1");
+    assert_eq!(FeaturePointId::FP_11_6.to_string(), "11.6");
+}

@@ -63,7 +63,7 @@ enum Target {
 /// How one low-level FAP is realised.
 enum Recipe {
     Local {
-        fp: &'static str,
+        fp: FeaturePointId,
         target: Target,
         /// Radius as a multiple of the FAPU distance `of`.
         radius: f64,
@@ -120,16 +120,16 @@ fn recipe(fap: FapId) -> Recipe {
     use Side::{Both, Left, Right};
     match fap.number() {
         3 => Recipe::OpenJaw,
-        4 | 17 => lip("2.2", 0.28, Upper, Both),
-        5 | 16 => lip("2.3", 0.28, Lower, Both),
-        6 | 12 => lip("2.4", 0.28, Any, Left),
-        7 | 13 => lip("2.5", 0.28, Any, Right),
-        8 => lip("2.6", 0.22, Upper, Left),
-        9 => lip("2.7", 0.22, Upper, Right),
-        10 => lip("2.8", 0.22, Lower, Left),
-        11 => lip("2.9", 0.22, Lower, Right),
+        4 | 17 => lip(FeaturePointId::FP_2_2, 0.28, Upper, Both),
+        5 | 16 => lip(FeaturePointId::FP_2_3, 0.28, Lower, Both),
+        6 | 12 => lip(FeaturePointId::FP_2_4, 0.28, Any, Left),
+        7 | 13 => lip(FeaturePointId::FP_2_5, 0.28, Any, Right),
+        8 => lip(FeaturePointId::FP_2_6, 0.22, Upper, Left),
+        9 => lip(FeaturePointId::FP_2_7, 0.22, Upper, Right),
+        10 => lip(FeaturePointId::FP_2_8, 0.22, Lower, Left),
+        11 => lip(FeaturePointId::FP_2_9, 0.22, Lower, Right),
         14 | 15 => Recipe::JawTranslate,
-        18 => lip("2.10", 0.3, Lower, Both),
+        18 => lip(FeaturePointId::FP_2_10, 0.3, Lower, Both),
         19 => Recipe::Lid {
             left: true,
             upper: true,
@@ -152,35 +152,35 @@ fn recipe(fap: FapId) -> Recipe {
         28 => Recipe::EyeThrust { left: false },
         29 => Recipe::Pupil { left: true },
         30 => Recipe::Pupil { left: false },
-        31 | 37 => skin("4.1", 0.25, Es, Left),
-        32 | 38 => skin("4.2", 0.25, Es, Right),
-        33 => skin("4.3", 0.25, Es, Left),
-        34 => skin("4.4", 0.25, Es, Right),
-        35 => skin("4.5", 0.25, Es, Left),
-        36 => skin("4.6", 0.25, Es, Right),
-        39 => skin("5.1", 0.3, Es, Left),
-        40 => skin("5.2", 0.3, Es, Right),
-        41 => skin("5.3", 0.3, Es, Left),
-        42 => skin("5.4", 0.3, Es, Right),
-        43..=45 => tongue("6.1", 0.9),
-        46 => tongue("6.2", 0.8),
+        31 | 37 => skin(FeaturePointId::FP_4_1, 0.25, Es, Left),
+        32 | 38 => skin(FeaturePointId::FP_4_2, 0.25, Es, Right),
+        33 => skin(FeaturePointId::FP_4_3, 0.25, Es, Left),
+        34 => skin(FeaturePointId::FP_4_4, 0.25, Es, Right),
+        35 => skin(FeaturePointId::FP_4_5, 0.25, Es, Left),
+        36 => skin(FeaturePointId::FP_4_6, 0.25, Es, Right),
+        39 => skin(FeaturePointId::FP_5_1, 0.3, Es, Left),
+        40 => skin(FeaturePointId::FP_5_2, 0.3, Es, Right),
+        41 => skin(FeaturePointId::FP_5_3, 0.3, Es, Left),
+        42 => skin(FeaturePointId::FP_5_4, 0.3, Es, Right),
+        43..=45 => tongue(FeaturePointId::FP_6_1, 0.9),
+        46 => tongue(FeaturePointId::FP_6_2, 0.8),
         47 => Recipe::TongueRoll,
         48..=50 => Recipe::Head,
-        51 => lip("8.1", 0.28, Upper, Both),
-        52 => lip("8.2", 0.28, Lower, Both),
-        53 | 59 => lip("8.3", 0.28, Any, Left),
-        54 | 60 => lip("8.4", 0.28, Any, Right),
-        55 => lip("8.5", 0.22, Upper, Left),
-        56 => lip("8.6", 0.22, Upper, Right),
-        57 => lip("8.7", 0.22, Lower, Left),
-        58 => lip("8.8", 0.22, Lower, Right),
-        61 => skin("9.1", 0.2, Ens, Left),
-        62 => skin("9.2", 0.2, Ens, Right),
-        63 | 64 => skin("9.3", 0.3, Ens, Both),
-        65 => skin("10.1", 0.6, Ens, Left),
-        66 => skin("10.2", 0.6, Ens, Right),
-        67 => skin("10.3", 0.6, Ens, Left),
-        68 => skin("10.4", 0.6, Ens, Right),
+        51 => lip(FeaturePointId::FP_8_1, 0.28, Upper, Both),
+        52 => lip(FeaturePointId::FP_8_2, 0.28, Lower, Both),
+        53 | 59 => lip(FeaturePointId::FP_8_3, 0.28, Any, Left),
+        54 | 60 => lip(FeaturePointId::FP_8_4, 0.28, Any, Right),
+        55 => lip(FeaturePointId::FP_8_5, 0.22, Upper, Left),
+        56 => lip(FeaturePointId::FP_8_6, 0.22, Upper, Right),
+        57 => lip(FeaturePointId::FP_8_7, 0.22, Lower, Left),
+        58 => lip(FeaturePointId::FP_8_8, 0.22, Lower, Right),
+        61 => skin(FeaturePointId::FP_9_1, 0.2, Ens, Left),
+        62 => skin(FeaturePointId::FP_9_2, 0.2, Ens, Right),
+        63 | 64 => skin(FeaturePointId::FP_9_3, 0.3, Ens, Both),
+        65 => skin(FeaturePointId::FP_10_1, 0.6, Ens, Left),
+        66 => skin(FeaturePointId::FP_10_2, 0.6, Ens, Right),
+        67 => skin(FeaturePointId::FP_10_3, 0.6, Ens, Left),
+        68 => skin(FeaturePointId::FP_10_4, 0.6, Ens, Right),
         n => unreachable!("FAP {n} is not low-level"),
     }
 }
@@ -227,8 +227,7 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn fp(&self, label: &str) -> DVec3 {
-        let id: FeaturePointId = label.parse().expect("label");
+    fn fp(&self, id: FeaturePointId) -> DVec3 {
         self.face
             .feature_point(id)
             .expect("feature point")
@@ -244,11 +243,11 @@ impl Ctx<'_> {
     /// to 0 at the mouth corners, the jaw line, behind the hinge and down the neck.
     fn jaw_weights(&self) -> Vec<f64> {
         let d = &self.fapu.distances;
-        let slit_y = self.fp("2.2").y;
-        let corner_x = self.fp("2.4").x;
-        let chin = self.fp("2.1");
-        let pivot_y = self.fp("7.1").y;
-        let jaw_x = self.fp("2.13").x;
+        let slit_y = self.fp(FeaturePointId::FP_2_2).y;
+        let corner_x = self.fp(FeaturePointId::FP_2_4).x;
+        let chin = self.fp(FeaturePointId::FP_2_1);
+        let pivot_y = self.fp(FeaturePointId::FP_7_1).y;
+        let jaw_x = self.fp(FeaturePointId::FP_2_13).x;
         let hinge = self.info.jaw_hinge;
         let blend_h = 0.5 * d.mns0;
         self.skin
@@ -400,7 +399,7 @@ impl Ctx<'_> {
                 ));
             }
             Recipe::TongueRoll => {
-                let mid_x = self.fp("6.1").x;
+                let mid_x = self.fp(FeaturePointId::FP_6_1).x;
                 let rates = self
                     .tongue
                     .iter()
@@ -425,7 +424,7 @@ impl Ctx<'_> {
 
     fn open_jaw(&self, t: &mut FaceDefTable) {
         let hinge = self.info.jaw_hinge;
-        let chin = self.fp("2.1") - hinge;
+        let chin = self.fp(FeaturePointId::FP_2_1) - hinge;
         let mns = self.unit(FapuKind::Mns);
         // Angle at which the chin point has dropped by `drop`.
         let angle_for = |drop: f64| -> f64 {
@@ -463,7 +462,7 @@ impl Ctx<'_> {
         // to bisection precision).
         let chin_v = self
             .face
-            .feature_point("2.1".parse().expect("label"))
+            .feature_point(FeaturePointId::FP_2_1)
             .expect("2.1")
             .vertex;
         if let Some(slot) = coord_index.iter().position(|&v| v == chin_v) {

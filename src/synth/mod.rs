@@ -442,18 +442,17 @@ impl SynthFace {
     /// IRISD0 = 3.1.y − 3.3.y, ES0 = 3.5.x − 3.6.x, ENS0 = 3.5.y − 9.15.y,
     /// MNS0 = 9.15.y − 2.2.y, MW0 = 8.3.x − 8.4.x.
     pub fn fapu(&self) -> Fapu {
-        let p = |label: &str| -> glam::DVec3 {
-            let id: FeaturePointId = label.parse().expect("valid label");
+        let p = |id: FeaturePointId| -> glam::DVec3 {
             self.feature_point(id)
                 .map(|f| f.position.as_dvec3())
                 .expect("synthetic faces have every FAPU feature point")
         };
         Fapu::from_distances(FapuDistances {
-            irisd0: p("3.1").y - p("3.3").y,
-            es0: p("3.5").x - p("3.6").x,
-            ens0: p("3.5").y - p("9.15").y,
-            mns0: p("9.15").y - p("2.2").y,
-            mw0: p("8.3").x - p("8.4").x,
+            irisd0: p(FeaturePointId::FP_3_1).y - p(FeaturePointId::FP_3_3).y,
+            es0: p(FeaturePointId::FP_3_5).x - p(FeaturePointId::FP_3_6).x,
+            ens0: p(FeaturePointId::FP_3_5).y - p(FeaturePointId::FP_9_15).y,
+            mns0: p(FeaturePointId::FP_9_15).y - p(FeaturePointId::FP_2_2).y,
+            mw0: p(FeaturePointId::FP_8_3).x - p(FeaturePointId::FP_8_4).x,
         })
         .expect("synthetic FAPU distances are positive")
     }

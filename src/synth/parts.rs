@@ -122,10 +122,6 @@ pub(super) fn signed_volume(positions: &[DVec3], polygons: &[Vec<u32>]) -> f64 {
     v / 6.0
 }
 
-fn fp(s: &str) -> FeaturePointId {
-    s.parse().expect("label")
-}
-
 pub(super) fn build(p: &HeadParams, skin: &Skin) -> Parts {
     use std::f64::consts::{PI, TAU};
     let style = p.polygons;
@@ -137,10 +133,22 @@ pub(super) fn build(p: &HeadParams, skin: &Skin) -> Parts {
     let mut eyes = Vec::new();
     let mut eye_centres = [DVec3::ZERO; 2];
     let mut pupil_ring = Vec::new();
-    for (side, (top, bottom, outer, inner)) in
-        [("3.1", "3.3", "3.7", "3.11"), ("3.2", "3.4", "3.12", "3.8")]
-            .into_iter()
-            .enumerate()
+    for (side, (top, bottom, outer, inner)) in [
+        (
+            FeaturePointId::FP_3_1,
+            FeaturePointId::FP_3_3,
+            FeaturePointId::FP_3_7,
+            FeaturePointId::FP_3_11,
+        ),
+        (
+            FeaturePointId::FP_3_2,
+            FeaturePointId::FP_3_4,
+            FeaturePointId::FP_3_12,
+            FeaturePointId::FP_3_8,
+        ),
+    ]
+    .into_iter()
+    .enumerate()
     {
         let (t, b) = (skin.fp(top), skin.fp(bottom));
         let half_width = (skin.fp(outer).x - skin.fp(inner).x).abs() / 2.0;
@@ -187,7 +195,7 @@ pub(super) fn build(p: &HeadParams, skin: &Skin) -> Parts {
     }
 
     // Teeth: two arches (closed bent slabs) meeting at the slit height, behind the lips.
-    let slit = skin.fp("2.2");
+    let slit = skin.fp(FeaturePointId::FP_2_2);
     let lip_thickness = 0.35 * (p.upper_lip_height + p.lower_lip_height);
     let z_front = slit.z - lip_thickness;
     let arch_w = 0.8 * p.mouth_half_width;
@@ -301,7 +309,7 @@ pub(super) fn build(p: &HeadParams, skin: &Skin) -> Parts {
         center: center.as_vec3(),
     };
     let transforms = vec![
-        tf(names::HEAD_TF, None, skin.fp("7.1")),
+        tf(names::HEAD_TF, None, skin.fp(FeaturePointId::FP_7_1)),
         tf(names::EYE_L_TF, Some(0), eye_centres[0]),
         tf(names::EYE_R_TF, Some(0), eye_centres[1]),
         tf(
@@ -326,16 +334,16 @@ pub(super) fn build(p: &HeadParams, skin: &Skin) -> Parts {
         tongue.into_mesh(names::TONGUE, 4, [0.80, 0.36, 0.40]),
     ];
     let feature_points = vec![
-        (fp("3.5"), 1, 0),
-        (fp("3.6"), 2, 0),
-        (fp("9.8"), 3, mid + 1),
-        (fp("9.10"), 3, mid),
-        (fp("9.9"), 4, mid),
-        (fp("9.11"), 4, mid + 1),
-        (fp("6.1"), 5, 0),
-        (fp("6.2"), 5, tongue_at(t_seg / 4)),
-        (fp("6.3"), 5, tongue_at(0)),
-        (fp("6.4"), 5, tongue_at(t_seg / 2)),
+        (FeaturePointId::FP_3_5, 1, 0),
+        (FeaturePointId::FP_3_6, 2, 0),
+        (FeaturePointId::FP_9_8, 3, mid + 1),
+        (FeaturePointId::FP_9_10, 3, mid),
+        (FeaturePointId::FP_9_9, 4, mid),
+        (FeaturePointId::FP_9_11, 4, mid + 1),
+        (FeaturePointId::FP_6_1, 5, 0),
+        (FeaturePointId::FP_6_2, 5, tongue_at(t_seg / 4)),
+        (FeaturePointId::FP_6_3, 5, tongue_at(0)),
+        (FeaturePointId::FP_6_4, 5, tongue_at(t_seg / 2)),
     ];
     Parts {
         transforms,

@@ -37,14 +37,13 @@ pub(super) struct Skin {
 
 impl Skin {
     /// Position of a skin feature point.
-    pub fn fp(&self, label: &str) -> DVec3 {
-        let id: FeaturePointId = label.parse().expect("label");
+    pub fn fp(&self, id: FeaturePointId) -> DVec3 {
         let v = self
             .feature_points
             .iter()
             .find(|(f, _)| *f == id)
             .map(|(_, v)| *v)
-            .unwrap_or_else(|| panic!("skin has no feature point {label}"));
+            .unwrap_or_else(|| panic!("skin has no feature point {id}"));
         self.positions[v as usize]
     }
 }
@@ -491,8 +490,8 @@ enum Lip {
 
 /// (left/midline label, mirror label, plane, half, lip side, target in the plane).
 type Landmark = (
-    &'static str,
-    Option<&'static str>,
+    FeaturePointId,
+    Option<FeaturePointId>,
     Plane,
     Half,
     Lip,
@@ -500,33 +499,72 @@ type Landmark = (
 );
 
 fn place_feature_points(skin: &mut Skin, p: &HeadParams, g: &GridLandmarks) {
-    let fp = |s: &str| -> FeaturePointId { s.parse().expect("label") };
     let mut used: HashSet<u32> = HashSet::new();
     let mut out: Vec<(FeaturePointId, u32)> = Vec::new();
     // Fixed left/midline points; right ones are mirrors.
-    let fixed: [(&str, u32, Option<&str>); 14] = [
-        ("7.1", g.bottom_pole, None),
-        ("11.4", g.top_pole, None),
-        ("3.1", g.lid_top, Some("3.2")),
-        ("3.3", g.lid_bottom, Some("3.4")),
-        ("3.13", g.lid_top_outer, Some("3.14")),
-        ("3.9", g.lid_bottom_outer, Some("3.10")),
-        ("3.7", g.eye_outer, Some("3.12")),
-        ("3.11", g.eye_inner, Some("3.8")),
-        ("2.2", g.slit_mid_upper, None),
-        ("2.3", g.slit_mid_lower, None),
-        ("2.6", g.slit_half_upper, Some("2.7")),
-        ("2.8", g.slit_half_lower, Some("2.9")),
-        ("2.4", g.corner, Some("2.5")),
-        ("8.3", g.corner_outer, Some("8.4")),
+    let fixed: [(FeaturePointId, u32, Option<FeaturePointId>); 14] = [
+        (FeaturePointId::FP_7_1, g.bottom_pole, None),
+        (FeaturePointId::FP_11_4, g.top_pole, None),
+        (
+            FeaturePointId::FP_3_1,
+            g.lid_top,
+            Some(FeaturePointId::FP_3_2),
+        ),
+        (
+            FeaturePointId::FP_3_3,
+            g.lid_bottom,
+            Some(FeaturePointId::FP_3_4),
+        ),
+        (
+            FeaturePointId::FP_3_13,
+            g.lid_top_outer,
+            Some(FeaturePointId::FP_3_14),
+        ),
+        (
+            FeaturePointId::FP_3_9,
+            g.lid_bottom_outer,
+            Some(FeaturePointId::FP_3_10),
+        ),
+        (
+            FeaturePointId::FP_3_7,
+            g.eye_outer,
+            Some(FeaturePointId::FP_3_12),
+        ),
+        (
+            FeaturePointId::FP_3_11,
+            g.eye_inner,
+            Some(FeaturePointId::FP_3_8),
+        ),
+        (FeaturePointId::FP_2_2, g.slit_mid_upper, None),
+        (FeaturePointId::FP_2_3, g.slit_mid_lower, None),
+        (
+            FeaturePointId::FP_2_6,
+            g.slit_half_upper,
+            Some(FeaturePointId::FP_2_7),
+        ),
+        (
+            FeaturePointId::FP_2_8,
+            g.slit_half_lower,
+            Some(FeaturePointId::FP_2_9),
+        ),
+        (
+            FeaturePointId::FP_2_4,
+            g.corner,
+            Some(FeaturePointId::FP_2_5),
+        ),
+        (
+            FeaturePointId::FP_8_3,
+            g.corner_outer,
+            Some(FeaturePointId::FP_8_4),
+        ),
     ];
     for (l, v, r) in fixed {
         used.insert(v);
-        out.push((fp(l), v));
+        out.push((l, v));
         if let Some(r) = r {
             let mv = skin.mirror[v as usize];
             used.insert(mv);
-            out.push((fp(r), mv));
+            out.push((r, mv));
         }
     }
     // Nose tip: the most protruding midline vertex between the nose base and the eyes.
@@ -542,7 +580,7 @@ fn place_feature_points(skin: &mut Skin, p: &HeadParams, g: &GridLandmarks) {
         })
         .expect("nose");
     used.insert(tip);
-    out.push((fp("9.3"), tip));
+    out.push((FeaturePointId::FP_9_3, tip));
 
     let xe = p.eye_separation / 2.0;
     let (ea, my, mw) = (p.eye_half_width, p.mouth_y, p.mouth_half_width);
@@ -553,33 +591,33 @@ fn place_feature_points(skin: &mut Skin, p: &HeadParams, g: &GridLandmarks) {
     // (left/midline label, mirror label, plane, half, lip side, target in the plane)
     #[rustfmt::skip]
     let searched: Vec<Landmark> = vec![
-        ("9.15", None, Plane::Front, Half::Midline, Lip::Any, [0.0, ny]),
-        ("2.1", None, Plane::Front, Half::Midline, Lip::Lower, [0.0, p.chin_y]),
-        ("2.10", None, Plane::Front, Half::Midline, Lip::Lower, [0.0, p.chin_y + 13.0]),
-        ("8.1", None, Plane::Front, Half::Midline, Lip::Upper, [0.0, my + p.upper_lip_height]),
-        ("8.2", None, Plane::Front, Half::Midline, Lip::Lower, [0.0, my - p.lower_lip_height]),
-        ("9.12", None, Plane::Front, Half::Midline, Lip::Any, [0.0, bridge_y]),
-        ("11.1", None, Plane::Front, Half::Midline, Lip::Any, [0.0, p.hairline_y]),
-        ("2.11", Some("2.12"), Plane::Front, Half::Left, Lip::Lower, [13.0, p.chin_y + 6.0]),
-        ("2.13", Some("2.14"), Plane::Side, Half::Left, Lip::Lower, [my - 14.0, ez + ed + 16.0]),
-        ("4.1", Some("4.2"), Plane::Front, Half::Left, Lip::Any, [xe - 0.75 * ea, brow - 1.0]),
-        ("4.3", Some("4.4"), Plane::Front, Half::Left, Lip::Any, [xe + 0.1 * ea, brow + 1.5]),
-        ("4.5", Some("4.6"), Plane::Front, Half::Left, Lip::Any, [xe + 1.15 * ea, brow - 2.0]),
-        ("5.1", Some("5.2"), Plane::Front, Half::Left, Lip::Any, [xe + 3.0, 0.5 * (ny + my) + 2.0]),
-        ("5.3", Some("5.4"), Plane::Front, Half::Left, Lip::Any, [xe + 10.0, p.eye_y - 15.0]),
-        ("8.5", Some("8.6"), Plane::Front, Half::Left, Lip::Upper, [0.5 * mw, my + 0.75 * p.upper_lip_height]),
-        ("8.7", Some("8.8"), Plane::Front, Half::Left, Lip::Lower, [0.5 * mw, my - 0.75 * p.lower_lip_height]),
-        ("8.10", Some("8.9"), Plane::Front, Half::Left, Lip::Upper, [0.2 * mw, my + p.upper_lip_height + 0.8]),
-        ("9.1", Some("9.2"), Plane::Front, Half::Left, Lip::Any, [p.nose_half_width, ny + 3.0]),
-        ("9.5", Some("9.4"), Plane::Front, Half::Left, Lip::Any, [0.5 * p.nose_half_width, ny + 0.5]),
-        ("9.7", Some("9.6"), Plane::Front, Half::Left, Lip::Any, [6.0, p.eye_y - 5.0]),
-        ("9.13", Some("9.14"), Plane::Front, Half::Left, Lip::Any, [7.0, bridge_y]),
-        ("11.3", Some("11.2"), Plane::Front, Half::Left, Lip::Any, [xe + ea + 12.0, p.hairline_y - 22.0]),
-        ("10.1", Some("10.2"), Plane::Side, Half::Left, Lip::Any, [ey + 0.85 * eh, ez]),
-        ("10.3", Some("10.4"), Plane::Side, Half::Left, Lip::Any, [ey + 0.1 * eh, ez - 0.85 * ed]),
-        ("10.5", Some("10.6"), Plane::Side, Half::Left, Lip::Any, [ey - 0.9 * eh, ez]),
-        ("10.7", Some("10.8"), Plane::Side, Half::Left, Lip::Any, [ey - 0.7 * eh, ez + 0.8 * ed]),
-        ("10.9", Some("10.10"), Plane::Side, Half::Left, Lip::Any, [ey + 0.7 * eh, ez + 0.8 * ed]),
+        (FeaturePointId::FP_9_15, None, Plane::Front, Half::Midline, Lip::Any, [0.0, ny]),
+        (FeaturePointId::FP_2_1, None, Plane::Front, Half::Midline, Lip::Lower, [0.0, p.chin_y]),
+        (FeaturePointId::FP_2_10, None, Plane::Front, Half::Midline, Lip::Lower, [0.0, p.chin_y + 13.0]),
+        (FeaturePointId::FP_8_1, None, Plane::Front, Half::Midline, Lip::Upper, [0.0, my + p.upper_lip_height]),
+        (FeaturePointId::FP_8_2, None, Plane::Front, Half::Midline, Lip::Lower, [0.0, my - p.lower_lip_height]),
+        (FeaturePointId::FP_9_12, None, Plane::Front, Half::Midline, Lip::Any, [0.0, bridge_y]),
+        (FeaturePointId::FP_11_1, None, Plane::Front, Half::Midline, Lip::Any, [0.0, p.hairline_y]),
+        (FeaturePointId::FP_2_11, Some(FeaturePointId::FP_2_12), Plane::Front, Half::Left, Lip::Lower, [13.0, p.chin_y + 6.0]),
+        (FeaturePointId::FP_2_13, Some(FeaturePointId::FP_2_14), Plane::Side, Half::Left, Lip::Lower, [my - 14.0, ez + ed + 16.0]),
+        (FeaturePointId::FP_4_1, Some(FeaturePointId::FP_4_2), Plane::Front, Half::Left, Lip::Any, [xe - 0.75 * ea, brow - 1.0]),
+        (FeaturePointId::FP_4_3, Some(FeaturePointId::FP_4_4), Plane::Front, Half::Left, Lip::Any, [xe + 0.1 * ea, brow + 1.5]),
+        (FeaturePointId::FP_4_5, Some(FeaturePointId::FP_4_6), Plane::Front, Half::Left, Lip::Any, [xe + 1.15 * ea, brow - 2.0]),
+        (FeaturePointId::FP_5_1, Some(FeaturePointId::FP_5_2), Plane::Front, Half::Left, Lip::Any, [xe + 3.0, 0.5 * (ny + my) + 2.0]),
+        (FeaturePointId::FP_5_3, Some(FeaturePointId::FP_5_4), Plane::Front, Half::Left, Lip::Any, [xe + 10.0, p.eye_y - 15.0]),
+        (FeaturePointId::FP_8_5, Some(FeaturePointId::FP_8_6), Plane::Front, Half::Left, Lip::Upper, [0.5 * mw, my + 0.75 * p.upper_lip_height]),
+        (FeaturePointId::FP_8_7, Some(FeaturePointId::FP_8_8), Plane::Front, Half::Left, Lip::Lower, [0.5 * mw, my - 0.75 * p.lower_lip_height]),
+        (FeaturePointId::FP_8_10, Some(FeaturePointId::FP_8_9), Plane::Front, Half::Left, Lip::Upper, [0.2 * mw, my + p.upper_lip_height + 0.8]),
+        (FeaturePointId::FP_9_1, Some(FeaturePointId::FP_9_2), Plane::Front, Half::Left, Lip::Any, [p.nose_half_width, ny + 3.0]),
+        (FeaturePointId::FP_9_5, Some(FeaturePointId::FP_9_4), Plane::Front, Half::Left, Lip::Any, [0.5 * p.nose_half_width, ny + 0.5]),
+        (FeaturePointId::FP_9_7, Some(FeaturePointId::FP_9_6), Plane::Front, Half::Left, Lip::Any, [6.0, p.eye_y - 5.0]),
+        (FeaturePointId::FP_9_13, Some(FeaturePointId::FP_9_14), Plane::Front, Half::Left, Lip::Any, [7.0, bridge_y]),
+        (FeaturePointId::FP_11_3, Some(FeaturePointId::FP_11_2), Plane::Front, Half::Left, Lip::Any, [xe + ea + 12.0, p.hairline_y - 22.0]),
+        (FeaturePointId::FP_10_1, Some(FeaturePointId::FP_10_2), Plane::Side, Half::Left, Lip::Any, [ey + 0.85 * eh, ez]),
+        (FeaturePointId::FP_10_3, Some(FeaturePointId::FP_10_4), Plane::Side, Half::Left, Lip::Any, [ey + 0.1 * eh, ez - 0.85 * ed]),
+        (FeaturePointId::FP_10_5, Some(FeaturePointId::FP_10_6), Plane::Side, Half::Left, Lip::Any, [ey - 0.9 * eh, ez]),
+        (FeaturePointId::FP_10_7, Some(FeaturePointId::FP_10_8), Plane::Side, Half::Left, Lip::Any, [ey - 0.7 * eh, ez + 0.8 * ed]),
+        (FeaturePointId::FP_10_9, Some(FeaturePointId::FP_10_10), Plane::Side, Half::Left, Lip::Any, [ey + 0.7 * eh, ez + 0.8 * ed]),
     ];
     let side_x = 0.5 * p.head_half_width;
     for (label, mirror_label, plane, half, lip, target) in searched {
@@ -615,11 +653,11 @@ fn place_feature_points(skin: &mut Skin, p: &HeadParams, g: &GridLandmarks) {
             })
             .unwrap_or_else(|| panic!("no skin vertex for feature point {label}"));
         used.insert(best);
-        out.push((fp(label), best));
+        out.push((label, best));
         if let Some(r) = mirror_label {
             let mv = skin.mirror[best as usize];
             used.insert(mv);
-            out.push((fp(r), mv));
+            out.push((r, mv));
         }
     }
     // 11.6: back of the skull, on the back midline at eye height.
@@ -633,7 +671,7 @@ fn place_feature_points(skin: &mut Skin, p: &HeadParams, g: &GridLandmarks) {
             d(a).total_cmp(&d(b))
         })
         .expect("back of the head");
-    out.push((fp("11.6"), back));
+    out.push((FeaturePointId::FP_11_6, back));
     out.sort_by_key(|(id, _)| id.ordinal());
     skin.feature_points = out;
 }

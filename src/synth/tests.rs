@@ -31,8 +31,8 @@ fn slit_copies_are_lower_and_coincide_with_the_upper_lip() {
         assert_eq!(s.positions[vu as usize], s.positions[vl as usize]);
     }
     // Corners are shared (upper side) and lie on the slit height.
-    let corner = s.fp("2.4");
-    assert!((corner.y - s.fp("2.2").y).abs() < 1e-9);
+    let corner = s.fp(FeaturePointId::FP_2_4);
+    assert!((corner.y - s.fp(FeaturePointId::FP_2_2).y).abs() < 1e-9);
 }
 
 #[test]

@@ -22,7 +22,12 @@ pub(crate) enum LipRegion {
 const ON_LINE: f64 = 1e-6;
 
 /// Inner-lip contour points whose absence only coarsens the polygons.
-pub(crate) const OPTIONAL: [&str; 4] = ["2.6", "2.7", "2.8", "2.9"];
+pub(crate) const OPTIONAL: [FeaturePointId; 4] = [
+    FeaturePointId::FP_2_6,
+    FeaturePointId::FP_2_7,
+    FeaturePointId::FP_2_8,
+    FeaturePointId::FP_2_9,
+];
 
 /// The two lip polygons of one face.
 #[derive(Clone, Debug)]
@@ -39,13 +44,10 @@ impl LipPolygons {
     /// corners and bottom (2.11, 2.1, 2.12). Extending the line to the outer corners keeps
     /// the lip corners' flesh apart too; both polygons share the line.
     pub fn new(fps: &BTreeMap<FeaturePointId, DVec2>) -> LipPolygons {
-        let get = |ids: &[&str]| -> Vec<DVec2> {
-            ids.iter()
-                .filter_map(|s| fps.get(&s.parse::<FeaturePointId>().expect("label")))
-                .copied()
-                .collect()
+        let get = |ids: &[FeaturePointId]| -> Vec<DVec2> {
+            ids.iter().filter_map(|id| fps.get(id)).copied().collect()
         };
-        let polygon = |line: &[&str], cap: &[&str]| {
+        let polygon = |line: &[FeaturePointId], cap: &[FeaturePointId]| {
             let mut l = get(line);
             l.sort_by(|a, b| a.x.total_cmp(&b.x));
             let mut c = get(cap);
@@ -55,12 +57,36 @@ impl LipPolygons {
         };
         LipPolygons {
             upper: polygon(
-                &["8.4", "2.5", "2.7", "2.2", "2.6", "2.4", "8.3"],
-                &["9.1", "9.15", "9.2"],
+                &[
+                    FeaturePointId::FP_8_4,
+                    FeaturePointId::FP_2_5,
+                    FeaturePointId::FP_2_7,
+                    FeaturePointId::FP_2_2,
+                    FeaturePointId::FP_2_6,
+                    FeaturePointId::FP_2_4,
+                    FeaturePointId::FP_8_3,
+                ],
+                &[
+                    FeaturePointId::FP_9_1,
+                    FeaturePointId::FP_9_15,
+                    FeaturePointId::FP_9_2,
+                ],
             ),
             lower: polygon(
-                &["8.4", "2.5", "2.9", "2.3", "2.8", "2.4", "8.3"],
-                &["2.11", "2.1", "2.12"],
+                &[
+                    FeaturePointId::FP_8_4,
+                    FeaturePointId::FP_2_5,
+                    FeaturePointId::FP_2_9,
+                    FeaturePointId::FP_2_3,
+                    FeaturePointId::FP_2_8,
+                    FeaturePointId::FP_2_4,
+                    FeaturePointId::FP_8_3,
+                ],
+                &[
+                    FeaturePointId::FP_2_11,
+                    FeaturePointId::FP_2_1,
+                    FeaturePointId::FP_2_12,
+                ],
             ),
         }
     }

@@ -179,10 +179,7 @@ pub fn required_feature_points() -> Vec<FeaturePointId> {
 
 /// Feature points whose absence only degrades the result (a warning).
 pub fn optional_feature_points() -> Vec<FeaturePointId> {
-    lips::OPTIONAL
-        .iter()
-        .map(|s| s.parse().expect("valid label"))
-        .collect()
+    lips::OPTIONAL.to_vec()
 }
 
 fn check_surface(surface: &CloneSurface, name: &str) -> Result<()> {

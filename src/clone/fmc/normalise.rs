@@ -83,13 +83,8 @@ pub(crate) fn normalise(surface: &CloneSurface, mode: NormalisationMode) -> Norm
         .iter()
         .map(|(&id, p)| (id, p.as_dvec3()))
         .collect();
-    let pupil = |id: &str| {
-        surface
-            .fp(id.parse().expect("valid label"))
-            .unwrap_or(Vec3::ZERO)
-            .as_dvec3()
-    };
-    let centre = (pupil("3.5") + pupil("3.6")) * 0.5;
+    let pupil = |id: FeaturePointId| surface.fp(id).unwrap_or(Vec3::ZERO).as_dvec3();
+    let centre = (pupil(FeaturePointId::FP_3_5) + pupil(FeaturePointId::FP_3_6)) * 0.5;
     // A feature-point vertex belongs to its own point even where points coincide.
     let mut own: BTreeMap<u32, FeaturePointId> = BTreeMap::new();
     for (&id, &v) in &surface.fp_vertices {

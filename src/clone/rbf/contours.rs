@@ -23,8 +23,7 @@ pub(crate) struct Contours {
     pub lower_lip: Option<Vec<u32>>,
 }
 
-fn fp_vertex(surface: &CloneSurface, label: &str) -> Option<u32> {
-    let id: FeaturePointId = label.parse().ok()?;
+fn fp_vertex(surface: &CloneSurface, id: FeaturePointId) -> Option<u32> {
     surface.fp_vertices.get(&id).copied()
 }
 
@@ -37,12 +36,12 @@ pub(crate) fn extract(
     warnings: &mut Vec<String>,
 ) -> Contours {
     let pos = &surface.positions;
-    let mut eye = |labels: [&str; 4], name: &str| -> Option<Vec<u32>> {
-        let fps: Option<Vec<u32>> = labels.iter().map(|l| fp_vertex(surface, l)).collect();
+    let mut eye = |labels: [FeaturePointId; 4], name: &str| -> Option<Vec<u32>> {
+        let fps: Option<Vec<u32>> = labels.iter().map(|&l| fp_vertex(surface, l)).collect();
         let Some(fps) = fps else {
             warnings.push(format!(
                 "{face}: {name} contour skipped: feature points {} are not all surface vertices",
-                labels.join(", ")
+                labels.map(|l| l.to_string()).join(", ")
             ));
             return None;
         };
@@ -54,10 +53,29 @@ pub(crate) fn extract(
             }
         }
     };
-    let right_eye = eye(["3.2", "3.8", "3.4", "3.12"], "right eye");
-    let left_eye = eye(["3.1", "3.7", "3.3", "3.11"], "left eye");
+    let right_eye = eye(
+        [
+            FeaturePointId::FP_3_2,
+            FeaturePointId::FP_3_8,
+            FeaturePointId::FP_3_4,
+            FeaturePointId::FP_3_12,
+        ],
+        "right eye",
+    );
+    let left_eye = eye(
+        [
+            FeaturePointId::FP_3_1,
+            FeaturePointId::FP_3_7,
+            FeaturePointId::FP_3_3,
+            FeaturePointId::FP_3_11,
+        ],
+        "left eye",
+    );
     let (mut upper_lip, mut lower_lip) = (None, None);
-    match (fp_vertex(surface, "2.5"), fp_vertex(surface, "2.4")) {
+    match (
+        fp_vertex(surface, FeaturePointId::FP_2_5),
+        fp_vertex(surface, FeaturePointId::FP_2_4),
+    ) {
         (Some(s), Some(e)) => {
             for (upper, slot) in [(true, &mut upper_lip), (false, &mut lower_lip)] {
                 match lip_walk(pos, adj, (incidence, &surface.triangles), s, e, upper) {
