@@ -19,6 +19,7 @@
 //!   cloning grid.
 //! - [`showcase`]: rendered playback frames, contact sheets, the cloning grid and the
 //!   end-to-end demo (`fbakit demo`).
+//! - [`export`]: outputs for people to look at: the one-file HTML viewer (`fbakit view`).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -26,6 +27,7 @@
 pub mod candide;
 pub mod clone;
 pub mod error;
+pub mod export;
 pub mod face;
 pub mod fap;
 pub mod fat;
