@@ -125,6 +125,9 @@ pub struct CameraFrame {
     pub target: [f32; 3],
     /// Radius.
     pub radius: f32,
+    /// Half the size of the box around the same points along x, y, z (the camera fits the
+    /// x-y rectangle to the view, in front of the box).
+    pub half_extent: [f32; 3],
 }
 
 /// A feature point in the overlay.
@@ -528,7 +531,7 @@ fn fap_groups(face: &FaceModel, tracks: &[KeyTrack]) -> Vec<FapGroup> {
                 1,
                 KeyControl {
                     key: key.name(),
-                    label: format!("expression {} ({})", e.number(), e.name()),
+                    label: e.name().to_string(),
                     fapu: None,
                     min: 0.0,
                     max: HIGH_LEVEL_FULL.max(seen.ceil()),
@@ -573,6 +576,7 @@ fn camera_frame(face: &FaceModel) -> CameraFrame {
         return CameraFrame {
             target: [0.0; 3],
             radius: 1.0,
+            half_extent: [1.0; 3],
         };
     };
     let (lo, hi) = points
@@ -582,6 +586,7 @@ fn camera_frame(face: &FaceModel) -> CameraFrame {
     CameraFrame {
         target: ((lo + hi) * 0.5).to_array(),
         radius,
+        half_extent: ((hi - lo) * 0.5).max(Vec3::splat(radius * 0.01)).to_array(),
     }
 }
 

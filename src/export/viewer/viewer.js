@@ -49,7 +49,9 @@
   function frameFace() {
     const vfov = T.MathUtils.degToRad(camera.fov);
     const hfov = 2 * Math.atan(Math.tan(vfov / 2) * camera.aspect);
-    const dist = (radius * 1.08) / Math.sin(Math.min(vfov, hfov) / 2);
+    const [ex, ey, ez] = model.camera.half_extent;
+    // Fit the face's x-y rectangle with a margin, from in front of its depth.
+    const dist = 1.12 * Math.max(ey / Math.tan(vfov / 2), ex / Math.tan(hfov / 2)) + ez;
     camera.position.set(target.x, target.y, target.z + dist);
     camera.near = dist / 100;
     camera.far = dist * 20;
@@ -263,6 +265,7 @@
     const tt = Math.max(0, Math.min(t, Math.max(duration - 1e-4, 0)));
     action.time = tt;
     mixer.update(0);
+    invalidate();
   }
 
   function enterAnimation() {
@@ -281,6 +284,7 @@
   function pause() {
     playing = false;
     updatePlayButton();
+    invalidate();
   }
 
   function seek(t) {
@@ -299,6 +303,7 @@
     showValue(name, v);
     applyPose();
     updatePlayButton();
+    invalidate();
   }
 
   function neutral() {
@@ -310,6 +315,7 @@
     }
     applyPose();
     updatePlayButton();
+    invalidate();
   }
 
   /** Sliders (and `values`) show the stream at the current time. */
@@ -457,18 +463,27 @@
     renderer.render(scene, camera);
   }
 
+  // Frames are drawn only when something changed (playing, camera moving, a pose or display
+  // change), so a paused page leaves the CPU alone.
+  let dirty = true;
+  function invalidate() {
+    dirty = true;
+  }
+
   function tick(now) {
     const dt = Math.min((now - lastTick) / 1000, 0.25);
     lastTick = now;
-    if (mixer && mode === 'animation') {
-      if (playing) {
-        mixer.update(dt * speed);
-        syncFromStream();
-      }
-      updateTransport();
+    if (mixer && mode === 'animation' && playing) {
+      mixer.update(dt * speed);
+      syncFromStream();
+      dirty = true;
     }
-    controls.update();
-    renderNow();
+    if (controls.update()) dirty = true;
+    if (dirty) {
+      if (mixer && mode === 'animation') updateTransport();
+      renderNow();
+      dirty = false;
+    }
     requestAnimationFrame(tick);
   }
 
@@ -485,12 +500,18 @@
         if (!o.isMesh) return;
         for (const m of Array.isArray(o.material) ? o.material : [o.material]) m.wireframe = e.target.checked;
       });
+      invalidate();
     });
     $('toggle-points').addEventListener('change', (e) => {
       if (fpPoints) fpPoints.visible = e.target.checked;
       if (!e.target.checked) $('hover-note').textContent = '';
+      invalidate();
     });
-    $('reset-camera').addEventListener('click', frameFace);
+    $('reset-camera').addEventListener('click', () => {
+      frameFace();
+      invalidate();
+    });
+    controls.addEventListener('change', invalidate);
     $('reset-pose').addEventListener('click', neutral);
     window.addEventListener('keydown', (e) => {
       if (e.code !== 'Space' || !action) return;
@@ -501,7 +522,7 @@
     });
     new ResizeObserver(() => {
       resize();
-      renderNow();
+      invalidate();
     }).observe(stage);
   }
 
