@@ -28,12 +28,12 @@
 
   const scene = new T.Scene();
   const camera = new T.PerspectiveCamera(28, 1, 0.01, 1000);
-  scene.add(new T.HemisphereLight(0xf4f1ee, 0x3a3f4a, 1.6));
-  const key = new T.DirectionalLight(0xffffff, 2.2);
-  key.position.set(-0.6, 0.7, 1.0);
-  const fill = new T.DirectionalLight(0xdfe8ff, 0.7);
+  scene.add(new T.HemisphereLight(0xf4f1ee, 0x2a2e36, 0.9));
+  const key = new T.DirectionalLight(0xfff6ec, 2.8);
+  key.position.set(-0.7, 0.8, 1.0);
+  const fill = new T.DirectionalLight(0xdfe8ff, 0.45);
   fill.position.set(0.8, 0.1, 0.6);
-  const rim = new T.DirectionalLight(0xffffff, 0.6);
+  const rim = new T.DirectionalLight(0xffffff, 0.9);
   rim.position.set(0.0, 0.8, -1.0);
   // Lights follow the camera so the face stays lit from the viewer's side while orbiting.
   camera.add(key, fill, rim);
@@ -52,7 +52,14 @@
     const [ex, ey, ez] = model.camera.half_extent;
     // Fit the face's x-y rectangle with a margin, from in front of its depth.
     const dist = 1.12 * Math.max(ey / Math.tan(vfov / 2), ex / Math.tan(hfov / 2)) + ez;
-    camera.position.set(target.x, target.y, target.z + dist);
+    // A little from the side and above, so the face reads as 3D from the first frame.
+    const yaw = T.MathUtils.degToRad(14);
+    const pitch = T.MathUtils.degToRad(5);
+    camera.position.set(
+      target.x + dist * Math.sin(yaw) * Math.cos(pitch),
+      target.y + dist * Math.sin(pitch),
+      target.z + dist * Math.cos(yaw) * Math.cos(pitch),
+    );
     camera.near = dist / 100;
     camera.far = dist * 20;
     camera.updateProjectionMatrix();
