@@ -65,7 +65,9 @@ fn writes_a_page_and_reports_it() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("viewer page"), "{text}");
     assert!(
-        text.contains("plays 75 frames of `samples/speech.fap` on `alma` at 25 fps (2.960 s), looping"),
+        text.contains(
+            "plays 75 frames of `samples/speech.fap` on `alma` at 25 fps (2.960 s), looping"
+        ),
         "{text}"
     );
 }
@@ -77,7 +79,11 @@ fn refuses_bad_usage_and_writes_nothing() {
         (&["bruno"], "face.wrl", "writes an .html page"),
         (&["missing-face.wrl"], "a.html", "missing-face.wrl"),
         (&["alma", "--fps", "30"], "b.html", "need a STREAM"),
-        (&["alma", "no-such-stream.fap"], "c.html", "no-such-stream.fap"),
+        (
+            &["alma", "no-such-stream.fap"],
+            "c.html",
+            "no-such-stream.fap",
+        ),
     ];
     for (args, out, message) in cases {
         let target = dir.path().join(out);

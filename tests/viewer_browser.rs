@@ -30,7 +30,8 @@ fn check_page(page: &Path) -> Option<Value> {
         None
     };
     let mut cmd = Command::new("node");
-    cmd.arg(root().join("tests/support/viewer-check.mjs")).arg(page);
+    cmd.arg(root().join("tests/support/viewer-check.mjs"))
+        .arg(page);
     if std::env::var_os("VIEWER_BROWSER_DIR").is_none() {
         let local = root().join("target/viewer-browser");
         if local.is_dir() {
@@ -58,13 +59,20 @@ fn f(v: &Value) -> f64 {
 fn assert_clean(r: &Value) {
     assert_eq!(r["consoleErrors"], Value::Array(vec![]), "console errors");
     assert_eq!(r["pageErrors"], Value::Array(vec![]), "page errors");
-    assert_eq!(r["foreignRequests"], Value::Array(vec![]), "requests left the file");
+    assert_eq!(
+        r["foreignRequests"],
+        Value::Array(vec![]),
+        "requests left the file"
+    );
 }
 
 fn assert_slider_moves_the_mouth(r: &Value) {
     assert_eq!(r["slider"]["key"], "open_jaw");
     let c = &r["sliderChange"];
-    assert!(f(&c["opaqueFraction"]) > 0.5, "mouth region is not on the face: {c}");
+    assert!(
+        f(&c["opaqueFraction"]) > 0.5,
+        "mouth region is not on the face: {c}"
+    );
     assert!(
         f(&c["changedFraction"]) > 0.01 && f(&c["meanAbsDiff"]) > 0.5,
         "moving open_jaw did not change the mouth: {c}"
@@ -72,7 +80,10 @@ fn assert_slider_moves_the_mouth(r: &Value) {
     assert_eq!(r["stateAfterSlider"]["mode"], "pose");
     assert_eq!(r["stateAfterSlider"]["playing"], false);
     let shown = r["sliderOutput"].as_str().unwrap();
-    assert!(shown.starts_with("1024") && shown.ends_with("MNS"), "{shown}");
+    assert!(
+        shown.starts_with("1024") && shown.ends_with("MNS"),
+        "{shown}"
+    );
 }
 
 #[test]
@@ -111,7 +122,10 @@ fn speech_page_plays_and_poses_in_chromium() {
     let picked = f(&r["pickedFrame"]["time"]);
     assert!(picked > 0.0);
     let c = &r["timeChange"];
-    assert!(f(&c["opaqueFraction"]) > 0.5, "mouth region is not on the face: {c}");
+    assert!(
+        f(&c["opaqueFraction"]) > 0.5,
+        "mouth region is not on the face: {c}"
+    );
     assert!(
         f(&c["changedFraction"]) > 0.01 && f(&c["meanAbsDiff"]) > 0.5,
         "the mouth did not change between t=0 and t={picked}: {c}"
@@ -131,7 +145,11 @@ fn neutral_page_from_the_cli_poses_in_chromium() {
         .arg(&page)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 
     let Some(r) = check_page(&page) else { return };
     assert_clean(&r);

@@ -106,9 +106,10 @@ pub fn run(a: ViewArgs) -> Result<u8> {
                 .into_iter()
                 .map(|(k, n)| format!("{k} in {n} frames"))
                 .collect();
-            let name = path
-                .file_name()
-                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into());
+            let name = path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into(),
+            );
             Some((player.animation()?, player.fps(), name))
         }
         None => None,

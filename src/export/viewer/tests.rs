@@ -161,8 +161,8 @@ fn sliders_cover_every_key_with_a_table() {
 
 #[test]
 fn open_jaw_slider_is_in_mns_and_covers_its_table() {
-    let model = ViewerModel::new(alma(), &export_face(alma(), None).unwrap().document, None)
-        .unwrap();
+    let model =
+        ViewerModel::new(alma(), &export_face(alma(), None).unwrap().document, None).unwrap();
     let jaw = model
         .groups
         .iter()
@@ -256,11 +256,7 @@ fn feature_points_are_bound_to_mesh_nodes_and_frame_the_camera() {
     let doc = export_face(alma(), None).unwrap().document;
     let model = ViewerModel::new(alma(), &doc, None).unwrap();
     assert_eq!(model.feature_points.len(), alma().feature_points.len());
-    let lip = model
-        .feature_points
-        .iter()
-        .find(|p| p.id == "8.1")
-        .unwrap();
+    let lip = model.feature_points.iter().find(|p| p.id == "8.1").unwrap();
     assert!(lip.node.is_some() && !lip.vertices.is_empty());
     let c = Vec3::from_array(model.camera.target);
     for p in &model.feature_points {
@@ -273,7 +269,9 @@ fn title_is_escaped_and_long_animations_are_refused() {
     let mut face = alma().clone();
     face.name = "<b>&\"x".into();
     let page = ViewerPage::new(&face, None).unwrap();
-    assert!(page.html.contains("<title>&lt;b&gt;&amp;&quot;x · fbakit viewer</title>"));
+    assert!(page
+        .html
+        .contains("<title>&lt;b&gt;&amp;&quot;x · fbakit viewer</title>"));
     let model = page_model(&page.html);
     assert_eq!(model["face"], "<b>&\"x");
     assert!(!script_body(&page.html, "fbakit-data").contains('<'));
