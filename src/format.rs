@@ -194,6 +194,9 @@ mod tests {
         assert_eq!(f("a.wrz"), Some(OutputFormat::VrmlGz));
         assert_eq!(f("x/a.glb"), Some(OutputFormat::Glb));
         assert_eq!(f("frames/"), Some(OutputFormat::Directory));
+        assert_eq!(f("a.html"), Some(OutputFormat::Html));
+        assert_eq!(f("A.HTM"), Some(OutputFormat::Html));
+        assert_eq!(f("page"), None);
         assert_eq!(f("a.xyz"), None);
         assert_eq!(f(".glb"), None, "a bare extension is not a file name");
     }

@@ -18,7 +18,8 @@
 //! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
 //!   cloning grid.
 //! - [`export`]: outputs — glTF with morph targets and animation, OBJ frame sequences,
-//!   rendered pictures (contact sheets, turntables, the cloning grid).
+//!   rendered pictures (contact sheets, turntables, the cloning grid), the one-file HTML
+//!   viewer (`fbakit view`).
 //! - [`demo`]: the end-to-end demo application (`fbakit demo`).
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads (plain and gzip) and atomic writes.

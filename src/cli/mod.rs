@@ -16,6 +16,7 @@ pub mod fap;
 mod fapu;
 pub mod play;
 mod show;
+mod view;
 
 /// A cloning method on the command line (`--method fmc|rbf`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -167,6 +168,22 @@ pub enum Command {
         after_help = "Examples:\n  fbakit demo\n  fbakit demo --out /tmp/demo --method rbf --json"
     )]
     Demo(show::DemoArgs),
+    /// Write one self-contained HTML page that plays a FAP stream on a face, with FAP sliders.
+    #[command(
+        long_about = "Write one self-contained HTML page (three.js, the face as an animated \
+                      glb and the viewer script all inside; works offline from file://). It \
+                      plays STREAM on FACE looping, with play/pause, a time scrubber and \
+                      speed; a panel of FAP sliders grouped as the standard groups them, in \
+                      FAPU, poses the face live; wireframe and feature-point overlays; the \
+                      face's FAP units are shown. Without STREAM the page shows the neutral \
+                      face with its sliders. FACE is a VRML face file (.wrl, .wrl.gz), an OBJ \
+                      with --fp, or `alma` / `bruno`.",
+        after_help = "Examples:\n  fbakit view alma samples/speech.fap -o alma.html\n  \
+                      fbakit view bruno -o bruno.html\n  \
+                      fbakit view face.wrl.gz talk.fap -o talk.html --fps 30 --frames 0..300\n  \
+                      fbakit view head.obj --fp head.fdp -o head.html"
+    )]
+    View(view::ViewArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -193,6 +210,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Eval(cmd) => clone::run_eval(cmd),
         Command::Grid(args) => show::grid(args),
         Command::Demo(args) => show::demo(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

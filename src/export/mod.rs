@@ -5,6 +5,8 @@
 //! - [`obj_sequence`]: one OBJ file per played frame plus a `frames.json` index.
 //! - [`picture`]: rendered PNG pictures — played frames, contact sheets, turntables, the
 //!   cloning grid.
+//! - [`viewer`]: one self-contained HTML page that shows a face in the browser, plays a FAP
+//!   stream on it and poses it live with FAP sliders (`fbakit view`).
 //!
 //! The player ([`crate::player`]) only computes frames; everything that turns frames into
 //! files lives here.
@@ -12,6 +14,7 @@
 pub mod gltf;
 pub mod obj_sequence;
 pub mod picture;
+pub mod viewer;
 
 use std::path::Path;
 

@@ -149,6 +149,24 @@ impl FromStr for FapId {
     }
 }
 
+/// What a FAP group (1..=10, [`FapInfo::group`]) moves, as the standard's group table says
+/// (`visemes and expressions`, `jaw, chin, inner lip, lip corners`, …); `None` outside 1..=10.
+pub fn fap_group_content(group: u8) -> Option<&'static str> {
+    Some(match group {
+        1 => "visemes and expressions",
+        2 => "jaw, chin, inner lip, lip corners",
+        3 => "eyelids, eyeballs, pupils",
+        4 => "eyebrows",
+        5 => "cheeks",
+        6 => "tongue",
+        7 => "head rotation",
+        8 => "outer lip",
+        9 => "nose",
+        10 => "ears",
+        _ => return None,
+    })
+}
+
 /// The BIFS `FAP` node field name of a low-level FAP (differs from the table name for six FAPs).
 pub fn bifs_field_name(id: FapId) -> &'static str {
     match id.number() {

@@ -1,0 +1,158 @@
+//! `fbakit view FACE [STREAM] -o face.html`: one self-contained HTML page that shows the face,
+//! plays the stream looping and poses the face with FAP sliders.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use fbakit::error::{Error, Result};
+use fbakit::export::viewer::{ViewerAnimation, ViewerPage};
+use fbakit::face::{read_with, FaceReadOptions};
+use fbakit::fap::{read_stream_file, ReadOptions};
+use fbakit::format::{refuse_overwriting_input, OutputFormat};
+use fbakit::player::{PlayOptions, Player};
+use serde::Serialize;
+
+use super::play::parse_range;
+use super::{print_json, EXIT_OK};
+
+/// Arguments of `view`.
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// Face: a VRML face file (.wrl, .wrl.gz), an OBJ with --fp, or `alma` / `bruno`.
+    pub face: PathBuf,
+    /// FAP stream to play (`.fap` or `.json`); without it the page shows the neutral face.
+    pub stream: Option<PathBuf>,
+    /// Feature points for the face (replacing its own; needed for an OBJ face).
+    #[arg(long, value_name = "FILE")]
+    pub fp: Option<PathBuf>,
+    /// Output page (`.html`).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Frame rate of the embedded animation (the stream is resampled); default: the stream's.
+    #[arg(long, value_name = "N")]
+    pub fps: Option<f64>,
+    /// Stream frames to play, `a..b` (end exclusive; `a..` and `..b` too).
+    #[arg(long, value_name = "a..b", value_parser = parse_range)]
+    pub frames: Option<std::ops::Range<usize>>,
+    /// Read the stream strictly.
+    #[arg(long)]
+    pub strict: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct ViewReport {
+    face: String,
+    stream: Option<String>,
+    output: String,
+    bytes: usize,
+    glb_bytes: usize,
+    frames: usize,
+    fps: Option<f64>,
+    duration_seconds: f64,
+    missing_tables: Vec<String>,
+    warnings: Vec<String>,
+}
+
+/// Refuses an output that is not an `.html` / `.htm` file (so a typo never overwrites a face).
+/// Runs `view`.
+pub fn run(a: ViewArgs) -> Result<u8> {
+    OutputFormat::resolve(&a.output, &[OutputFormat::Html], "the viewer page")?;
+    let mut inputs: Vec<&Path> = vec![&a.face];
+    inputs.extend(a.stream.as_deref());
+    refuse_overwriting_input(&a.output, &inputs)?;
+    if a.stream.is_none() && (a.fps.is_some() || a.frames.is_some()) {
+        return Err(Error::Invalid(
+            "--fps and --frames need a STREAM to play".into(),
+        ));
+    }
+    let face = read_with(
+        &a.face,
+        &FaceReadOptions::with_feature_points(a.fp.as_deref()),
+    )?
+    .0;
+    let mut warnings = Vec::new();
+    let mut missing = Vec::new();
+    let played = match &a.stream {
+        Some(path) => {
+            let opts = if a.strict {
+                ReadOptions::strict()
+            } else {
+                ReadOptions::lenient()
+            };
+            let (stream, diags) = read_stream_file(path, &opts)?;
+            warnings.extend(diags.iter().map(|d| d.to_string()));
+            let player = Player::new(
+                &face,
+                &stream,
+                PlayOptions {
+                    fps: a.fps,
+                    frames: a.frames.clone(),
+                },
+            )?;
+            missing = player
+                .missing_tables()
+                .into_iter()
+                .map(|(k, n)| format!("{k} in {n} frames"))
+                .collect();
+            let name = path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into(),
+            );
+            Some((player.animation()?, player.fps(), name))
+        }
+        None => None,
+    };
+    let anim = played.as_ref().map(|(frames, fps, name)| ViewerAnimation {
+        frames,
+        fps: *fps,
+        name,
+    });
+    let page = ViewerPage::new(&face, anim.as_ref())?;
+    page.write(&a.output)?;
+    warnings.extend(page.warnings.iter().cloned());
+    let report = ViewReport {
+        face: face.name.clone(),
+        stream: a.stream.as_ref().map(|p| p.display().to_string()),
+        output: a.output.display().to_string(),
+        bytes: page.html.len(),
+        glb_bytes: page.glb_bytes,
+        frames: anim.as_ref().map_or(0, |a| a.frames.len()),
+        fps: anim.as_ref().map(|a| a.fps),
+        duration_seconds: anim
+            .as_ref()
+            .and_then(|a| Some(a.frames.last()?.time - a.frames.first()?.time))
+            .unwrap_or(0.0),
+        missing_tables: missing,
+        warnings,
+    };
+    if a.json {
+        print_json(&report)?;
+    } else {
+        println!(
+            "wrote {}: viewer page, {:.1} MB (glb {:.1} MB)",
+            report.output,
+            report.bytes as f64 / 1e6,
+            report.glb_bytes as f64 / 1e6
+        );
+        match (&report.stream, report.fps) {
+            (Some(s), Some(fps)) => println!(
+                "plays {} frames of `{s}` on `{}` at {fps} fps ({:.3} s), looping",
+                report.frames, report.face, report.duration_seconds
+            ),
+            _ => println!("shows `{}` at neutral (no stream)", report.face),
+        }
+        if !report.missing_tables.is_empty() {
+            println!("missing tables (used by the stream, no table in the face):");
+            for m in &report.missing_tables {
+                println!("  {m}");
+            }
+        }
+        for w in &report.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    Ok(EXIT_OK)
+}

@@ -1,0 +1,159 @@
+//! Loads `fbakit view` pages in a real browser (headless Chromium on SwiftShader) through
+//! `tests/support/viewer-check.mjs`, and checks what a viewer sees: the page plays on load,
+//! pauses, seeks and scrubs; the mouth region of the rendered canvas changes between two times
+//! of the stream and when a FAP slider moves; no console error, no request leaves the file.
+//!
+//! Needs `node`, the npm package `playwright-core` (found through `$VIEWER_BROWSER_DIR`, an
+//! `npm install --prefix` directory, defaulting to `target/viewer-browser`) and Chromium
+//! (`$CHROMIUM_PATH` or `/usr/bin/chromium`). Without them the tests print a note and return,
+//! unless `$VIEWER_BROWSER_REQUIRED` is set (as `.ci/run` does once it installed both).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use fbakit::export::viewer::{ViewerAnimation, ViewerPage};
+use fbakit::fap::{read_stream_file, ReadOptions};
+use fbakit::player::{PlayOptions, Player};
+use serde_json::Value;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The check script's report for `page`, or `None` (with a note) when the browser is missing.
+fn check_page(page: &Path) -> Option<Value> {
+    let required = std::env::var_os("VIEWER_BROWSER_REQUIRED").is_some();
+    let skip = |why: String| {
+        assert!(!required, "viewer browser test required but: {why}");
+        eprintln!("note: skipping viewer browser test: {why}");
+        None
+    };
+    let mut cmd = Command::new("node");
+    cmd.arg(root().join("tests/support/viewer-check.mjs"))
+        .arg(page);
+    if std::env::var_os("VIEWER_BROWSER_DIR").is_none() {
+        let local = root().join("target/viewer-browser");
+        if local.is_dir() {
+            cmd.env("VIEWER_BROWSER_DIR", local);
+        }
+    }
+    let out = match cmd.output() {
+        Ok(o) => o,
+        Err(e) => return skip(format!("cannot run node ({e})")),
+    };
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if out.status.code() == Some(3) {
+        return skip(stderr.trim().to_string());
+    }
+    assert!(out.status.success(), "viewer check failed: {stderr}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    eprintln!("{text}");
+    Some(serde_json::from_str(text.trim()).unwrap())
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+fn assert_clean(r: &Value) {
+    assert_eq!(r["consoleErrors"], Value::Array(vec![]), "console errors");
+    assert_eq!(r["pageErrors"], Value::Array(vec![]), "page errors");
+    assert_eq!(
+        r["foreignRequests"],
+        Value::Array(vec![]),
+        "requests left the file"
+    );
+}
+
+fn assert_slider_moves_the_mouth(r: &Value) {
+    assert_eq!(r["slider"]["key"], "open_jaw");
+    let c = &r["sliderChange"];
+    assert!(
+        f(&c["opaqueFraction"]) > 0.5,
+        "mouth region is not on the face: {c}"
+    );
+    assert!(
+        f(&c["changedFraction"]) > 0.01 && f(&c["meanAbsDiff"]) > 0.5,
+        "moving open_jaw did not change the mouth: {c}"
+    );
+    assert_eq!(r["stateAfterSlider"]["mode"], "pose");
+    assert_eq!(r["stateAfterSlider"]["playing"], false);
+    let shown = r["sliderOutput"].as_str().unwrap();
+    assert!(
+        shown.starts_with("1024") && shown.ends_with("MNS"),
+        "{shown}"
+    );
+}
+
+#[test]
+fn speech_page_plays_and_poses_in_chromium() {
+    let face = fbakit::synth::alma().to_face_model();
+    let (stream, _) =
+        read_stream_file(&root().join("samples/speech.fap"), &ReadOptions::lenient()).unwrap();
+    let player = Player::new(&face, &stream, PlayOptions::default()).unwrap();
+    let frames = player.animation().unwrap();
+    let anim = ViewerAnimation {
+        frames: &frames,
+        fps: player.fps(),
+        name: "speech.fap",
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let page: PathBuf = dir.path().join("alma-speech.html");
+    ViewerPage::new(&face, Some(&anim))
+        .unwrap()
+        .write(&page)
+        .unwrap();
+
+    let Some(r) = check_page(&page) else { return };
+    assert_clean(&r);
+    assert_eq!(r["ready"]["frames"], 75);
+    assert!((f(&r["ready"]["duration"]) - 2.96).abs() < 1e-3);
+
+    // Opens ready to watch: playing the animation, and the clock moves.
+    assert_eq!(r["stateOnLoad"]["mode"], "animation");
+    assert_eq!(r["stateOnLoad"]["playing"], true);
+    assert_eq!(r["timeAdvanced"], true);
+    assert_eq!(r["stateAfterPauseClick"]["playing"], false);
+
+    // The mouth region (from 18 projected lip points) differs between frame 0 and a frame
+    // where the mouth FAPs differ most from it.
+    assert!(f(&r["mouthRegion"]["points"]) >= 8.0);
+    let picked = f(&r["pickedFrame"]["time"]);
+    assert!(picked > 0.0);
+    let c = &r["timeChange"];
+    assert!(
+        f(&c["opaqueFraction"]) > 0.5,
+        "mouth region is not on the face: {c}"
+    );
+    assert!(
+        f(&c["changedFraction"]) > 0.01 && f(&c["meanAbsDiff"]) > 0.5,
+        "the mouth did not change between t=0 and t={picked}: {c}"
+    );
+    assert!((f(&r["stateAfterSeek"]["time"]) - picked).abs() < 1e-3);
+    assert!((f(&r["stateAfterScrub"]["time"]) - picked / 2.0).abs() < 0.02);
+
+    assert_slider_moves_the_mouth(&r);
+}
+
+#[test]
+fn neutral_page_from_the_cli_poses_in_chromium() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("bruno.html");
+    let out = Command::new(env!("CARGO_BIN_EXE_fbakit"))
+        .args(["view", "bruno", "-o"])
+        .arg(&page)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let Some(r) = check_page(&page) else { return };
+    assert_clean(&r);
+    assert_eq!(r["ready"]["frames"], 0);
+    assert_eq!(r["stateOnLoad"]["mode"], "pose");
+    assert_eq!(r["stateOnLoad"]["playing"], false);
+    assert_slider_moves_the_mouth(&r);
+}
