@@ -19,6 +19,8 @@
 //!   cloning grid.
 //! - [`showcase`]: rendered playback frames, contact sheets, the cloning grid and the
 //!   end-to-end demo (`fbakit demo`).
+//! - [`export`]: videos of a played stream: MP4 (through `ffmpeg`), GIF, PNG frames.
+//! - [`speech`]: text to a FAP stream: phoneme timing from espeak-ng, visemes, blending.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads and atomic writes.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
@@ -26,6 +28,7 @@
 pub mod candide;
 pub mod clone;
 pub mod error;
+pub mod export;
 pub mod face;
 pub mod fap;
 pub mod fat;
@@ -36,6 +39,7 @@ pub mod mesh;
 pub mod player;
 pub mod render;
 pub mod showcase;
+pub mod speech;
 pub mod spec;
 pub mod synth;
 pub mod vrml;
