@@ -17,6 +17,7 @@ mod fapu;
 pub mod play;
 mod render;
 mod show;
+mod speak;
 
 /// A cloning method on the command line (`--method fmc|rbf`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -187,6 +188,23 @@ pub enum Command {
                       fbakit render alma samples/lowlevel.fap -o frames/"
     )]
     Render(render::RenderArgs),
+    /// Say a text with espeak-ng: a FAP stream of blended visemes (25 fps) and the WAV audio.
+    #[command(
+        long_about = "Say TEXT with the espeak-ng speech synthesiser (its library \
+                      libespeak-ng, Debian package espeak-ng): the phonemes and their timing \
+                      come from the same synthesis as the audio, each phoneme becomes one of \
+                      the standard's 14 visemes (specs/phoneme-visemes.csv), neighbouring \
+                      visemes are blended with FAP 1 (viseme_select1/2 + blend), and the \
+                      stream lasts as long as the audio (within half a frame). --mouth faps \
+                      writes jaw and lip FAPs instead, for faces without viseme tables. Exit \
+                      codes: 0 ok, 2 bad input (empty text, unknown voice), 1 other failures \
+                      (including espeak-ng not installed).",
+        after_help = "Examples:\n  fbakit speak \"Hello world\" -o hello.fap --wav hello.wav\n  \
+                      fbakit render alma hello.fap --audio hello.wav -o hello.mp4\n  \
+                      fbakit speak \"Guten Tag\" --voice de -o tag.fap --wav tag.wav\n  \
+                      fbakit speak \"Hello\" --mouth faps -o hello-candide.fap --json"
+    )]
+    Speak(speak::SpeakArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -214,6 +232,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Grid(args) => show::grid(args),
         Command::Demo(args) => show::demo(args),
         Command::Render(args) => render::run(args),
+        Command::Speak(args) => speak::run(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),
