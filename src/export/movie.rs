@@ -4,10 +4,12 @@
 //! however long the stream is.
 //!
 //! The camera looks at the face from the front and is framed once, on the neutral face's
-//! feature points (the standard's landmarks span brows, eyes, nose, mouth, chin, cheeks,
-//! ears and hairline), widened by [`FEATURE_POINT_MARGIN`] so a dropped jaw stays in the
-//! picture. A face with fewer than [`MIN_FRAMING_POINTS`] positioned feature points is
-//! framed on its whole neutral mesh instead.
+//! *facial* feature points — chin and inner lips (group 2), eyes (3), brows (4), cheeks
+//! (5), outer lips (8), nose (9) and the hairline (11.1–11.3); not the ears, the top and
+//! back of the head or the spine, which would frame the whole head small — widened by
+//! [`FEATURE_POINT_MARGIN`] so a dropped jaw stays in the picture: a talking-head close-up.
+//! A face with fewer than [`MIN_FRAMING_POINTS`] such points is framed on its whole neutral
+//! mesh instead.
 
 use glam::Vec3;
 use serde::Serialize;
@@ -22,7 +24,7 @@ use crate::render::{Camera, RenderOptions};
 use crate::showcase::FaceView;
 
 /// Fraction of the feature points' box added on every side of the framed box.
-pub const FEATURE_POINT_MARGIN: f32 = 0.12;
+pub const FEATURE_POINT_MARGIN: f32 = 0.15;
 /// Fewest positioned feature points to frame on (fewer: frame the whole neutral face).
 pub const MIN_FRAMING_POINTS: usize = 4;
 
@@ -52,12 +54,18 @@ pub struct MovieReport {
     pub missing_tables: Vec<(String, usize)>,
 }
 
-/// The box around the face's positioned feature points widened by
+/// Whether a feature point belongs to the face region a video frames (see the module docs).
+fn frames_the_face(id: crate::spec::FeaturePointId) -> bool {
+    matches!(id.group(), 2 | 3 | 4 | 5 | 8 | 9) || (id.group() == 11 && id.index() <= 3)
+}
+
+/// The box around the face's positioned facial feature points widened by
 /// [`FEATURE_POINT_MARGIN`], or `None` with fewer than [`MIN_FRAMING_POINTS`] of them.
 pub fn feature_point_box(face: &FaceModel) -> Option<Aabb> {
     let points: Vec<Vec3> = face
         .feature_points
         .iter()
+        .filter(|p| frames_the_face(p.id))
         .filter_map(|p| p.position)
         .filter(|p| p.is_finite())
         .collect();
@@ -144,9 +152,10 @@ mod tests {
         let b = feature_point_box(&face).unwrap();
         let view = FaceView::new(&face).unwrap();
         let head = view.neutral_bounds();
-        // The landmark box is a real box inside the (padded) head box.
+        // The landmark box is a real box, smaller than the head: a close-up of the face.
         assert!(b.size().min_element() > 0.0);
-        assert!(b.size().y <= head.size().y * (1.0 + 2.0 * FEATURE_POINT_MARGIN));
+        assert!(b.size().x < head.size().x && b.size().y < head.size().y);
+        assert!(b.size().y > 0.5 * head.size().y);
         let (_, framed) = movie_camera(&face, &view);
         assert!(framed);
         let mut bare = face.clone();
