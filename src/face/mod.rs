@@ -12,6 +12,7 @@
 
 pub mod morphs;
 pub mod obj_io;
+pub mod parts;
 pub mod summary;
 pub mod validate;
 pub mod vrml_io;
