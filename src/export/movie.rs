@@ -152,12 +152,15 @@ mod tests {
         let b = feature_point_box(&face).unwrap();
         let view = FaceView::new(&face).unwrap();
         let head = view.neutral_bounds();
-        // The landmark box is a real box, smaller than the head: a close-up of the face.
+        // The landmark box is a real box, shallower than the head (no back of the head), and
+        // the camera on it is closer than the whole-head camera: a close-up of the face.
         assert!(b.size().min_element() > 0.0);
-        assert!(b.size().x < head.size().x && b.size().y < head.size().y);
+        assert!(b.size().z < 0.8 * head.size().z, "{b:?} in {head:?}");
         assert!(b.size().y > 0.5 * head.size().y);
-        let (_, framed) = movie_camera(&face, &view);
+        let (cam, framed) = movie_camera(&face, &view);
         assert!(framed);
+        let whole = view.front_camera();
+        assert!(cam.eye.distance(cam.target) < 0.9 * whole.eye.distance(whole.target));
         let mut bare = face.clone();
         bare.feature_points = Default::default();
         assert!(feature_point_box(&bare).is_none());
