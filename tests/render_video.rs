@@ -265,7 +265,7 @@ fn failures_leave_nothing_behind() {
         // ffmpeg itself fails (the "audio" is a FAP file): exit 1 and no mp4.
         let o = fbakit(&["render", "alma", fap, "-o", &path("e.mp4"), "--audio", fap]);
         assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
-        assert!(stderr(&o).contains("ffmpeg failed"), "{}", stderr(&o));
+        assert!(stderr(&o).contains("ffmpeg: failed"), "{}", stderr(&o));
     } else {
         eprintln!("skip the ffmpeg failure case: ffmpeg is not installed");
     }

@@ -69,8 +69,20 @@ struct RenderReport {
     warnings: Vec<String>,
 }
 
+/// `main` restores the default SIGPIPE action (die) for `fbakit ... | head`; `render` feeds
+/// frames into ffmpeg through a pipe, and when ffmpeg stops early that write must fail with
+/// an error we can report (and clean up after), not kill the process.
+fn ignore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: SIG_IGN is a valid disposition; no handler code runs.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_IGN);
+    }
+}
+
 /// Runs `render`.
 pub fn run(a: RenderArgs) -> Result<u8> {
+    ignore_sigpipe();
     let format = VideoFormat::from_path(&a.output)?;
     if a.audio.is_some() && format != VideoFormat::Mp4 {
         return Err(Error::Unsupported(

@@ -14,8 +14,12 @@
 //! needs even sides). With an audio file it is encoded as AAC and **the video sets the
 //! length**: the audio is padded with silence (`-af apad`) and cut where the video ends
 //! (`-shortest`), so a soundtrack longer than the animation is cut and a shorter one ends
-//! in silence. Without `ffmpeg` on the `PATH` the sink fails with
-//! [`Error::MissingTool`] naming the package to install.
+//! in silence (`-shortest` ends at the first packet boundary after the video's end, so
+//! the container can be up to one AAC frame, 1024 samples, longer). Without `ffmpeg` on the
+//! `PATH` the sink fails with [`Error::MissingTool`] naming the package to install. When
+//! `ffmpeg` stops early, the next write gets a broken pipe, which becomes an error with
+//! `ffmpeg`'s last message — if the process ignores SIGPIPE (Rust's default; `fbakit
+//! render` keeps it so).
 //!
 //! ## GIF
 //! Encoded with the `gif` crate, one locally quantised palette per frame, looping forever.
@@ -328,10 +332,11 @@ impl Mp4Sink {
             .rev()
             .find(|l| !l.trim().is_empty())
             .unwrap_or("no message");
-        Err(Error::Invalid(format!(
-            "{FFMPEG} failed ({status}): {}",
-            last.trim()
-        )))
+        // An operation failure (exit 1): ffmpeg's message says whether the input was bad.
+        Err(Error::io(
+            FFMPEG,
+            std::io::Error::other(format!("failed ({status}): {}", last.trim())),
+        ))
     }
 }
 
