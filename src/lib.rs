@@ -39,7 +39,7 @@ pub mod mesh;
 pub mod player;
 pub mod render;
 pub mod showcase;
-pub mod speech;
 pub mod spec;
+pub mod speech;
 pub mod synth;
 pub mod vrml;

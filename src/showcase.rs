@@ -66,7 +66,9 @@ impl FaceView {
         for (i, m) in face.meshes.iter().enumerate() {
             let triangles = orient_outwards(&m.mesh.triangles(), &neutral[i]);
             let mesh_part = FacePart::of_mesh_name(&m.name);
-            for (part, triangles) in split_mesh(mesh_part, &neutral[i], &triangles, &face.feature_points) {
+            for (part, triangles) in
+                split_mesh(mesh_part, &neutral[i], &triangles, &face.feature_points)
+            {
                 let colour = match m.color {
                     Some(c) if part.takes_mesh_colour() => c,
                     _ if part == FacePart::Skin => DEFAULT_COLOUR,

@@ -124,7 +124,10 @@ fn mp4_has_the_stream_duration_frames_and_size() {
         (duration - FRAMES as f64 / FPS).abs() < 1e-3,
         "{duration} s"
     );
-    assert_eq!(others(dir.path(), &["short.fap", "talk.mp4"]), Vec::<String>::new());
+    assert_eq!(
+        others(dir.path(), &["short.fap", "talk.mp4"]),
+        Vec::<String>::new()
+    );
 }
 
 #[test]
@@ -187,9 +190,7 @@ fn gif_decodes_to_every_frame_with_the_frame_rate_delays() {
     assert!(o.status.success(), "{}", stderr(&o));
     let mut opts = gif::DecodeOptions::new();
     opts.set_color_output(gif::ColorOutput::RGBA);
-    let mut d = opts
-        .read_info(std::fs::File::open(&out).unwrap())
-        .unwrap();
+    let mut d = opts.read_info(std::fs::File::open(&out).unwrap()).unwrap();
     assert_eq!((d.width(), d.height()), (48, 40));
     let mut delays = Vec::new();
     let mut distinct = std::collections::HashSet::new();
@@ -233,7 +234,10 @@ fn png_folder_holds_every_frame() {
         let r = decoder.read_info().unwrap();
         assert_eq!((r.info().width, r.info().height), (40, 32));
     }
-    assert_eq!(others(dir.path(), &["short.fap", "frames"]), Vec::<String>::new());
+    assert_eq!(
+        others(dir.path(), &["short.fap", "frames"]),
+        Vec::<String>::new()
+    );
 }
 
 #[test]
@@ -244,7 +248,14 @@ fn failures_leave_nothing_behind() {
     let path = |n: &str| dir.path().join(n).to_string_lossy().into_owned();
     // A stream that does not parse: bad input, nothing written.
     std::fs::write(dir.path().join("bad.fap"), "2.1 x 25 1\n1 1\n").unwrap();
-    let o = fbakit(&["render", "alma", &path("bad.fap"), "-o", &path("a.gif"), "--strict"]);
+    let o = fbakit(&[
+        "render",
+        "alma",
+        &path("bad.fap"),
+        "-o",
+        &path("a.gif"),
+        "--strict",
+    ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     // Audio for a GIF, an unknown extension: refused before anything is written.
     let o = fbakit(&["render", "alma", fap, "-o", &path("b.gif"), "--audio", fap]);
@@ -253,14 +264,25 @@ fn failures_leave_nothing_behind() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains(".avi"), "{}", stderr(&o));
     // A missing soundtrack is bad input.
-    let o = fbakit(&["render", "alma", fap, "-o", &path("d.mp4"), "--audio", &path("none.wav")]);
+    let o = fbakit(&[
+        "render",
+        "alma",
+        fap,
+        "-o",
+        &path("d.mp4"),
+        "--audio",
+        &path("none.wav"),
+    ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     // A folder that holds other files is not overwritten.
     std::fs::create_dir(dir.path().join("mine")).unwrap();
     std::fs::write(dir.path().join("mine/notes.txt"), "keep").unwrap();
     let o = fbakit(&["render", "alma", fap, "-o", &path("mine")]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert_eq!(std::fs::read_to_string(dir.path().join("mine/notes.txt")).unwrap(), "keep");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("mine/notes.txt")).unwrap(),
+        "keep"
+    );
     if ffmpeg_available() {
         // ffmpeg itself fails (the "audio" is a FAP file): exit 1 and no mp4.
         let o = fbakit(&["render", "alma", fap, "-o", &path("e.mp4"), "--audio", fap]);
@@ -282,7 +304,13 @@ fn without_ffmpeg_mp4_says_what_to_install() {
     let out = dir.path().join("x.mp4");
     let empty = tempfile::tempdir().unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(["render", "alma", fap.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .args([
+            "render",
+            "alma",
+            fap.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
         .env("PATH", empty.path())
         .output()
         .unwrap();

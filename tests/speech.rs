@@ -55,7 +55,10 @@ fn stream_lasts_as_long_as_the_wav() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    for text in ["Hello world", "The quick brown fox jumps over the lazy dog."] {
+    for text in [
+        "Hello world",
+        "The quick brown fox jumps over the lazy dog.",
+    ] {
         let o = fbakit(
             dir.path(),
             &["speak", text, "-o", "s.fap", "--wav", "s.wav"],
@@ -170,7 +173,10 @@ fn bad_input_is_exit_2_and_writes_nothing() {
     );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("no-such-voice"), "{}", stderr(&o));
-    let o = fbakit(dir.path(), &["speak", "hi", "-o", "x.fap", "--wav", "x.fap"]);
+    let o = fbakit(
+        dir.path(),
+        &["speak", "hi", "-o", "x.fap", "--wav", "x.fap"],
+    );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
@@ -211,7 +217,14 @@ fn talking_head_mp4_from_typed_text() {
     let dir = tempfile::tempdir().unwrap();
     let o = fbakit(
         dir.path(),
-        &["speak", "Hello world", "-o", "hello.fap", "--wav", "hello.wav"],
+        &[
+            "speak",
+            "Hello world",
+            "-o",
+            "hello.fap",
+            "--wav",
+            "hello.wav",
+        ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let o = fbakit(
@@ -252,5 +265,8 @@ fn talking_head_mp4_from_typed_text() {
         .unwrap()
         .parse()
         .unwrap();
-    assert!((duration - audio).abs() < 0.1, "mp4 {duration} s, wav {audio} s");
+    assert!(
+        (duration - audio).abs() < 0.1,
+        "mp4 {duration} s, wav {audio} s"
+    );
 }

@@ -124,11 +124,7 @@ pub fn run(a: SpeakArgs) -> Result<u8> {
             report.unmapped_phonemes.join(" ")
         );
     }
-    let phonemes: Vec<&str> = report
-        .phonemes
-        .iter()
-        .map(|p| p.symbol.as_str())
-        .collect();
+    let phonemes: Vec<&str> = report.phonemes.iter().map(|p| p.symbol.as_str()).collect();
     let visemes: Vec<&str> = report.visemes.iter().map(|k| k.viseme.label()).collect();
     println!(
         "wrote {}: {} frames at {} fps ({:.3} s)",

@@ -75,7 +75,8 @@ pub fn feature_point_box(face: &FaceModel) -> Option<Aabb> {
     let b = Aabb::of_points(&points)?;
     let size = b.size();
     // A flat or degenerate set (all points in a plane) still gets depth from its width.
-    let pad = Vec3::splat(size.max_element() * FEATURE_POINT_MARGIN).max(size * FEATURE_POINT_MARGIN);
+    let pad =
+        Vec3::splat(size.max_element() * FEATURE_POINT_MARGIN).max(size * FEATURE_POINT_MARGIN);
     Some(Aabb {
         min: b.min - pad,
         max: b.max + pad,
@@ -196,7 +197,8 @@ mod tests {
         };
         let mut sink = open_sink(&out, VideoFormat::PngFolder, &settings).unwrap();
         let mut calls = 0;
-        let report = render_movie(&face, &stream, &opts, sink.as_mut(), &mut |_, _| calls += 1).unwrap();
+        let report =
+            render_movie(&face, &stream, &opts, sink.as_mut(), &mut |_, _| calls += 1).unwrap();
         let written = sink.finish().unwrap();
         assert_eq!(report.frames, 6);
         assert_eq!(calls, 6);

@@ -189,58 +189,43 @@ fn ffmpeg_missing() -> Error {
 /// The `ffmpeg` arguments that encode raw RGB frames of `settings` from standard input into
 /// the MP4 file `out` (see the module docs).
 pub fn ffmpeg_arguments(settings: &VideoSettings, out: &Path) -> Vec<std::ffi::OsString> {
+    let audio = settings.audio.as_deref();
+    let size = format!("{}x{}", settings.width, settings.height);
+    let rate = format!("{}", settings.fps);
     let mut a: Vec<std::ffi::OsString> = Vec::new();
-    let mut push = |s: &str| a.push(s.into());
-    for s in ["-hide_banner", "-loglevel", "error", "-y"] {
-        push(s);
+    let mut push = |items: &[&std::ffi::OsStr]| a.extend(items.iter().map(|s| s.to_os_string()));
+    let s = |t: &'static str| std::ffi::OsStr::new(t);
+    push(&[s("-hide_banner"), s("-loglevel"), s("error"), s("-y")]);
+    push(&[s("-f"), s("rawvideo"), s("-pix_fmt"), s("rgb24")]);
+    push(&[
+        s("-video_size"),
+        size.as_ref(),
+        s("-framerate"),
+        rate.as_ref(),
+    ]);
+    push(&[s("-i"), s("pipe:0")]);
+    if let Some(audio) = audio {
+        push(&[s("-i"), audio.as_os_str()]);
     }
-    for s in ["-f", "rawvideo", "-pix_fmt", "rgb24", "-video_size"] {
-        push(s);
+    push(&[s("-map"), s("0:v:0")]);
+    if audio.is_some() {
+        push(&[s("-map"), s("1:a:0")]);
     }
-    push(&format!("{}x{}", settings.width, settings.height));
-    push("-framerate");
-    push(&format!("{}", settings.fps));
-    push("-i");
-    push("pipe:0");
-    let mut a = a;
-    if let Some(audio) = &settings.audio {
-        a.push("-i".into());
-        a.push(audio.as_os_str().into());
+    push(&[s("-vf"), s("pad=ceil(iw/2)*2:ceil(ih/2)*2")]);
+    push(&[
+        s("-c:v"),
+        s("libx264"),
+        s("-preset"),
+        s("medium"),
+        s("-crf"),
+        s("20"),
+    ]);
+    push(&[s("-pix_fmt"), s("yuv420p"), s("-movflags"), s("+faststart")]);
+    if audio.is_some() {
+        push(&[s("-c:a"), s("aac"), s("-b:a"), s("128k")]);
+        push(&[s("-af"), s("apad"), s("-shortest")]);
     }
-    let mut push = |s: &str| a.push(s.into());
-    for s in ["-map", "0:v:0"] {
-        push(s);
-    }
-    if settings.audio.is_some() {
-        for s in ["-map", "1:a:0"] {
-            push(s);
-        }
-    }
-    for s in [
-        "-vf",
-        "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-        "-c:v",
-        "libx264",
-        "-preset",
-        "medium",
-        "-crf",
-        "20",
-        "-pix_fmt",
-        "yuv420p",
-        "-movflags",
-        "+faststart",
-    ] {
-        push(s);
-    }
-    if settings.audio.is_some() {
-        for s in ["-c:a", "aac", "-b:a", "128k", "-af", "apad", "-shortest"] {
-            push(s);
-        }
-    }
-    for s in ["-f", "mp4"] {
-        push(s);
-    }
-    a.push(out.as_os_str().into());
+    push(&[s("-f"), s("mp4"), out.as_os_str()]);
     a
 }
 

@@ -96,9 +96,7 @@ impl FacePart {
     /// mouth is mouth cavity; `None` keeps the front colour, darkened.
     pub fn inside_colour(self) -> Option<[f32; 3]> {
         match self {
-            FacePart::Skin | FacePart::MouthCavity => {
-                Some(FacePart::MouthCavity.default_colour())
-            }
+            FacePart::Skin | FacePart::MouthCavity => Some(FacePart::MouthCavity.default_colour()),
             _ => None,
         }
     }
@@ -165,7 +163,11 @@ pub fn split_mesh(
 
 /// Eyeball centre (vertex mean) and unit direction to its pupil feature point.
 fn eye_frame(positions: &[Vec3], fps: &FeaturePointSet) -> Option<(Vec3, Vec3)> {
-    let finite: Vec<Vec3> = positions.iter().copied().filter(|p| p.is_finite()).collect();
+    let finite: Vec<Vec3> = positions
+        .iter()
+        .copied()
+        .filter(|p| p.is_finite())
+        .collect();
     if finite.is_empty() {
         return None;
     }
@@ -278,11 +280,7 @@ mod tests {
     fn eyes_get_an_iris_around_the_pupil_point() {
         let face = crate::face::FaceModel::from_synth(&crate::synth::alma());
         let neutral = crate::showcase::neutral_positions(&face);
-        let eye = face
-            .meshes
-            .iter()
-            .position(|m| m.name == "eye_l")
-            .unwrap();
+        let eye = face.meshes.iter().position(|m| m.name == "eye_l").unwrap();
         let tris = face.meshes[eye].mesh.triangles();
         let groups = split_mesh(
             FacePart::EyeWhite,

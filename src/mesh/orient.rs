@@ -21,7 +21,8 @@ use glam::Vec3;
 pub fn orient_outwards(triangles: &[[u32; 3]], positions: &[Vec3]) -> Vec<[u32; 3]> {
     let n = positions.len() as u32;
     let mut out = triangles.to_vec();
-    let valid = |t: &[u32; 3]| t.iter().all(|&i| i < n) && t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
+    let valid =
+        |t: &[u32; 3]| t.iter().all(|&i| i < n) && t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
     // Undirected edge → the triangles using it.
     let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(triangles.len() * 2);
     for (ti, t) in triangles.iter().enumerate() {
@@ -30,7 +31,10 @@ pub fn orient_outwards(triangles: &[[u32; 3]], positions: &[Vec3]) -> Vec<[u32; 
         }
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            edges.entry((a.min(b), a.max(b))).or_default().push(ti as u32);
+            edges
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(ti as u32);
         }
     }
     let mut seen = vec![false; triangles.len()];
@@ -150,7 +154,10 @@ mod tests {
     #[test]
     fn mixed_winding_becomes_consistent_and_outward() {
         let (p, t) = cube();
-        assert!((signed_volume(&p, &t) - 1.0).abs() < 1e-6, "fixture is outward");
+        assert!(
+            (signed_volume(&p, &t) - 1.0).abs() < 1e-6,
+            "fixture is outward"
+        );
         let mut mixed = t.clone();
         for (i, tri) in mixed.iter_mut().enumerate() {
             if i % 3 == 0 {

@@ -315,7 +315,10 @@ mod tests {
         for duration in [0.4, 0.41, 1.028, 2.0] {
             let a = speech_animation(&hello(), duration, &opts).unwrap();
             let len = a.stream.frames.len() as f64 / a.stream.frame_rate;
-            assert!((len - duration).abs() <= 0.5 / opts.fps + 1e-12, "{duration}");
+            assert!(
+                (len - duration).abs() <= 0.5 / opts.fps + 1e-12,
+                "{duration}"
+            );
             assert!(a.stream.problems().is_empty());
         }
     }

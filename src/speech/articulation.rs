@@ -16,20 +16,20 @@ pub const ARTICULATION_FAPS: [u8; 7] = [3, 4, 5, 6, 7, 16, 17];
 /// Per viseme 0..=14: open_jaw, lower_t_midlip, raise_b_midlip, stretch_l_cornerlip,
 /// stretch_r_cornerlip, push_b_lip, push_t_lip.
 const ARTICULATION: [[f64; 7]; Viseme::COUNT] = [
-    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],           // 0 sil: rest
-    [20.0, 40.0, 40.0, 0.0, 0.0, 0.0, 0.0],        // 1 PP: lips pressed together
-    [60.0, 0.0, 20.0, 0.0, 0.0, -20.0, 0.0],       // 2 FF: lower lip up and back to the teeth
-    [120.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],       // 3 TH: tongue between slightly parted teeth
-    [100.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],       // 4 DD
-    [140.0, 0.0, 0.0, 10.0, 10.0, 0.0, 0.0],       // 5 kk
-    [80.0, 0.0, 0.0, -60.0, -60.0, 80.0, 80.0],    // 6 CH: rounded, protruded
-    [60.0, 0.0, 0.0, 60.0, 60.0, 0.0, 0.0],        // 7 SS: teeth close, lips spread
-    [100.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],       // 8 nn
-    [80.0, 0.0, 0.0, -40.0, -40.0, 50.0, 50.0],    // 9 RR: slightly rounded
-    [320.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],       // 10 aa: widest jaw opening
-    [200.0, 0.0, 0.0, 80.0, 80.0, 0.0, 0.0],       // 11 E
-    [110.0, 0.0, 0.0, 110.0, 110.0, 0.0, 0.0],     // 12 ih: spread
-    [260.0, 0.0, 0.0, -80.0, -80.0, 60.0, 60.0],   // 13 oh: open and rounded
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],             // 0 sil: rest
+    [20.0, 40.0, 40.0, 0.0, 0.0, 0.0, 0.0],          // 1 PP: lips pressed together
+    [60.0, 0.0, 20.0, 0.0, 0.0, -20.0, 0.0],         // 2 FF: lower lip up and back to the teeth
+    [120.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],         // 3 TH: tongue between slightly parted teeth
+    [100.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],         // 4 DD
+    [140.0, 0.0, 0.0, 10.0, 10.0, 0.0, 0.0],         // 5 kk
+    [80.0, 0.0, 0.0, -60.0, -60.0, 80.0, 80.0],      // 6 CH: rounded, protruded
+    [60.0, 0.0, 0.0, 60.0, 60.0, 0.0, 0.0],          // 7 SS: teeth close, lips spread
+    [100.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],         // 8 nn
+    [80.0, 0.0, 0.0, -40.0, -40.0, 50.0, 50.0],      // 9 RR: slightly rounded
+    [320.0, 0.0, 0.0, 20.0, 20.0, 0.0, 0.0],         // 10 aa: widest jaw opening
+    [200.0, 0.0, 0.0, 80.0, 80.0, 0.0, 0.0],         // 11 E
+    [110.0, 0.0, 0.0, 110.0, 110.0, 0.0, 0.0],       // 12 ih: spread
+    [260.0, 0.0, 0.0, -80.0, -80.0, 60.0, 60.0],     // 13 oh: open and rounded
     [100.0, 0.0, 0.0, -140.0, -140.0, 110.0, 110.0], // 14 ou: tight rounding
 ];
 
@@ -52,7 +52,10 @@ mod tests {
             let v = Viseme::new(n).unwrap();
             for (id, value) in articulation(v) {
                 assert!(id.info().accepts(value), "viseme {n}: FAP {id} = {value}");
-                assert!(value.abs() <= 400.0, "viseme {n}: FAP {id} = {value} is not light");
+                assert!(
+                    value.abs() <= 400.0,
+                    "viseme {n}: FAP {id} = {value} is not light"
+                );
             }
         }
         let jaw = |n: u8| {

@@ -195,10 +195,7 @@ mod tests {
                 assert_eq!(t.lookup(p), Some(VisemeTarget::Single(v)), "{p}");
             }
         }
-        assert_eq!(
-            PhonemeVisemeTable::standard().rows().len(),
-            t.rows().len()
-        );
+        assert_eq!(PhonemeVisemeTable::standard().rows().len(), t.rows().len());
     }
 
     #[test]
@@ -233,6 +230,9 @@ mod tests {
         let header = "phon,viseme\np,1\n";
         assert!(PhonemeVisemeTable::parse(header, Path::new("v.csv")).is_err());
         assert!(parse_target("3>").is_none());
-        assert_eq!(parse_target("3>4"), Some(VisemeTarget::Glide(vis(3), vis(4))));
+        assert_eq!(
+            parse_target("3>4"),
+            Some(VisemeTarget::Glide(vis(3), vis(4)))
+        );
     }
 }
