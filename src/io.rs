@@ -271,6 +271,38 @@ mod tests {
     }
 
     #[test]
+    fn atomic_file_appears_on_commit_only() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("v.mp4");
+        let mut f = AtomicFile::create(&p, ".mp4").unwrap();
+        assert!(f.temp_path().to_string_lossy().ends_with(".mp4"));
+        f.file().write_all(b"data").unwrap();
+        assert!(!p.exists());
+        f.commit().unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"data");
+        let dropped = AtomicFile::create(&dir.path().join("w.mp4"), ".mp4").unwrap();
+        drop(dropped);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn atomic_dir_replaces_the_old_directory_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("frames");
+        std::fs::create_dir(&p).unwrap();
+        std::fs::write(p.join("old.png"), b"old").unwrap();
+        let d = AtomicDir::create(&p).unwrap();
+        std::fs::write(d.temp_path().join("new.png"), b"new").unwrap();
+        assert!(p.join("old.png").exists(), "old content until commit");
+        d.commit().unwrap();
+        assert!(!p.join("old.png").exists());
+        assert_eq!(std::fs::read(p.join("new.png")).unwrap(), b"new");
+        let dropped = AtomicDir::create(&dir.path().join("other")).unwrap();
+        drop(dropped);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
     fn bounded_read_refuses_large_files() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("big");
