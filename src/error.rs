@@ -176,6 +176,11 @@ pub enum Error {
     /// The requested operation or format is not supported.
     #[error("unsupported: {0}")]
     Unsupported(String),
+    /// A program or library the operation needs is not installed (e.g. `ffmpeg`,
+    /// `espeak-ng`); the message says what to install. An environment problem, not bad
+    /// input: exit code 1.
+    #[error("{0}")]
+    MissingTool(String),
 }
 
 impl Error {
@@ -199,6 +204,7 @@ impl Error {
                     | std::io::ErrorKind::FileTooLarge
             ),
             Error::Parse(_) | Error::Invalid(_) | Error::Unsupported(_) => true,
+            Error::MissingTool(_) => false,
         }
     }
 }

@@ -8,7 +8,7 @@ use std::io::{Read, Write};
 use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
 use flate2::Compression;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 
@@ -81,6 +81,137 @@ pub fn write_atomic_with(
     set_default_permissions(tmp.as_file()).map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
+}
+
+/// The directory a new output at `path` is created in (`.` for a bare file name).
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// An output file written over time (a video fed frame by frame, or by another program):
+/// a temporary file beside `path` that [`AtomicFile::commit`] renames into place. Dropped
+/// without a commit (an error, a panic), the temporary file is removed and `path` is left
+/// as it was.
+#[derive(Debug)]
+pub struct AtomicFile {
+    tmp: tempfile::NamedTempFile,
+    path: PathBuf,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file beside `path`; its name ends in `suffix` (programs such as
+    /// `ffmpeg` pick a container from the extension).
+    pub fn create(path: &Path, suffix: &str) -> Result<AtomicFile> {
+        let dir = parent_dir(path);
+        let tmp = tempfile::Builder::new()
+            .prefix(".fbakit-")
+            .suffix(suffix)
+            .tempfile_in(dir)
+            .map_err(|e| Error::io(dir, e))?;
+        Ok(AtomicFile {
+            tmp,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Where the content is being written (hand this to a program that writes the file).
+    pub fn temp_path(&self) -> &Path {
+        self.tmp.path()
+    }
+
+    /// The final path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The open temporary file.
+    pub fn file(&mut self) -> &mut std::fs::File {
+        self.tmp.as_file_mut()
+    }
+
+    /// Flushes the content to disk, gives it the permissions of a plain new file and renames
+    /// it to the final path.
+    pub fn commit(self) -> Result<()> {
+        let AtomicFile { tmp, path } = self;
+        tmp.as_file().sync_all().map_err(|e| Error::io(&path, e))?;
+        set_default_permissions(tmp.as_file()).map_err(|e| Error::io(&path, e))?;
+        tmp.persist(&path).map_err(|e| Error::io(&path, e.error))?;
+        Ok(())
+    }
+}
+
+/// An output directory filled over time (one file per frame): a temporary directory beside
+/// `path` that [`AtomicDir::commit`] renames into place, replacing an existing directory
+/// there. Dropped without a commit, the temporary directory and its files are removed.
+#[derive(Debug)]
+pub struct AtomicDir {
+    tmp: tempfile::TempDir,
+    path: PathBuf,
+}
+
+impl AtomicDir {
+    /// Creates the temporary directory beside `path` (the parent must exist).
+    pub fn create(path: &Path) -> Result<AtomicDir> {
+        let dir = parent_dir(path);
+        let tmp = tempfile::Builder::new()
+            .prefix(".fbakit-")
+            .suffix(".tmp")
+            .tempdir_in(dir)
+            .map_err(|e| Error::io(dir, e))?;
+        Ok(AtomicDir {
+            tmp,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Where the files are being written.
+    pub fn temp_path(&self) -> &Path {
+        self.tmp.path()
+    }
+
+    /// The final path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames the directory into place. An existing directory at the final path is first
+    /// moved aside and removed only after the rename succeeded.
+    pub fn commit(self) -> Result<()> {
+        let AtomicDir { tmp, path } = self;
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            // Temporary directories are private (0700); a plain new directory is 0777 less
+            // the umask, which for the common 022 is 0755.
+            let _ = std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o755));
+        }
+        let old = if path.exists() {
+            let aside = tempfile::Builder::new()
+                .prefix(".fbakit-old-")
+                .tempdir_in(parent_dir(&path))
+                .map_err(|e| Error::io(&path, e))?;
+            let aside_path = aside.path().join("old");
+            std::fs::rename(&path, &aside_path).map_err(|e| Error::io(&path, e))?;
+            Some((aside, aside_path))
+        } else {
+            None
+        };
+        let kept = tmp.keep();
+        if let Err(e) = std::fs::rename(&kept, &path) {
+            // Put the old directory back; the new one is dropped.
+            if let Some((_, aside_path)) = &old {
+                let _ = std::fs::rename(aside_path, &path);
+            }
+            let _ = std::fs::remove_dir_all(&kept);
+            return Err(Error::io(&path, e));
+        }
+        // `old`'s TempDir removes the previous content when dropped here.
+        drop(old);
+        Ok(())
+    }
 }
 
 /// Temporary files are created private (0600); an output should get the permissions a plain
@@ -165,6 +296,38 @@ mod tests {
             mode, expected,
             "atomic output {mode:o} vs plain file {expected:o}"
         );
+    }
+
+    #[test]
+    fn atomic_file_appears_on_commit_only() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("v.mp4");
+        let mut f = AtomicFile::create(&p, ".mp4").unwrap();
+        assert!(f.temp_path().to_string_lossy().ends_with(".mp4"));
+        f.file().write_all(b"data").unwrap();
+        assert!(!p.exists());
+        f.commit().unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"data");
+        let dropped = AtomicFile::create(&dir.path().join("w.mp4"), ".mp4").unwrap();
+        drop(dropped);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn atomic_dir_replaces_the_old_directory_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("frames");
+        std::fs::create_dir(&p).unwrap();
+        std::fs::write(p.join("old.png"), b"old").unwrap();
+        let d = AtomicDir::create(&p).unwrap();
+        std::fs::write(d.temp_path().join("new.png"), b"new").unwrap();
+        assert!(p.join("old.png").exists(), "old content until commit");
+        d.commit().unwrap();
+        assert!(!p.join("old.png").exists());
+        assert_eq!(std::fs::read(p.join("new.png")).unwrap(), b"new");
+        let dropped = AtomicDir::create(&dir.path().join("other")).unwrap();
+        drop(dropped);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

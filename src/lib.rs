@@ -19,8 +19,9 @@
 //!   cloning grid.
 //! - [`export`]: outputs — glTF with morph targets and animation, OBJ frame sequences,
 //!   rendered pictures (contact sheets, turntables, the cloning grid), the one-file HTML
-//!   viewer (`fbakit view`).
+//!   viewer (`fbakit view`), videos (MP4 through `ffmpeg`, GIF, PNG frames).
 //! - [`demo`]: the end-to-end demo application (`fbakit demo`).
+//! - [`speech`]: text to a FAP stream: phoneme timing from espeak-ng, visemes, blending.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads (plain and gzip) and atomic writes.
 //! - [`format`]: output formats resolved once from a path; refusing to overwrite inputs.
@@ -46,5 +47,6 @@ pub mod player;
 pub mod prelude;
 pub mod render;
 pub mod spec;
+pub mod speech;
 pub mod synth;
 pub mod vrml;

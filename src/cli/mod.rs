@@ -15,7 +15,9 @@ pub mod face_export;
 pub mod fap;
 mod fapu;
 pub mod play;
+mod render;
 mod show;
+mod speak;
 mod view;
 
 /// A cloning method on the command line (`--method fmc|rbf`).
@@ -184,6 +186,42 @@ pub enum Command {
                       fbakit view head.obj --fp head.fdp -o head.html"
     )]
     View(view::ViewArgs),
+    /// Render a FAP stream played on a face as a video: .mp4 (with --audio), .gif or PNG frames.
+    #[command(
+        long_about = "Render a FAP stream played on a face as a video at the stream's frame \
+                      rate (--fps to resample), the camera framed on the face's feature \
+                      points. OUT ending in .mp4 gives H.264 (yuv420p, plays in browsers) \
+                      through the ffmpeg program, with --audio muxed in as AAC: the video \
+                      sets the length (longer audio is cut, shorter audio ends in silence). \
+                      OUT ending in .gif gives an animated GIF; a directory gives one PNG \
+                      per frame (frame_00000.png, ...). Frames are streamed: memory does \
+                      not grow with the length. Nothing is left behind on failure. Exit \
+                      codes: 0 ok, 2 bad usage or input, 1 other failures (including \
+                      ffmpeg not installed).",
+        after_help = "Examples:\n  fbakit render alma samples/speech.fap -o speech.mp4\n  \
+                      fbakit speak \"Hello world\" -o hello.fap --wav hello.wav && \
+                      fbakit render alma hello.fap --audio hello.wav -o hello.mp4\n  \
+                      fbakit render bruno samples/speech.fap -o speech.gif --size 256x256 --fps 12.5\n  \
+                      fbakit render alma samples/lowlevel.fap -o frames/"
+    )]
+    Render(render::RenderArgs),
+    /// Say a text with espeak-ng: a FAP stream of blended visemes (25 fps) and the WAV audio.
+    #[command(
+        long_about = "Say TEXT with the espeak-ng speech synthesiser (its library \
+                      libespeak-ng, Debian package espeak-ng): the phonemes and their timing \
+                      come from the same synthesis as the audio, each phoneme becomes one of \
+                      the standard's 14 visemes (specs/phoneme-visemes.csv), neighbouring \
+                      visemes are blended with FAP 1 (viseme_select1/2 + blend), and the \
+                      stream lasts as long as the audio (within half a frame). --mouth faps \
+                      writes jaw and lip FAPs instead, for faces without viseme tables. Exit \
+                      codes: 0 ok, 2 bad input (empty text, unknown voice), 1 other failures \
+                      (including espeak-ng not installed).",
+        after_help = "Examples:\n  fbakit speak \"Hello world\" -o hello.fap --wav hello.wav\n  \
+                      fbakit render alma hello.fap --audio hello.wav -o hello.mp4\n  \
+                      fbakit speak \"Guten Tag\" --voice de -o tag.fap --wav tag.wav\n  \
+                      fbakit speak \"Hello\" --mouth faps -o hello-candide.fap --json"
+    )]
+    Speak(speak::SpeakArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -211,6 +249,8 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Grid(args) => show::grid(args),
         Command::Demo(args) => show::demo(args),
         Command::View(args) => view::run(args),
+        Command::Render(args) => render::run(args),
+        Command::Speak(args) => speak::run(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -7,13 +7,17 @@
 //!   cloning grid.
 //! - [`viewer`]: one self-contained HTML page that shows a face in the browser, plays a FAP
 //!   stream on it and poses it live with FAP sliders (`fbakit view`).
+//! - [`video`], [`movie`]: videos of a played stream — MP4 through `ffmpeg`, GIF, PNG frames
+//!   (`fbakit render`).
 //!
 //! The player ([`crate::player`]) only computes frames; everything that turns frames into
 //! files lives here.
 
 pub mod gltf;
+pub mod movie;
 pub mod obj_sequence;
 pub mod picture;
+pub mod video;
 pub mod viewer;
 
 use std::path::Path;

@@ -10,10 +10,12 @@ use glam::Vec3;
 
 use crate::clone::face::{clone_face, CloneOptions, Method};
 use crate::error::{Error, Result};
+use crate::face::parts::{split_mesh, FacePart};
 use crate::face::FaceModel;
 use crate::fap::FapStream;
 use crate::fat::eval::Activation;
 use crate::fat::{Fat, TableKey};
+use crate::mesh::orient::orient_outwards;
 use crate::mesh::Aabb;
 use crate::player::{PlayOptions, Player, PlayerFrame};
 use crate::render::{
@@ -27,33 +29,56 @@ const SHEET_PADDING: u32 = 6;
 /// Caption colour drawn into grid cells.
 const CELL_CAPTION: [u8; 4] = [235, 235, 235, 255];
 
-/// A face prepared for drawing: triangles and colour per mesh, and the neutral bounds every
-/// frame of this face is framed on.
+/// A face prepared for drawing: per mesh, its triangles (wound consistently outwards,
+/// [`crate::mesh::orient::orient_outwards`]) grouped by face part with a material each
+/// ([`crate::face::parts`]: eye whites with iris and pupil, teeth, tongue, mouth cavity, the
+/// inside of the head seen through the lips), and the neutral bounds every frame of this
+/// face is framed on.
 #[derive(Clone, Debug)]
 pub struct FaceView {
-    triangles: Vec<Vec<[u32; 3]>>,
-    colours: Vec<[f32; 3]>,
+    parts: Vec<DrawPart>,
     neutral_bounds: Aabb,
 }
 
+/// Triangles of one mesh drawn in one material.
+#[derive(Clone, Debug)]
+struct DrawPart {
+    mesh: usize,
+    triangles: Vec<[u32; 3]>,
+    colour: [f32; 3],
+    inside_colour: Option<[f32; 3]>,
+}
+
 impl FaceView {
-    /// Triangulates `face`'s meshes and measures its neutral pose. Errors when the face has
-    /// no finite vertex.
+    /// Triangulates `face`'s meshes, orients and splits them into parts, and measures its
+    /// neutral pose. Errors when the face has no finite vertex.
     pub fn new(face: &FaceModel) -> Result<FaceView> {
-        let triangles: Vec<Vec<[u32; 3]>> =
-            face.meshes.iter().map(|m| m.mesh.triangles()).collect();
-        let colours: Vec<[f32; 3]> = face
-            .meshes
-            .iter()
-            .map(|m| m.color.unwrap_or(DEFAULT_COLOUR))
-            .collect();
         let neutral = face.neutral_world_positions();
-        let meshes = render_meshes(&neutral, &triangles, &colours);
+        let mut parts = Vec::new();
+        for (i, m) in face.meshes.iter().enumerate() {
+            let triangles = orient_outwards(&m.mesh.triangles(), &neutral[i]);
+            let mesh_part = FacePart::of_mesh_name(&m.name);
+            for (part, triangles) in
+                split_mesh(mesh_part, &neutral[i], &triangles, &face.feature_points)
+            {
+                let colour = match m.color {
+                    Some(c) if part.takes_mesh_colour() => c,
+                    _ if part == FacePart::Skin => DEFAULT_COLOUR,
+                    _ => part.default_colour(),
+                };
+                parts.push(DrawPart {
+                    mesh: i,
+                    triangles,
+                    colour,
+                    inside_colour: part.inside_colour(),
+                });
+            }
+        }
+        let meshes = render_meshes(&neutral, &parts);
         let neutral_bounds = bounds(&meshes)
             .ok_or_else(|| Error::Invalid(format!("face `{}` has no vertex to draw", face.name)))?;
         Ok(FaceView {
-            triangles,
-            colours,
+            parts,
             neutral_bounds,
         })
     }
@@ -71,11 +96,7 @@ impl FaceView {
     /// Draws world positions (one list per mesh, as [`crate::face::FacePose::world_positions_into`]
     /// makes them).
     pub fn render(&self, positions: &[Vec<Vec3>], camera: &Camera, opts: &RenderOptions) -> Image {
-        render(
-            &render_meshes(positions, &self.triangles, &self.colours),
-            camera,
-            opts,
-        )
+        render(&render_meshes(positions, &self.parts), camera, opts)
     }
 
     /// Like [`FaceView::render`] from several yaw angles (radians) at one distance.
@@ -85,21 +106,21 @@ impl FaceView {
         angles: &[f32],
         opts: &RenderOptions,
     ) -> Vec<Image> {
-        let meshes = render_meshes(positions, &self.triangles, &self.colours);
+        let meshes = render_meshes(positions, &self.parts);
         turntable(&meshes, &self.neutral_bounds, angles, opts)
     }
 }
 
-fn render_meshes<'a>(
-    positions: &'a [Vec<Vec3>],
-    triangles: &'a [Vec<[u32; 3]>],
-    colours: &[[f32; 3]],
-) -> Vec<RenderMesh<'a>> {
-    positions
+fn render_meshes<'a>(positions: &'a [Vec<Vec3>], parts: &'a [DrawPart]) -> Vec<RenderMesh<'a>> {
+    parts
         .iter()
-        .zip(triangles)
-        .zip(colours)
-        .map(|((p, t), c)| RenderMesh::new(p, t, *c))
+        .filter_map(|p| {
+            let pos = positions.get(p.mesh)?;
+            Some(RenderMesh {
+                inside_colour: p.inside_colour,
+                ..RenderMesh::new(pos, &p.triangles, p.colour)
+            })
+        })
         .collect()
 }
 

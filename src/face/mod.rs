@@ -16,6 +16,7 @@ pub mod bundled;
 pub mod candide;
 pub mod format;
 pub mod morphs;
+pub mod parts;
 pub mod pose;
 pub mod read;
 pub mod summary;

@@ -17,6 +17,7 @@
 
 pub mod geometry;
 pub mod obj;
+pub mod orient;
 pub mod spatial;
 pub(crate) mod text;
 

@@ -55,6 +55,9 @@ pub struct RenderMesh<'a> {
     pub normals: Option<&'a [Vec3]>,
     /// Diffuse colour, sRGB components in `[0, 1]`.
     pub colour: [f32; 3],
+    /// Colour of the back faces (the inside of a surface, seen through an opening such as
+    /// the mouth), sRGB; `None` draws them in `colour`, darkened.
+    pub inside_colour: Option<[f32; 3]>,
 }
 
 impl<'a> RenderMesh<'a> {
@@ -65,6 +68,7 @@ impl<'a> RenderMesh<'a> {
             triangles,
             normals: None,
             colour,
+            inside_colour: None,
         }
     }
 }

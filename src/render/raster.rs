@@ -173,6 +173,9 @@ fn setup(
         vertices.extend(projected);
 
         let albedo = Vec3::from(mesh.colour.map(srgb_to_linear));
+        let inside = mesh.inside_colour.map_or(albedo * INTERIOR_DARKENING, |c| {
+            Vec3::from(c.map(srgb_to_linear)) * INTERIOR_DARKENING
+        });
         let n = mesh.positions.len() as u32;
         for tri in mesh.triangles {
             if tri.iter().any(|&i| i >= n) {
@@ -224,11 +227,7 @@ fn setup(
                 y0: y0 as i32,
                 y1: y1 as i32,
                 face_normal,
-                albedo: if back {
-                    albedo * INTERIOR_DARKENING
-                } else {
-                    albedo
-                },
+                albedo: if back { inside } else { albedo },
                 back,
             });
         }

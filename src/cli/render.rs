@@ -1,0 +1,185 @@
+//! `fbakit render FACE STREAM -o out.mp4|out.gif|frames/`: a video of a FAP stream played on
+//! a face, optionally with a soundtrack.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use fbakit::error::{Error, Result};
+use fbakit::export::movie::{movie_fps, render_movie, MovieOptions};
+use fbakit::export::video::{open_sink, VideoFormat, VideoSettings};
+use fbakit::fap::{read_stream_file, ReadOptions};
+
+use serde::Serialize;
+
+use super::play::{parse_size, progress};
+use super::{print_json, EXIT_OK};
+
+/// Arguments of `render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// Face: a VRML face file, or `alma` / `bruno` for the built-in faces.
+    pub face: PathBuf,
+    /// FAP stream (`.fap` or `.json`).
+    pub stream: PathBuf,
+    /// Output: `.mp4` (needs the ffmpeg program), `.gif`, or a directory for one PNG per
+    /// frame.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Frame size in pixels, `WxH`.
+    #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Video frame rate (the stream is resampled); default: the stream's.
+    #[arg(long, value_name = "N", value_parser = parse_fps)]
+    pub fps: Option<f64>,
+    /// Sound file muxed into the mp4 (e.g. the WAV from `fbakit speak`). The video sets the
+    /// length: longer audio is cut, shorter audio ends in silence.
+    #[arg(long, value_name = "FILE")]
+    pub audio: Option<PathBuf>,
+    /// Read the stream strictly.
+    #[arg(long)]
+    pub strict: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Parses `--fps` (finite, 0 < fps <= 240).
+fn parse_fps(s: &str) -> std::result::Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 240.0 => Ok(v),
+        _ => Err(format!("`{s}` is not a frame rate between 0 and 240")),
+    }
+}
+
+#[derive(Debug, Serialize)]
+struct RenderReport {
+    face: String,
+    stream: String,
+    output: String,
+    format: VideoFormat,
+    frames: usize,
+    fps: f64,
+    duration_seconds: f64,
+    width: u32,
+    height: u32,
+    audio: Option<String>,
+    bytes: u64,
+    framed_on_feature_points: bool,
+    missing_tables: Vec<(String, usize)>,
+    warnings: Vec<String>,
+}
+
+/// `main` restores the default SIGPIPE action (die) for `fbakit ... | head`; `render` feeds
+/// frames into ffmpeg through a pipe, and when ffmpeg stops early that write must fail with
+/// an error we can report (and clean up after), not kill the process.
+fn ignore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: SIG_IGN is a valid disposition; no handler code runs.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_IGN);
+    }
+}
+
+/// Runs `render`.
+pub fn run(a: RenderArgs) -> Result<u8> {
+    ignore_sigpipe();
+    let format = VideoFormat::from_path(&a.output)?;
+    if a.audio.is_some() && format != VideoFormat::Mp4 {
+        return Err(Error::Unsupported(
+            "--audio needs an .mp4 output (GIF and PNG frames have no sound)".into(),
+        ));
+    }
+    let face = fbakit::face::read(&a.face)?;
+    let opts = if a.strict {
+        ReadOptions::strict()
+    } else {
+        ReadOptions::lenient()
+    };
+    let (stream, stream_warnings) = read_stream_file(&a.stream, &opts)?;
+    let warnings: Vec<String> = stream_warnings.iter().map(|d| d.to_string()).collect();
+    let settings = VideoSettings {
+        width: a.size.0,
+        height: a.size.1,
+        fps: movie_fps(&stream, a.fps),
+        audio: a.audio.clone(),
+    };
+    let mut sink = open_sink(&a.output, format, &settings)?;
+    let movie = MovieOptions {
+        width: a.size.0,
+        height: a.size.1,
+        fps: a.fps,
+    };
+    let bar = progress(0, "rendering");
+    let report = render_movie(&face, &stream, &movie, sink.as_mut(), &mut |n, total| {
+        bar.set_length(total as u64);
+        bar.set_position(n as u64);
+    });
+    let report = match report {
+        Ok(r) => r,
+        Err(e) => {
+            bar.finish_and_clear();
+            return Err(e);
+        }
+    };
+    let written = sink.finish()?;
+    bar.finish_and_clear();
+    let out = RenderReport {
+        face: face.name.clone(),
+        stream: a.stream.display().to_string(),
+        output: written.path.display().to_string(),
+        format,
+        frames: report.frames,
+        fps: report.fps,
+        duration_seconds: report.duration_seconds,
+        width: a.size.0,
+        height: a.size.1,
+        audio: a.audio.as_ref().map(|p| p.display().to_string()),
+        bytes: written.bytes,
+        framed_on_feature_points: report.framed_on_feature_points,
+        missing_tables: report.missing_tables,
+        warnings,
+    };
+    if a.json {
+        print_json(&out)?;
+    } else {
+        for w in &out.warnings {
+            eprintln!("warning: {w}");
+        }
+        let what = match format {
+            VideoFormat::Mp4 if out.audio.is_some() => "H.264 MP4 with AAC audio",
+            VideoFormat::Mp4 => "H.264 MP4",
+            VideoFormat::Gif => "animated GIF",
+            VideoFormat::PngFolder => "PNG frames",
+        };
+        println!(
+            "wrote {}: {what}, {} frames {}x{} at {} fps ({:.3} s, {} bytes)",
+            out.output, out.frames, out.width, out.height, out.fps, out.duration_seconds, out.bytes
+        );
+        if !out.missing_tables.is_empty() {
+            let keys: Vec<String> = out
+                .missing_tables
+                .iter()
+                .map(|(k, n)| format!("{k} ({n} frames)"))
+                .collect();
+            eprintln!(
+                "warning: the face has no table for {} (those did not move it)",
+                keys.join(", ")
+            );
+        }
+    }
+    Ok(EXIT_OK)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_rates() {
+        assert_eq!(parse_fps("30"), Ok(30.0));
+        assert_eq!(parse_fps("12.5"), Ok(12.5));
+        for bad in ["0", "-1", "nan", "inf", "1000", "x"] {
+            assert!(parse_fps(bad).is_err(), "{bad}");
+        }
+    }
+}
