@@ -1,5 +1,8 @@
+use glam::{DVec3, Vec3};
+
 use super::*;
 use crate::clone::eval::pose;
+use crate::face::FaceTransform;
 use crate::fat::eval::Activation;
 use crate::spec::FapId;
 use crate::synth::{generate, HeadParams};
