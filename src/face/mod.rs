@@ -2,7 +2,7 @@
 //! and Facial Animation Tables (FAT).
 //!
 //! [`FaceModel`] is what cloning and playing work on. It is read from and written to VRML97
-//! face files ([`vrml_io`]; any face file by extension, gzip and OBJ included: [`obj_io`]),
+//! face files ([`vrml`]; any face file by extension, gzip and OBJ included: [`obj_io`]),
 //! built from OBJ morph sets ([`morphs`]), from CANDIDE-3 ([`crate::candide::face`]) or from
 //! the procedural generator ([`FaceModel::from_synth`]); [`summary`] describes one.
 //!
@@ -14,7 +14,10 @@ pub mod morphs;
 pub mod obj_io;
 pub mod summary;
 pub mod validate;
-pub mod vrml_io;
+pub mod vrml;
+/// The old path of [`vrml`] (kept while code written against it is merged; use `face::vrml`).
+#[doc(hidden)]
+pub use vrml as vrml_io;
 
 use std::collections::HashMap;
 

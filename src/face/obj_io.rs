@@ -28,7 +28,7 @@ use flate2::write::GzEncoder;
 use flate2::Compression;
 use glam::{Affine3A, Vec3};
 
-use super::vrml_io::{face_from_scene, face_to_scene, FaceReadReport, FeaturePointMatch};
+use super::vrml::{face_from_scene, face_to_scene, FaceReadReport, FeaturePointMatch};
 use super::{FaceMesh, FaceModel};
 use crate::error::{Error, Result};
 use crate::fdp::{FeaturePointSet, VertexBinding};
@@ -260,7 +260,7 @@ pub fn gzip(data: &[u8], w: &mut dyn Write) -> std::io::Result<()> {
 /// Writes a face in the format its extension names (see the module docs), atomically.
 pub fn write_face(path: &Path, face: &FaceModel) -> Result<()> {
     match FaceFormat::of_path(path)? {
-        FaceFormat::Vrml => super::vrml_io::write_face_file(path, face),
+        FaceFormat::Vrml => super::vrml::write_face_file(path, face),
         FaceFormat::VrmlGz => {
             let text = crate::vrml::write_vrml_string(&face_to_scene(face)?);
             crate::io::write_atomic_with(path, |w| gzip(text.as_bytes(), w))
