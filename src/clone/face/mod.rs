@@ -187,31 +187,9 @@ pub fn clone_face(
     report
         .timings
         .push("motions", clock.elapsed().as_secs_f64());
-    // 5. Surface method (only motions that move the skin).
-    let moving: Vec<SurfaceMotion> = motions
-        .iter()
-        .filter(|m| !m.offsets.is_empty())
-        .cloned()
-        .collect();
-    let mut result = clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts)?;
-    for (name, s) in &result.timings.steps {
-        report
-            .timings
-            .push(&format!("{}:{name}", opts.method.name()), *s);
-    }
-    report.stats.extend(result.stats.clone());
-    report.warnings.append(&mut result.warnings);
-    // 6. FAPU rescale (RBF).
-    if opts.method == Method::Rbf && opts.rbf_fapu_rescale {
-        let clock = Instant::now();
-        report.fapu_rescale =
-            rescale_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
-        report
-            .timings
-            .push("rescale", clock.elapsed().as_secs_f64());
-    }
-    let cloned: HashMap<(TableKey, u64), &SurfaceMotion> = result
-        .motions
+    // 5, 6. Surface method and FAPU rescale.
+    let cloned_motions = clone_skin_motions(&ssurf, &tsurf, &motions, opts, &mut report)?;
+    let cloned: HashMap<(TableKey, u64), &SurfaceMotion> = cloned_motions
         .iter()
         .map(|m| ((m.key, m.value.to_bits()), m))
         .collect();
@@ -243,6 +221,41 @@ pub fn clone_face(
     report.source_parts = sparts;
     report.target_parts = tparts;
     Ok(CloneOutcome { face, report })
+}
+
+/// Steps 5 and 6: the surface method on the motions that move the skin, then (RBF) the FAPU
+/// rescale. Returns one cloned motion per moving source motion.
+fn clone_skin_motions(
+    ssurf: &SkinSurface,
+    tsurf: &SkinSurface,
+    motions: &[SurfaceMotion],
+    opts: &CloneOptions,
+    report: &mut CloneReport,
+) -> Result<Vec<SurfaceMotion>> {
+    // Only motions that move the skin.
+    let moving: Vec<SurfaceMotion> = motions
+        .iter()
+        .filter(|m| !m.offsets.is_empty())
+        .cloned()
+        .collect();
+    let mut result = clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts)?;
+    for (name, s) in &result.timings.steps {
+        report
+            .timings
+            .push(&format!("{}:{name}", opts.method.name()), *s);
+    }
+    report.stats.extend(result.stats.clone());
+    report.warnings.append(&mut result.warnings);
+    // FAPU rescale (RBF only).
+    if opts.method == Method::Rbf && opts.rbf_fapu_rescale {
+        let clock = Instant::now();
+        report.fapu_rescale =
+            rescale_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+        report
+            .timings
+            .push("rescale", clock.elapsed().as_secs_f64());
+    }
+    Ok(result.motions)
 }
 
 /// A face (`side` = "source" or "target") needs a skin mesh; meshes of neither skin nor a

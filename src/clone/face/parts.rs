@@ -154,57 +154,8 @@ pub fn identify_parts(face: &FaceModel) -> FaceParts {
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
     let n = face.meshes.len();
-    let mut part_of: Vec<Option<Part>> = vec![None; n];
-    let mut has_skin_fp = vec![false; n];
-    for fp in face.feature_points.iter() {
-        let Some((mi, _)) = fp_mesh_vertex(face, &frames, fp.id, diag * 1e-4) else {
-            continue;
-        };
-        match Part::of_feature_point(fp.id) {
-            Some(p) => {
-                if part_of[mi].is_none() {
-                    part_of[mi] = Some(p);
-                }
-            }
-            None => has_skin_fp[mi] = true,
-        }
-    }
-    // A mesh holding skin points is skin even if a part point sits on it too (one-mesh heads).
-    for mi in 0..n {
-        if has_skin_fp[mi] {
-            part_of[mi] = None;
-        }
-    }
-    // Connectivity between meshes through coincident vertex positions.
-    let q = (diag * 1e-5).max(f32::MIN_POSITIVE);
-    let mut cells: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
-    for (mi, m) in face.meshes.iter().enumerate() {
-        for &p in &m.mesh.positions {
-            let w = frames.meshes[mi].transform_point3(p);
-            if !w.is_finite() {
-                continue;
-            }
-            let key = (
-                (w.x / q).round() as i64,
-                (w.y / q).round() as i64,
-                (w.z / q).round() as i64,
-            );
-            let list = cells.entry(key).or_default();
-            if !list.contains(&mi) {
-                list.push(mi);
-            }
-        }
-    }
-    let mut adjacent: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
-    for list in cells.values().filter(|l| l.len() > 1) {
-        for &a in list {
-            for &b in list {
-                if a != b {
-                    adjacent[a].insert(b);
-                }
-            }
-        }
-    }
+    let (mut part_of, has_skin_fp) = seed_parts(face, &frames, diag);
+    let adjacent = mesh_adjacency(face, &frames, diag);
     // Grow parts over connected meshes that hold no skin point and belong to nothing yet.
     let mut queue: Vec<usize> = (0..n).filter(|&m| part_of[m].is_some()).collect();
     while let Some(m) = queue.pop() {
@@ -237,4 +188,67 @@ pub fn identify_parts(face: &FaceModel) -> FaceParts {
         }
     }
     out
+}
+
+/// Per mesh, the part its feature points identify and whether it holds a skin feature point
+/// (which makes it skin even if a part point sits on it too).
+fn seed_parts(face: &FaceModel, frames: &FaceFrames, diag: f32) -> (Vec<Option<Part>>, Vec<bool>) {
+    let n = face.meshes.len();
+    let mut part_of: Vec<Option<Part>> = vec![None; n];
+    let mut has_skin_fp = vec![false; n];
+    for fp in face.feature_points.iter() {
+        let Some((mi, _)) = fp_mesh_vertex(face, frames, fp.id, diag * 1e-4) else {
+            continue;
+        };
+        match Part::of_feature_point(fp.id) {
+            Some(p) => {
+                if part_of[mi].is_none() {
+                    part_of[mi] = Some(p);
+                }
+            }
+            None => has_skin_fp[mi] = true,
+        }
+    }
+    // A mesh holding skin points is skin even if a part point sits on it too (one-mesh heads).
+    for mi in 0..n {
+        if has_skin_fp[mi] {
+            part_of[mi] = None;
+        }
+    }
+    (part_of, has_skin_fp)
+}
+
+/// The meshes each mesh is connected to: sharing a vertex position, quantised at 1e-5 of the
+/// face's size `diag`.
+fn mesh_adjacency(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Vec<BTreeSet<usize>> {
+    let q = (diag * 1e-5).max(f32::MIN_POSITIVE);
+    let mut cells: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
+    for (mi, m) in face.meshes.iter().enumerate() {
+        for &p in &m.mesh.positions {
+            let w = frames.meshes[mi].transform_point3(p);
+            if !w.is_finite() {
+                continue;
+            }
+            let key = (
+                (w.x / q).round() as i64,
+                (w.y / q).round() as i64,
+                (w.z / q).round() as i64,
+            );
+            let list = cells.entry(key).or_default();
+            if !list.contains(&mi) {
+                list.push(mi);
+            }
+        }
+    }
+    let mut adjacent: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); face.meshes.len()];
+    for list in cells.values().filter(|l| l.len() > 1) {
+        for &a in list {
+            for &b in list {
+                if a != b {
+                    adjacent[a].insert(b);
+                }
+            }
+        }
+    }
+    adjacent
 }
