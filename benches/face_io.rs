@@ -12,7 +12,7 @@ use std::sync::LazyLock;
 
 use divan::counter::BytesCount;
 use divan::{black_box, Bencher};
-use fbakit::face::vrml_io::{face_from_scene, write_face_string};
+use fbakit::face::vrml::{face_from_scene, write_face_string};
 use fbakit::face::FaceModel;
 use fbakit::fat::eval::Activation;
 use fbakit::io::{gunzip_bounded, gzip};

@@ -271,7 +271,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
 
     let mut files = Vec::new();
     let wrl = out_dir.join("bruno-cloned.wrl");
-    crate::face::vrml_io::write_face_file(&wrl, &bruno)?;
+    crate::face::vrml::write_face_file(&wrl, &bruno)?;
     record(
         &mut files,
         wrl,

@@ -156,10 +156,8 @@ fn write_synth_faces() {
         return;
     };
     let (a, b) = faces();
-    fbakit::face::vrml_io::write_face_file(&std::path::Path::new(&dir).join("alma.wrl"), a)
-        .unwrap();
-    fbakit::face::vrml_io::write_face_file(&std::path::Path::new(&dir).join("bruno.wrl"), b)
-        .unwrap();
+    fbakit::face::vrml::write_face_file(&std::path::Path::new(&dir).join("alma.wrl"), a).unwrap();
+    fbakit::face::vrml::write_face_file(&std::path::Path::new(&dir).join("bruno.wrl"), b).unwrap();
 }
 
 #[test]

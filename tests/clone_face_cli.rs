@@ -2,7 +2,7 @@
 
 use std::process::Command;
 
-use fbakit::face::vrml_io::write_face_file;
+use fbakit::face::vrml::write_face_file;
 
 fn fbakit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_fbakit"))
@@ -27,7 +27,7 @@ fn clone_writes_a_face_and_reports() {
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(json["report"]["method"], "rbf");
     assert!(json["report"]["tables"].as_u64().unwrap() >= 80);
-    let (face, _) = fbakit::face::vrml_io::read_face_file(&out).unwrap();
+    let (face, _) = fbakit::face::vrml::read_face_file(&out).unwrap();
     assert!(face.fat.tables.len() >= 80);
     let o = fbakit()
         .args(["eval", "compliance"])

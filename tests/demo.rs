@@ -82,7 +82,7 @@ fn demo_writes_every_file() {
         assert_eq!(file.bytes, len);
     }
     // The cloned face reads back with its FAT.
-    let (bruno, _) = fbakit::face::vrml_io::read_face_file(&demo_file("bruno-cloned.wrl")).unwrap();
+    let (bruno, _) = fbakit::face::vrml::read_face_file(&demo_file("bruno-cloned.wrl")).unwrap();
     assert_eq!(bruno.fat.tables.len(), report.cloned_tables);
     assert!(
         report.cloned_tables >= 80,

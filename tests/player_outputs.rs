@@ -130,7 +130,7 @@ fn play_reports_missing_tables() {
     let mut face = fbakit::synth::alma().to_face_model();
     face.fat.tables.clear();
     let face_path = dir.path().join("bare.wrl");
-    fbakit::face::vrml_io::write_face_file(&face_path, &face).unwrap();
+    fbakit::face::vrml::write_face_file(&face_path, &face).unwrap();
     let out = dir.path().join("o.glb");
     let o = fbakit(&[
         "play",

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::vrml_io::FeaturePointMatch;
+use super::vrml::FeaturePointMatch;
 use super::FaceModel;
 use crate::error::{Error, Result};
 use crate::fdp::{FeaturePointSet, VertexBinding};

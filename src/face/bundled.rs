@@ -2,7 +2,7 @@
 //! files in `samples/faces/` (made by [`crate::synth`]; a test pins them to the generator),
 //! so every command reads them by name through the one face reader.
 
-use super::vrml_io::FaceReadReport;
+use super::vrml::FaceReadReport;
 use super::FaceModel;
 use crate::error::Result;
 

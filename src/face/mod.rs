@@ -21,14 +21,14 @@ pub mod pose;
 pub mod read;
 pub mod summary;
 pub mod validate;
-pub mod vrml_io;
+pub mod vrml;
 pub mod write;
 
 pub use bundled::BundledFace;
 pub use format::FaceFormat;
 pub use pose::FacePose;
 pub use read::{read, read_bytes, read_with, FaceReadOptions};
-pub use vrml_io::FaceReadReport;
+pub use vrml::FaceReadReport;
 pub use write::write;
 
 use std::collections::HashMap;

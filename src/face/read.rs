@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use super::attach::attach_feature_points;
 use super::bundled::BundledFace;
 use super::format::{face_name, FaceFormat};
-use super::vrml_io::{face_from_scene, FaceReadReport};
+use super::vrml::{face_from_scene, FaceReadReport};
 use super::{FaceMesh, FaceModel};
 use crate::error::{Error, Result};
 use crate::io::{gunzip_bounded, DEFAULT_MAX_INPUT_BYTES};
@@ -206,7 +206,7 @@ fn attach_file(
     face: &mut FaceModel,
     fp: &Path,
     face_path: &Path,
-) -> Result<Vec<super::vrml_io::FeaturePointMatch>> {
+) -> Result<Vec<super::vrml::FeaturePointMatch>> {
     let file = crate::fdp::read_feature_points(fp)?;
     let alias = face_path
         .file_name()

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use super::vrml_io::{FaceFileKind, FaceReadReport, FeaturePointMatch};
+use super::vrml::{FaceFileKind, FaceReadReport, FeaturePointMatch};
 use super::FaceModel;
 use crate::fat::{TableKey, TransformField};
 use crate::spec::{FapId, FapuKind};

@@ -5,12 +5,12 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::validate::validate_face;
-use super::vrml_io::{face_from_scene, write_face_string, FaceFileKind};
+use super::vrml::{face_from_scene, write_face_string, FaceFileKind};
 use super::*;
 use crate::error::Severity;
 use crate::spec::FeaturePointId;
 
-fn read_str(text: &str) -> (FaceModel, super::vrml_io::FaceReadReport) {
+fn read_str(text: &str) -> (FaceModel, super::vrml::FaceReadReport) {
     let scene = crate::vrml::parse_vrml(Path::new("t.wrl"), text).expect("parses");
     face_from_scene(scene, "t").expect("reads")
 }

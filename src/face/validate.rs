@@ -10,7 +10,7 @@
 use crate::error::{Diagnostic, Severity};
 use crate::fat::validate::{validate_fat, FatEntry};
 
-use super::vrml_io::FaceReadReport;
+use super::vrml::FaceReadReport;
 use super::FaceModel;
 
 /// All problems of a face read from a file (reader diagnostics included), located.

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::{Affine3A, Vec3};
 
-use super::vrml_io::face_to_scene;
+use super::vrml::face_to_scene;
 use super::FaceModel;
 use crate::error::{Error, Result};
 use crate::format::OutputFormat;
@@ -22,7 +22,7 @@ pub const WRITABLE: &[OutputFormat] =
 /// Writes a face in the format its extension names (see the module docs), atomically.
 pub fn write(path: &Path, face: &FaceModel) -> Result<()> {
     match OutputFormat::resolve(path, WRITABLE, "a face file")? {
-        OutputFormat::Vrml => super::vrml_io::write_face_file(path, face),
+        OutputFormat::Vrml => super::vrml::write_face_file(path, face),
         OutputFormat::VrmlGz => {
             let text = crate::vrml::write_vrml_string(&face_to_scene(face)?);
             crate::io::write_atomic_with(path, |w| gzip(text.as_bytes(), w))

@@ -11,9 +11,11 @@
 //!   uses its own small model rather than `gltf-json`, whose index/`Checked` wrappers buy little
 //!   for a writer that only ever produces valid indices, and whose output we want to control to
 //!   the field (no defaults written, no empty arrays).
-//! - [`builder`]: plain data in ([`MeshData`], [`NodeData`], [`AnimationData`]), checked as it
-//!   is added to a [`SceneBuilder`], laid out into one binary buffer by
-//!   [`SceneBuilder::build`].
+//! - The scene builder: plain data in ([`MeshData`], [`NodeData`], [`AnimationData`];
+//!   `scene_data.rs`), checked as it is added to a [`SceneBuilder`] (`builder.rs`), laid out
+//!   by [`SceneBuilder::build`] into one binary buffer of views and accessors (`layout.rs`)
+//!   and the JSON objects that use them (`document.rs`). [`area_weighted_normals`]
+//!   (`normals.rs`) supplies normals a mesh is given without.
 //! - [`container`]: the [`GltfDocument`] written as `.glb` (JSON and `BIN` chunks, 4-byte
 //!   aligned) or as `.gltf` with the buffer embedded as a base64 data URI (one self-contained
 //!   file; prefer `.glb` for large faces, it is a quarter smaller and faster to load).
@@ -66,15 +68,21 @@
 //! # Ok::<(), fbakit::error::Error>(())
 //! ```
 
-pub mod builder;
+mod builder;
 pub mod container;
+mod document;
 pub mod json;
+mod layout;
+mod normals;
+mod scene_data;
 
-pub use builder::{
-    area_weighted_normals, AnimationData, ChannelData, ChannelValues, Interpolation, MaterialData,
-    MeshData, MeshId, MorphOffsets, MorphTargetData, NodeData, NodeId, SceneBuilder,
-};
+pub use builder::SceneBuilder;
 pub use container::{parse_glb, GlbChunks, GltfDocument};
+pub use normals::area_weighted_normals;
+pub use scene_data::{
+    AnimationData, ChannelData, ChannelValues, Interpolation, MaterialData, MeshData, MeshId,
+    MorphOffsets, MorphTargetData, NodeData, NodeId,
+};
 
 #[cfg(test)]
 mod tests;

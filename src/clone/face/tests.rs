@@ -1,4 +1,7 @@
+use glam::{DVec3, Vec3};
+
 use super::*;
+use crate::face::FaceTransform;
 use crate::fat::eval::Activation;
 use crate::spec::FapId;
 use crate::synth::{generate, HeadParams};

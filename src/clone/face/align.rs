@@ -1,0 +1,197 @@
+//! The similarity that aligns the target face onto the source (Umeyama's least-squares fit,
+//! with small rotations snapped away; module docs of [`super`], step 2).
+
+use glam::{DMat3, DVec3, Vec3};
+use serde::Serialize;
+
+use super::CloneOptions;
+use crate::error::{Error, Result};
+use crate::face::FaceModel;
+
+/// A similarity `p ↦ s·R·p + t`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Similarity {
+    /// Uniform scale.
+    pub scale: f64,
+    /// Rotation.
+    pub rotation: glam::DQuat,
+    /// Translation.
+    pub translation: DVec3,
+}
+
+impl Default for Similarity {
+    fn default() -> Self {
+        Similarity::IDENTITY
+    }
+}
+
+impl Similarity {
+    /// The identity.
+    pub const IDENTITY: Similarity = Similarity {
+        scale: 1.0,
+        rotation: glam::DQuat::IDENTITY,
+        translation: DVec3::ZERO,
+    };
+
+    /// Maps a point.
+    pub fn point(&self, p: Vec3) -> Vec3 {
+        (self.rotation * p.as_dvec3() * self.scale + self.translation).as_vec3()
+    }
+
+    /// Maps a displacement.
+    pub fn vector(&self, v: Vec3) -> Vec3 {
+        (self.rotation * v.as_dvec3() * self.scale).as_vec3()
+    }
+
+    /// Maps a displacement back (`Rᵀ v / s`).
+    pub fn inverse_vector(&self, v: DVec3) -> DVec3 {
+        self.rotation.inverse() * v / self.scale
+    }
+
+    /// Maps a point back.
+    pub fn inverse_point(&self, p: DVec3) -> DVec3 {
+        self.inverse_vector(p - self.translation)
+    }
+
+    /// Least-squares similarity taking `from[i]` onto `to[i]` (Umeyama 1991). Needs three
+    /// non-collinear pairs.
+    pub fn fit(from: &[DVec3], to: &[DVec3]) -> Result<Similarity> {
+        let n = from.len().min(to.len());
+        if n < 3 {
+            return Err(Error::Invalid(format!(
+                "aligning the faces needs at least 3 shared feature points, found {n}"
+            )));
+        }
+        let mf = from[..n].iter().sum::<DVec3>() / n as f64;
+        let mt = to[..n].iter().sum::<DVec3>() / n as f64;
+        let mut cov = nalgebra::Matrix3::<f64>::zeros();
+        let mut var_f = 0.0;
+        for i in 0..n {
+            let a = from[i] - mf;
+            let b = to[i] - mt;
+            var_f += a.length_squared();
+            cov += nalgebra::Vector3::new(b.x, b.y, b.z)
+                * nalgebra::Vector3::new(a.x, a.y, a.z).transpose();
+        }
+        cov /= n as f64;
+        var_f /= n as f64;
+        let svd = cov.svd(true, true);
+        let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+            return Err(Error::Invalid("feature point alignment: SVD failed".into()));
+        };
+        let mut sv = svd.singular_values;
+        // Rank check: collinear points leave the rotation undetermined.
+        if var_f <= 0.0 || sv.iter().filter(|&&x| x > 1e-12 * sv.max()).count() < 2 {
+            return Err(Error::Invalid(
+                "feature point alignment: the shared feature points are collinear".into(),
+            ));
+        }
+        let mut d = nalgebra::Matrix3::<f64>::identity();
+        if (u * vt).determinant() < 0.0 {
+            d[(2, 2)] = -1.0;
+            sv[2] = -sv[2];
+        }
+        let r = u * d * vt;
+        let scale = sv.sum() / var_f;
+        let rm = DMat3::from_cols_array(&[
+            r[(0, 0)],
+            r[(1, 0)],
+            r[(2, 0)],
+            r[(0, 1)],
+            r[(1, 1)],
+            r[(2, 1)],
+            r[(0, 2)],
+            r[(1, 2)],
+            r[(2, 2)],
+        ]);
+        let rotation = glam::DQuat::from_mat3(&rm).normalize();
+        let translation = mt - rotation * mf * scale;
+        if !scale.is_finite() || scale <= 0.0 || !translation.is_finite() {
+            return Err(Error::Invalid(
+                "feature point alignment gave a degenerate similarity".into(),
+            ));
+        }
+        Ok(Similarity {
+            scale,
+            rotation,
+            translation,
+        })
+    }
+
+    /// [`Similarity::fit`], except that a rotation of at most `snap_degrees` is taken as no
+    /// rotation at all: scale and translation are then refitted without it (least squares
+    /// about the centroids, `s = Σ a·b / Σ |a|²`). Faces modelled upright in the MPEG-4 frame
+    /// but with other proportions fit with a small spurious tilt (0.94° for the synthetic
+    /// alma → bruno), which only turns FAP directions away from the target's axes.
+    pub fn fit_snapped(from: &[DVec3], to: &[DVec3], snap_degrees: f64) -> Result<Similarity> {
+        let full = Similarity::fit(from, to)?;
+        if full.angle_degrees().abs() > snap_degrees {
+            return Ok(full);
+        }
+        let n = from.len().min(to.len());
+        let mf = from[..n].iter().sum::<DVec3>() / n as f64;
+        let mt = to[..n].iter().sum::<DVec3>() / n as f64;
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..n {
+            let a = from[i] - mf;
+            num += a.dot(to[i] - mt);
+            den += a.length_squared();
+        }
+        let scale = num / den;
+        if !scale.is_finite() || scale <= 0.0 {
+            return Ok(full);
+        }
+        Ok(Similarity {
+            scale,
+            rotation: glam::DQuat::IDENTITY,
+            translation: mt - mf * scale,
+        })
+    }
+
+    /// Rotation angle in degrees.
+    pub fn angle_degrees(&self) -> f64 {
+        self.rotation.to_axis_angle().1.to_degrees()
+    }
+}
+
+/// Feature points both faces place: `(target positions, source positions)`, in target order.
+fn shared_fps(source: &FaceModel, target: &FaceModel) -> (Vec<DVec3>, Vec<DVec3>) {
+    let mut from = Vec::new();
+    let mut to = Vec::new();
+    for fp in target.feature_points.iter() {
+        if let (Some(pt), Some(ps)) = (fp.position, source.feature_points.position(fp.id)) {
+            if pt.is_finite() && ps.is_finite() {
+                from.push(pt.as_dvec3());
+                to.push(ps.as_dvec3());
+            }
+        }
+    }
+    (from, to)
+}
+
+/// The target → source alignment [`super::clone_face`] uses: the snapped fit over the shared
+/// feature points, or the identity when [`CloneOptions::align`] is off.
+pub(super) fn face_alignment(
+    source: &FaceModel,
+    target: &FaceModel,
+    opts: &CloneOptions,
+) -> Result<Similarity> {
+    if opts.align {
+        let (from, to) = shared_fps(source, target);
+        Similarity::fit_snapped(&from, &to, opts.align_snap_degrees)
+    } else {
+        Ok(Similarity::IDENTITY)
+    }
+}
+
+/// RMS distance of the target's feature points mapped by `alignment` to the source's, in
+/// source units.
+pub(super) fn alignment_rms(source: &FaceModel, target: &FaceModel, alignment: &Similarity) -> f64 {
+    let (from, to) = shared_fps(source, target);
+    let ss: f64 = from
+        .iter()
+        .zip(&to)
+        .map(|(f, t)| (alignment.point(f.as_vec3()).as_dvec3() - *t).length_squared())
+        .sum();
+    (ss / from.len().max(1) as f64).sqrt()
+}

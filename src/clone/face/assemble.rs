@@ -1,0 +1,93 @@
+//! Building the target's FAT (module docs of [`super`], step 8): cloned skin motions back in
+//! each mesh's frame, rebuilt into tables, transform entries appended, every number checked.
+
+use std::collections::HashMap;
+
+use super::motions::back_to_meshes;
+use super::rigid::RigidPlan;
+use super::{CloneReport, FaceParts, Similarity, SkinSurface};
+use crate::clone::SurfaceMotion;
+use crate::error::{Error, Result};
+use crate::face::FaceModel;
+use crate::fat::morph::{fat_from_morph_targets, MorphTarget};
+use crate::fat::{Fat, TableKey};
+
+/// The source side of a clone: the face, its parts and its FAT as morph targets.
+pub(super) struct SourceMotions<'a> {
+    /// The source face.
+    pub face: &'a FaceModel,
+    /// Its parts.
+    pub parts: &'a FaceParts,
+    /// Its FAT as morph targets.
+    pub targets: &'a [MorphTarget],
+}
+
+/// The target FAT: one table per source morph target from the `cloned` skin motions (by key
+/// and value), plus the rigid plan's transform entries. Fails on any non-finite number.
+pub(super) fn assemble_fat(
+    source: &SourceMotions,
+    cloned: &HashMap<(TableKey, u64), &SurfaceMotion>,
+    face: &FaceModel,
+    tsurf: &SkinSurface,
+    alignment: &Similarity,
+    rigid: &RigidPlan,
+    report: &mut CloneReport,
+) -> Result<Fat> {
+    let frames = face.frames();
+    let mut out_targets = Vec::with_capacity(source.targets.len());
+    for t in source.targets {
+        let mut meshes = Vec::new();
+        if let Some(m) = cloned.get(&(t.key, t.value.to_bits())) {
+            meshes = back_to_meshes(face, &frames, tsurf, alignment, m);
+        }
+        out_targets.push(MorphTarget {
+            key: t.key,
+            value: t.value,
+            meshes,
+            transforms: Vec::new(),
+        });
+    }
+    let mut fat = fat_from_morph_targets(&out_targets)?;
+    rigid.add_entries(
+        source.face,
+        source.parts,
+        source.targets,
+        face,
+        &frames,
+        alignment,
+        tsurf,
+        &mut fat,
+        report,
+    );
+    check_finite(&fat)?;
+    Ok(fat)
+}
+
+/// Every displacement, border and transform entry of `fat` must be finite.
+fn check_finite(fat: &Fat) -> Result<()> {
+    for t in &fat.tables {
+        for m in &t.meshes {
+            if m.displacements.iter().any(|d| !d.is_finite())
+                || m.interval_borders.iter().any(|b| !b.is_finite())
+            {
+                return Err(Error::Invalid(format!(
+                    "cloning produced a non-finite displacement for {} on mesh `{}`",
+                    t.key, m.mesh
+                )));
+            }
+        }
+        for x in &t.transforms {
+            if !x.rotation_axis.is_finite()
+                || !x.rotation_angle.is_finite()
+                || !x.scale.is_finite()
+                || !x.translation.is_finite()
+            {
+                return Err(Error::Invalid(format!(
+                    "cloning produced a non-finite transform entry for {} on `{}`",
+                    t.key, x.transform
+                )));
+            }
+        }
+    }
+    Ok(())
+}

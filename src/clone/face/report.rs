@@ -1,0 +1,67 @@
+//! What a whole-face clone reports besides the face: timings, statistics, warnings, parts,
+//! alignment and the rigid-part handling.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::{FaceParts, Method, Part, Similarity};
+use crate::clone::StepTimings;
+use crate::face::FaceModel;
+
+/// What the rigid-part step found and did.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RigidReport {
+    /// Target transform used for each part (by name).
+    pub part_transforms: BTreeMap<Part, String>,
+    /// Target head transform.
+    pub head_transform: Option<String>,
+    /// Transforms fbakit created.
+    pub created_transforms: Vec<String>,
+    /// Centres installed: `(transform, centre in the face frame)`.
+    pub installed_centres: Vec<(String, [f32; 3])>,
+    /// Transform entries written to the target FAT.
+    pub transform_entries: usize,
+    /// Tables whose tongue deformation became a rigid tongue translation.
+    pub rigid_tongue_tables: usize,
+}
+
+/// Everything [`clone_face`](super::clone_face) reports besides the face.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CloneReport {
+    /// Method used.
+    pub method: Method,
+    /// Per-step timings (surface steps prefixed `fmc:` / `rbf:`).
+    pub timings: StepTimings,
+    /// Figures from the surface method and the face layer.
+    pub stats: BTreeMap<String, f64>,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+    /// Source parts.
+    pub source_parts: FaceParts,
+    /// Target parts.
+    pub target_parts: FaceParts,
+    /// Target → source alignment used.
+    pub alignment: Similarity,
+    /// RMS distance of the aligned target feature points to the source's, in source units.
+    pub alignment_rms: f64,
+    /// Skin vertices (welded) of source and target surfaces.
+    pub surface_vertices: [usize; 2],
+    /// Source morph targets cloned.
+    pub motions: usize,
+    /// Tables in the output FAT.
+    pub tables: usize,
+    /// RBF FAPU rescaling factors applied, per FAP name.
+    pub fapu_rescale: BTreeMap<String, f64>,
+    /// Rigid-part handling.
+    pub rigid: RigidReport,
+}
+
+/// The target with its new FAT, and the report.
+#[derive(Clone, Debug)]
+pub struct CloneOutcome {
+    /// The target face with the cloned FAT (and any transforms fbakit had to add).
+    pub face: FaceModel,
+    /// Timings, statistics, warnings.
+    pub report: CloneReport,
+}

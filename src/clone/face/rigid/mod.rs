@@ -1,0 +1,280 @@
+//! Rigid parts by transforms (module docs of [`super`], step 7): the target's part and head
+//! transforms are found or created, their centres installed, and source transforms mapped to
+//! them by role ([`RigidPlan`]); [`entries`] then writes the FAT's transform entries.
+
+mod centres;
+mod entries;
+mod hierarchy;
+
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
+
+use glam::{Affine3A, Vec3};
+
+pub use centres::install_center;
+use centres::{install_eye_centres, install_head_centre, install_rotated_part_centres};
+use hierarchy::{encloses, lowest_enclosing, roles, unique_name};
+
+use super::{CloneReport, FaceParts, Part, Similarity};
+use crate::error::Result;
+use crate::face::{FaceModel, FaceTransform};
+use crate::fat::TransformField;
+
+/// Role of a transform in cloning.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Role {
+    Part(Part),
+    Head,
+}
+
+/// The target transforms the source's transform motion maps to.
+pub(super) struct RigidPlan {
+    /// Target transform per source transform index.
+    map: HashMap<usize, (Role, usize)>,
+    /// Target tongue transform (for rigid tongue motion).
+    tongue: Option<usize>,
+}
+
+/// What the source FAT drives: transforms it moves or rotates, and the parts that therefore
+/// need a transform of their own on the target.
+struct SourceDrive<'a> {
+    /// Names of the source transforms any table moves.
+    driven: HashSet<&'a str>,
+    /// Names of the source transforms any table rotates.
+    rotated: HashSet<&'a str>,
+    /// Parts the target needs a transform for.
+    needed: BTreeSet<Part>,
+}
+
+impl<'a> SourceDrive<'a> {
+    fn of(source: &'a FaceModel, sparts: &FaceParts, sroles: &BTreeMap<Part, usize>) -> Self {
+        let driven: HashSet<&str> = source
+            .fat
+            .tables
+            .iter()
+            .flat_map(|t| t.transforms.iter().map(|x| x.transform.as_str()))
+            .collect();
+        let rotated: HashSet<&str> = source
+            .fat
+            .tables
+            .iter()
+            .flat_map(|t| t.transforms.iter())
+            .filter(|x| x.field == TransformField::Rotation)
+            .map(|x| x.transform.as_str())
+            .collect();
+        let tongue_meshes = tongue_mesh_names(source, sparts);
+        let tongue_deformed = source.fat.tables.iter().any(|t| {
+            t.meshes
+                .iter()
+                .any(|m| tongue_meshes.contains(m.mesh.as_str()))
+        });
+        let mut needed: BTreeSet<Part> = sroles
+            .iter()
+            .filter(|(_, &t)| driven.contains(source.transforms[t].name.as_str()))
+            .map(|(&p, _)| p)
+            .collect();
+        if tongue_deformed {
+            needed.insert(Part::Tongue);
+        }
+        SourceDrive {
+            driven,
+            rotated,
+            needed,
+        }
+    }
+}
+
+/// Names of the source's tongue meshes.
+fn tongue_mesh_names<'a>(source: &'a FaceModel, sparts: &FaceParts) -> HashSet<&'a str> {
+    sparts
+        .parts
+        .get(&Part::Tongue)
+        .into_iter()
+        .flatten()
+        .map(|&m| source.meshes[m].name.as_str())
+        .collect()
+}
+
+impl RigidPlan {
+    /// Prepares the target `face` for rigid motion: head and part transforms (created where
+    /// missing), their centres, and the map from source transforms. Fills `report.rigid` and
+    /// warns about created transforms and parts only one face has.
+    pub(super) fn install(
+        source: &FaceModel,
+        sparts: &FaceParts,
+        face: &mut FaceModel,
+        tparts: &FaceParts,
+        frame: &Similarity,
+        report: &mut CloneReport,
+    ) -> Result<RigidPlan> {
+        let (sroles, shead) = roles(source, sparts);
+        let drive = SourceDrive::of(source, sparts, &sroles);
+        let mut created = Vec::new();
+        let head = head_transform(face, tparts, &mut created);
+        let part_tf = part_transforms(face, tparts, head, &drive.needed, &mut created);
+        if !created.is_empty() {
+            face.scene = None;
+            report.warnings.push(format!(
+                "created transforms {}; the output is written as a new scene",
+                created.join(", ")
+            ));
+        }
+        let mut installed = Vec::new();
+        install_eye_centres(face, tparts, &part_tf, &mut installed);
+        install_head_centre(face, head, &mut installed, &mut report.warnings);
+        install_rotated_part_centres(
+            source,
+            &sroles,
+            &drive.rotated,
+            face,
+            &part_tf,
+            frame,
+            &mut installed,
+        );
+        let mut map = part_map(
+            source,
+            &sroles,
+            &part_tf,
+            &drive.driven,
+            &mut report.warnings,
+        );
+        if let Some(sh) = shead {
+            map.entry(sh).or_insert((Role::Head, head));
+        }
+        report.rigid.part_transforms = part_tf
+            .iter()
+            .map(|(&p, &t)| (p, face.transforms[t].name.clone()))
+            .collect();
+        report.rigid.head_transform = Some(face.transforms[head].name.clone());
+        report.rigid.created_transforms = created;
+        report.rigid.installed_centres = installed;
+        warn_unmatched_parts(sparts, tparts, &mut report.warnings);
+        Ok(RigidPlan {
+            map,
+            tongue: part_tf.get(&Part::Tongue).copied(),
+        })
+    }
+}
+
+/// The head transform: the lowest transform enclosing every face mesh, or a new root `head`
+/// above everything (its name goes to `created`).
+fn head_transform(face: &mut FaceModel, tparts: &FaceParts, created: &mut Vec<String>) -> usize {
+    if let Some(h) = lowest_enclosing(face, &tparts.face_meshes()) {
+        return h;
+    }
+    let name = unique_name(face, "head");
+    for t in &mut face.transforms {
+        t.parent = Some(t.parent.map_or(0, |p| p + 1));
+    }
+    for m in &mut face.meshes {
+        m.transform = Some(m.transform.map_or(0, |t| t + 1));
+    }
+    face.transforms
+        .insert(0, FaceTransform::new(name.clone(), None, Vec3::ZERO));
+    created.push(name);
+    0
+}
+
+/// The transform of each target part: its lowest enclosing transform when that holds only
+/// the part (the lower teeth may share theirs with the tongue), else — for `needed` parts — a
+/// new transform (its name goes to `created`).
+fn part_transforms(
+    face: &mut FaceModel,
+    tparts: &FaceParts,
+    head: usize,
+    needed: &BTreeSet<Part>,
+    created: &mut Vec<String>,
+) -> BTreeMap<Part, usize> {
+    let mut part_tf: BTreeMap<Part, usize> = BTreeMap::new();
+    for (&p, meshes) in &tparts.parts {
+        let low = lowest_enclosing(face, meshes);
+        let exclusive = low.is_some_and(|t| {
+            t != head
+                && (0..face.meshes.len()).all(|m| {
+                    !encloses(face, t, m)
+                        || meshes.contains(&m)
+                        || (p == Part::LowerTeeth
+                            && tparts
+                                .parts
+                                .get(&Part::Tongue)
+                                .is_some_and(|x| x.contains(&m)))
+                })
+        });
+        if exclusive {
+            part_tf.insert(p, low.expect("exclusive implies some"));
+        } else if needed.contains(&p) {
+            let (name, new_t) = add_part_transform(face, p, meshes, low.unwrap_or(head));
+            created.push(name);
+            part_tf.insert(p, new_t);
+        }
+    }
+    part_tf
+}
+
+/// Adds a transform for part `p` under `parent` and moves the part's meshes into it, their
+/// world positions unchanged. Returns its name and index.
+fn add_part_transform(
+    face: &mut FaceModel,
+    p: Part,
+    meshes: &[usize],
+    parent: usize,
+) -> (String, usize) {
+    let name = unique_name(face, &format!("{}_tf", p.name()));
+    let frames = face.frames();
+    let parent_world = frames.transforms[parent];
+    face.transforms
+        .push(FaceTransform::new(name.clone(), Some(parent), Vec3::ZERO));
+    let new_t = face.transforms.len() - 1;
+    for &m in meshes {
+        // Re-express the mesh in the new transform's frame (= the parent's).
+        let to_new = parent_world.inverse() * frames.meshes[m];
+        if to_new != Affine3A::IDENTITY {
+            for q in &mut face.meshes[m].mesh.positions {
+                *q = to_new.transform_point3(*q);
+            }
+        }
+        face.meshes[m].transform = Some(new_t);
+    }
+    (name, new_t)
+}
+
+/// Source part transform → target part transform; warns when the source drives a part the
+/// target lacks.
+fn part_map(
+    source: &FaceModel,
+    sroles: &BTreeMap<Part, usize>,
+    part_tf: &BTreeMap<Part, usize>,
+    driven: &HashSet<&str>,
+    warnings: &mut Vec<String>,
+) -> HashMap<usize, (Role, usize)> {
+    let mut map = HashMap::new();
+    for (&p, &st) in sroles {
+        match part_tf.get(&p) {
+            Some(&tt) => {
+                map.entry(st).or_insert((Role::Part(p), tt));
+            }
+            None => {
+                if driven.contains(source.transforms[st].name.as_str()) {
+                    warnings.push(format!(
+                        "target has no {} part: its transform motion is dropped",
+                        p.name()
+                    ));
+                }
+            }
+        }
+    }
+    map
+}
+
+/// Warns about each part only one of the faces has.
+fn warn_unmatched_parts(sparts: &FaceParts, tparts: &FaceParts, warnings: &mut Vec<String>) {
+    for p in Part::ALL {
+        if sparts.parts.contains_key(&p) != tparts.parts.contains_key(&p) {
+            let side = if sparts.parts.contains_key(&p) {
+                "target"
+            } else {
+                "source"
+            };
+            warnings.push(format!("the {side} face has no {} mesh", p.name()));
+        }
+    }
+}

@@ -1,0 +1,227 @@
+//! The skin of a face as one welded [`CloneSurface`], with the way back to its meshes (module
+//! docs of [`super`], step 3).
+
+use std::collections::{BTreeMap, HashMap};
+
+use glam::Vec3;
+
+use super::parts::{face_diagonal, fp_mesh_vertex};
+use super::Similarity;
+use crate::clone::CloneSurface;
+use crate::error::{Error, Result};
+use crate::face::{FaceFrames, FaceModel};
+use crate::fdp::{Fapu, FeaturePoint, FeaturePointSet};
+use crate::mesh::find_coincident_vertices;
+use crate::mesh::geometry::triangulate;
+use crate::spec::FeaturePointId;
+
+/// The skin of a face as a [`CloneSurface`], with the way back to its meshes.
+#[derive(Clone, Debug)]
+pub struct SkinSurface {
+    /// The surface (in the frame it was built in).
+    pub surface: CloneSurface,
+    /// Skin meshes, in concatenation order.
+    pub meshes: Vec<usize>,
+    /// First concatenated index of each skin mesh.
+    pub starts: Vec<usize>,
+    /// Surface vertex of each concatenated vertex.
+    pub welded: Vec<u32>,
+    /// Concatenated vertices of each surface vertex (CSR: `members[member_start[w]..[w+1]]`).
+    member_start: Vec<u32>,
+    members: Vec<u32>,
+}
+
+impl SkinSurface {
+    /// Concatenated vertices behind surface vertex `w`.
+    pub fn duplicates(&self, w: u32) -> &[u32] {
+        let a = self.member_start[w as usize] as usize;
+        let b = self.member_start[w as usize + 1] as usize;
+        &self.members[a..b]
+    }
+
+    /// `(mesh index, local vertex)` of a concatenated vertex.
+    pub fn locate(&self, concat: u32) -> (usize, u32) {
+        let k = self.starts.partition_point(|&s| s <= concat as usize) - 1;
+        (self.meshes[k], concat - self.starts[k] as u32)
+    }
+}
+
+/// Builds the [`CloneSurface`] of `skin` meshes, every position mapped by `frame` (module
+/// docs, step 3).
+pub fn build_skin_surface(
+    face: &FaceModel,
+    skin: &[usize],
+    frame: &Similarity,
+) -> Result<SkinSurface> {
+    let frames = face.frames();
+    let diag = face_diagonal(face, &frames);
+    let (positions, triangles, starts) = concatenate_skin(face, &frames, skin, frame);
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::Invalid(format!(
+            "face `{}`: skin vertex {i} has a non-finite position",
+            face.name
+        )));
+    }
+    let (fp_positions, fapu) = framed_feature_points(face, frame)?;
+    // Weld, keeping the closed mouth apart.
+    let eps = diag * frame.scale as f32 * 1e-6;
+    let mouth = mouth_box(&fp_positions, &fapu);
+    let (welded, surface_positions) = weld_outside_mouth(&positions, eps, mouth);
+    let (member_start, members) = duplicate_lists(&welded, surface_positions.len());
+    let tris: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t: &[u32; 3]| t.map(|v| welded[v as usize]))
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        .collect();
+    let mut fp_vertices = BTreeMap::new();
+    let mesh_slot: HashMap<usize, usize> = skin.iter().enumerate().map(|(k, &m)| (m, k)).collect();
+    for fp in face.feature_points.iter() {
+        if let Some((mi, v)) = fp_mesh_vertex(face, &frames, fp.id, diag * 1e-4) {
+            if let Some(&k) = mesh_slot.get(&mi) {
+                if (v as usize) < face.meshes[mi].mesh.positions.len() {
+                    fp_vertices.insert(fp.id, welded[starts[k] + v as usize]);
+                }
+            }
+        }
+    }
+    Ok(SkinSurface {
+        surface: CloneSurface {
+            positions: surface_positions,
+            triangles: tris,
+            fp_vertices,
+            fp_positions,
+            fapu,
+        },
+        meshes: skin.to_vec(),
+        starts,
+        welded,
+        member_start,
+        members,
+    })
+}
+
+/// The skin meshes placed in the face frame, mapped by `frame` and concatenated:
+/// `(positions, triangles, first index of each mesh)`.
+fn concatenate_skin(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    skin: &[usize],
+    frame: &Similarity,
+) -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<usize>) {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut starts = Vec::new();
+    for &mi in skin {
+        let m = &face.meshes[mi].mesh;
+        let start = positions.len();
+        starts.push(start);
+        positions.extend(
+            m.positions
+                .iter()
+                .map(|&p| frame.point(frames.meshes[mi].transform_point3(p))),
+        );
+        let (tris, _) = triangulate(&m.positions, &m.polygons);
+        triangles.extend(tris.iter().map(|t| t.map(|v| v + start as u32)));
+    }
+    (positions, triangles, starts)
+}
+
+/// The face's placed feature points mapped by `frame`, and the FAPU measured on them.
+fn framed_feature_points(
+    face: &FaceModel,
+    frame: &Similarity,
+) -> Result<(BTreeMap<FeaturePointId, Vec3>, Fapu)> {
+    let mut fp_set = FeaturePointSet::new();
+    let mut fp_positions = BTreeMap::new();
+    for fp in face.feature_points.iter() {
+        if let Some(p) = fp.position {
+            let q = frame.point(p);
+            fp_positions.insert(fp.id, q);
+            fp_set.insert(FeaturePoint::at(fp.id, q));
+        }
+    }
+    let fapu = Fapu::from_feature_points(&fp_set)
+        .map_err(|e| Error::Invalid(format!("face `{}`: {e}", face.name)))?;
+    Ok((fp_positions, fapu))
+}
+
+/// Welds vertices within `eps` of each other, except clusters inside the `mouth` box (a
+/// closed mouth's lips coincide and must stay apart). Returns the surface vertex of every
+/// input vertex and the surface positions.
+fn weld_outside_mouth(positions: &[Vec3], eps: f32, mouth: Option<Box3>) -> (Vec<u32>, Vec<Vec3>) {
+    let coincident = find_coincident_vertices(positions, eps);
+    let mut rep = coincident.representative.clone();
+    for cluster in &coincident.clusters {
+        let p = positions[cluster[0] as usize];
+        if mouth.is_some_and(|b| b.contains(p)) {
+            for &v in cluster {
+                rep[v as usize] = v;
+            }
+        }
+    }
+    let mut welded = vec![u32::MAX; positions.len()];
+    let mut surface_positions = Vec::new();
+    for i in 0..positions.len() {
+        if rep[i] as usize == i {
+            welded[i] = surface_positions.len() as u32;
+            surface_positions.push(positions[i]);
+        }
+    }
+    for i in 0..positions.len() {
+        welded[i] = welded[rep[i] as usize];
+    }
+    (welded, surface_positions)
+}
+
+/// The input vertices behind each of `count` surface vertices, as CSR lists
+/// `(member_start, members)` (see [`SkinSurface::duplicates`]).
+fn duplicate_lists(welded: &[u32], count: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut member_start = vec![0u32; count + 1];
+    for &w in welded {
+        member_start[w as usize + 1] += 1;
+    }
+    for i in 0..count {
+        member_start[i + 1] += member_start[i];
+    }
+    let mut fill = member_start.clone();
+    let mut members = vec![0u32; welded.len()];
+    for (i, &w) in welded.iter().enumerate() {
+        members[fill[w as usize] as usize] = i as u32;
+        fill[w as usize] += 1;
+    }
+    (member_start, members)
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy)]
+struct Box3 {
+    lo: Vec3,
+    hi: Vec3,
+}
+
+impl Box3 {
+    fn contains(&self, p: Vec3) -> bool {
+        p.cmpge(self.lo).all() && p.cmple(self.hi).all()
+    }
+}
+
+/// The box around the closed mouth's lip line: between the lip corners (8.3, 8.4) widened by
+/// 0.1 MW0, ±0.35 MNS0 about the lip line, from half an MW0 behind the corners forward.
+fn mouth_box(fps: &BTreeMap<FeaturePointId, Vec3>, fapu: &Fapu) -> Option<Box3> {
+    let get = |s: &str| {
+        fps.get(&s.parse::<FeaturePointId>().expect("label"))
+            .copied()
+    };
+    let (l, r) = (get("8.3")?, get("8.4")?);
+    let mw = fapu.distances.mw0 as f32;
+    let mns = fapu.distances.mns0 as f32;
+    let lip_y = match (get("2.2"), get("2.3")) {
+        (Some(a), Some(b)) => (a.y + b.y) / 2.0,
+        _ => (l.y + r.y) / 2.0,
+    };
+    let z = l.z.min(r.z);
+    Some(Box3 {
+        lo: Vec3::new(l.x.min(r.x) - 0.1 * mw, lip_y - 0.35 * mns, z - 0.5 * mw),
+        hi: Vec3::new(l.x.max(r.x) + 0.1 * mw, lip_y + 0.35 * mns, f32::INFINITY),
+    })
+}

@@ -1,0 +1,70 @@
+//! Binding `featurePointsCoord` entries to their nearest mesh vertex when a file has no
+//! fbakit record, and the report of each match.
+
+use glam::Vec3;
+use serde::Serialize;
+
+use crate::face::FaceModel;
+use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
+use crate::mesh::VertexIndex;
+use crate::spec::FeaturePointId;
+
+/// How a `featurePointsCoord` entry was matched to a mesh vertex.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FeaturePointMatch {
+    /// The point.
+    pub id: FeaturePointId,
+    /// Mesh it was bound to.
+    pub mesh: String,
+    /// Vertex it was bound to.
+    pub vertex: u32,
+    /// Distance between the given position and the vertex.
+    pub distance: f32,
+}
+
+/// Every `featurePointsCoord` entry (in the standard's label order, at most 84) as a feature
+/// point bound to the nearest vertex of any mesh; each match is appended to `matches`.
+pub(super) fn bind_to_nearest_vertices(
+    points: &[[f32; 3]],
+    model: &FaceModel,
+    matches: &mut Vec<FeaturePointMatch>,
+) -> FeaturePointSet {
+    let mut set = FeaturePointSet::new();
+    let frames = model.frames();
+    let mut owners: Vec<(usize, u32)> = Vec::new();
+    let mut world: Vec<Vec3> = Vec::new();
+    for (mi, m) in model.meshes.iter().enumerate() {
+        for (vi, p) in m.mesh.positions.iter().enumerate() {
+            owners.push((mi, vi as u32));
+            world.push(frames.meshes[mi].transform_point3(*p));
+        }
+    }
+    let index = VertexIndex::new(&world);
+    for (ordinal, p) in points
+        .iter()
+        .enumerate()
+        .take(crate::spec::NUM_FEATURE_POINTS)
+    {
+        let Some(id) = FeaturePointId::from_ordinal(ordinal) else {
+            continue;
+        };
+        let pos = Vec3::from_array(*p);
+        let mut point = FeaturePoint::at(id, pos);
+        if let Some((nearest, distance)) = index.nearest_vertex(pos) {
+            let (mi, vi) = owners[nearest as usize];
+            let mesh = model.meshes[mi].name.clone();
+            point.binding = Some(VertexBinding {
+                mesh: Some(mesh.clone()),
+                vertices: vec![vi],
+            });
+            matches.push(FeaturePointMatch {
+                id,
+                mesh,
+                vertex: vi,
+                distance,
+            });
+        }
+        set.insert(point);
+    }
+    set
+}

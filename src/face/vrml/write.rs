@@ -1,0 +1,140 @@
+//! Writing a face: [`FaceModel`] → VRML scene, patching the face's own scene when it has one
+//! or building a new `Face` (module docs of [`super`], "Writing").
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::bindings::{record_entries, replace_record};
+use super::write_fat::{attach_tables, table_nodes};
+use super::write_geometry::{build_geometry, patch_geometry};
+use crate::error::Result;
+use crate::face::FaceModel;
+use crate::spec::FeaturePointId;
+use crate::vrml::{FieldValue, Node, NodeId, NodeRef, Scene, Statement};
+
+/// Writes a face as a VRML97 file (atomically).
+pub fn write_face_file(path: &Path, face: &FaceModel) -> Result<()> {
+    let scene = face_to_scene(face)?;
+    crate::vrml::write_vrml_file(path, &scene)
+}
+
+/// The VRML text of a face.
+pub fn write_face_string(face: &FaceModel) -> Result<String> {
+    Ok(crate::vrml::write_vrml_string(&face_to_scene(face)?))
+}
+
+/// The VRML scene of a face: its own scene patched, or a new one.
+pub fn face_to_scene(face: &FaceModel) -> Result<Scene> {
+    face.check_structure()?;
+    let mut scene = face.scene.clone().unwrap_or_default();
+    let built_fresh = face.scene.is_none();
+    let geometry = if built_fresh {
+        build_geometry(&mut scene, face)
+    } else {
+        patch_geometry(&mut scene, face)?
+    };
+    let coords = feature_point_coords(face);
+    let record = record_entries(face);
+    let tables = table_nodes(face, &geometry.meshes, &geometry.transforms)?;
+
+    // The record goes before the face nodes so readers meet it first.
+    let info = replace_record(&mut scene, record);
+    let (face_node, fdp, new_face) = find_or_add_fdp(&mut scene);
+    let mut coord = Node::new("Coordinate");
+    coord
+        .fields
+        .push(("point".into(), FieldValue::MFVec3f(coords)));
+    let coord = add(&mut scene, coord);
+    set_field(
+        &mut scene.nodes[fdp.0],
+        "featurePointsCoord",
+        FieldValue::SFNode(Some(coord)),
+    );
+    if built_fresh {
+        set_field(
+            &mut scene.nodes[fdp.0],
+            "faceSceneGraph",
+            FieldValue::MFNode(geometry.roots),
+        );
+    }
+    attach_tables(&mut scene, fdp, tables);
+    // The record goes just before the face's root statement; a new face goes last.
+    let anchor = match new_face {
+        Some(_) => None,
+        None => Some(face_node.unwrap_or(fdp)),
+    };
+    let pos = anchor
+        .and_then(|a| {
+            scene
+                .statements
+                .iter()
+                .position(|s| matches!(s, Statement::Node(r) if r.id == a))
+        })
+        .unwrap_or(scene.statements.len());
+    scene.statements.insert(pos, Statement::Node(info));
+    if let Some(f) = new_face {
+        scene.statements.push(Statement::Node(f));
+    }
+    Ok(scene)
+}
+
+/// All 84 feature points in label order, missing ones at the mean of the present ones
+/// (`featurePointsCoord` must list them all).
+fn feature_point_coords(face: &FaceModel) -> Vec<[f32; 3]> {
+    let with_pos: Vec<Vec3> = face
+        .feature_points
+        .iter()
+        .filter_map(|p| p.position)
+        .collect();
+    let fill = if with_pos.is_empty() {
+        Vec3::ZERO
+    } else {
+        with_pos.iter().sum::<Vec3>() / with_pos.len() as f32
+    };
+    FeaturePointId::all()
+        .map(|id| face.feature_points.position(id).unwrap_or(fill).to_array())
+        .collect()
+}
+
+/// The scene's `Face` node (if any) and its `FDP` (or a bare `FDP`); without one, a new
+/// `Face { fdp FDP {} }` is added and returned as the third value, not yet a root statement.
+fn find_or_add_fdp(scene: &mut Scene) -> (Option<NodeId>, NodeId, Option<NodeRef>) {
+    let face_node = scene.nodes_of_type("Face").next();
+    let fdp = face_node
+        .and_then(|f| scene.get_sfnode(f, "fdp"))
+        .or_else(|| scene.nodes_of_type("FDP").next());
+    match fdp {
+        Some(f) => (face_node, f, None),
+        None => {
+            let fdp = add(scene, Node::new("FDP"));
+            let mut face_n = Node::new("Face");
+            face_n
+                .fields
+                .push(("fdp".into(), FieldValue::SFNode(Some(fdp))));
+            let face_ref = add(scene, face_n);
+            (face_node, fdp.id, Some(face_ref))
+        }
+    }
+}
+
+/// Sets field `name` of `node`, replacing its value or appending it.
+pub(super) fn set_field(node: &mut Node, name: &str, value: FieldValue) {
+    match node.fields.iter_mut().find(|(n, _)| n == name) {
+        Some((_, v)) => *v = value,
+        None => node.fields.push((name.to_string(), value)),
+    }
+}
+
+/// Adds `node` to the scene, referenced by its DEF (not a USE).
+pub(super) fn add(scene: &mut Scene, node: Node) -> NodeRef {
+    NodeRef {
+        id: scene.add_node(node),
+        is_use: false,
+    }
+}
+
+/// A `USE` of node `id`.
+pub(super) fn use_of(id: NodeId) -> NodeRef {
+    NodeRef { id, is_use: true }
+}
