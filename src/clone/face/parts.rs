@@ -48,14 +48,14 @@ impl Part {
 
     /// The feature points that identify the part.
     pub fn feature_points(self) -> Vec<FeaturePointId> {
-        let labels: &[&str] = match self {
-            Part::LeftEye => &["3.5"],
-            Part::RightEye => &["3.6"],
-            Part::UpperTeeth => &["9.8", "9.10"],
-            Part::LowerTeeth => &["9.9", "9.11"],
-            Part::Tongue => &["6.1", "6.2", "6.3", "6.4"],
-        };
-        labels.iter().map(|s| s.parse().expect("label")).collect()
+        use FeaturePointId as F;
+        match self {
+            Part::LeftEye => vec![F::FP_3_5],
+            Part::RightEye => vec![F::FP_3_6],
+            Part::UpperTeeth => vec![F::FP_9_8, F::FP_9_10],
+            Part::LowerTeeth => vec![F::FP_9_9, F::FP_9_11],
+            Part::Tongue => vec![F::FP_6_1, F::FP_6_2, F::FP_6_3, F::FP_6_4],
+        }
     }
 
     /// The part a feature point identifies, if any.

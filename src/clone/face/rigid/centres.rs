@@ -120,7 +120,10 @@ pub(super) fn install_head_centre(
     installed: &mut Vec<(String, [f32; 3])>,
     warnings: &mut Vec<String>,
 ) {
-    match face.feature_points.position("7.1".parse().expect("label")) {
+    match face
+        .feature_points
+        .position(crate::spec::FeaturePointId::FP_7_1)
+    {
         Some(c) => install_recorded(face, head, c, installed),
         None => warnings
             .push("target lacks 7.1 (neck base): the head keeps its centre of rotation".into()),
