@@ -15,6 +15,8 @@
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
 //! - [`player`]: plays FAP streams on faces (FAT evaluation per frame), glTF and OBJ output.
 //! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
+//! - [`rig`]: blendshape rigs (glTF morph targets, OBJ shape folders such as the ICT-FaceKit)
+//!   read into neutral meshes plus named shapes.
 //! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
 //!   cloning grid.
 //! - [`showcase`]: rendered playback frames, contact sheets, the cloning grid and the
@@ -35,6 +37,7 @@ pub mod io;
 pub mod mesh;
 pub mod player;
 pub mod render;
+pub mod rig;
 pub mod showcase;
 pub mod spec;
 pub mod synth;

@@ -15,6 +15,7 @@ pub mod face_export;
 pub mod fap;
 mod fapu;
 pub mod play;
+mod rig;
 mod show;
 
 /// A cloning method on the command line (`--method fmc|rbf`).
@@ -167,6 +168,12 @@ pub enum Command {
         after_help = "Examples:\n  fbakit demo\n  fbakit demo --out /tmp/demo --method rbf --json"
     )]
     Demo(show::DemoArgs),
+    /// Read blendshape rigs (glTF morph targets, OBJ shape folders such as the ICT-FaceKit).
+    #[command(
+        subcommand,
+        after_help = "Example:\n  fbakit rig info ../shared/data/ict-facekit"
+    )]
+    Rig(rig::RigCommand),
 }
 
 #[derive(Debug, clap::Args)]
@@ -193,6 +200,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Eval(cmd) => clone::run_eval(cmd),
         Command::Grid(args) => show::grid(args),
         Command::Demo(args) => show::demo(args),
+        Command::Rig(cmd) => rig::run(cmd),
     };
     match result {
         Ok(code) => ExitCode::from(code),
