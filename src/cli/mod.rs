@@ -12,6 +12,7 @@ mod candide;
 mod clone;
 pub mod face;
 pub mod face_export;
+mod face_from_rig;
 pub mod fap;
 mod fapu;
 pub mod play;

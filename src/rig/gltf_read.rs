@@ -463,20 +463,21 @@ impl Reader<'_> {
                 ));
             }
         }
-        let names =
-            if targets > 0 {
-                match self.target_names(mesh, targets)? {
-                    Some(n) => n,
-                    None => return Err(self.err(
+        let names = if targets > 0 {
+            match self.target_names(mesh, targets)? {
+                Some(n) => n,
+                None => {
+                    return Err(self.err(
                         &format!("meshes[{m}].extras.targetNames"),
                         format!(
                             "{targets} morph targets but no names (a rig's shapes must be named)"
                         ),
-                    )),
+                    ))
                 }
-            } else {
-                Vec::new()
-            };
+            }
+        } else {
+            Vec::new()
+        };
         let mut seen = HashMap::new();
         for (i, n) in names.iter().enumerate() {
             if let Some(j) = seen.insert(n.as_str(), i) {

@@ -15,6 +15,8 @@
 //! Shapes with the same name on several meshes (a head and its teeth both moving under
 //! `jawOpen`) are one shape.
 
+pub mod fap_map;
+pub mod fat_build;
 pub mod gltf_read;
 pub mod gltf_write;
 pub mod obj_folder;
@@ -201,6 +203,16 @@ impl Rig {
             }
         }
         out
+    }
+
+    /// The neutral as a face with a FAT realised through `map` and calibrated on
+    /// `feature_points` (see [`fat_build`]), with the report of what was realised.
+    pub fn to_face_with_fat(
+        &self,
+        feature_points: Option<crate::fdp::FeaturePointSet>,
+        map: &fap_map::FapMap,
+    ) -> Result<(FaceModel, fat_build::RigFatReport)> {
+        fat_build::face_from_rig(self, feature_points, map)
     }
 
     /// The neutral as a face: one [`FaceMesh`] per rig mesh (world space, no transforms), no
