@@ -172,6 +172,49 @@ fn synthetic_rig_calibrates_exactly() {
 }
 
 #[test]
+fn eyeball_rotation_is_calibrated_in_au() {
+    let (mut rig, mut points) = synthetic_rig();
+    // A separate eyeball piece (tetrahedron about c) whose front vertex is the left pupil.
+    let c = Vec3::new(30.0, 40.0, -10.0);
+    let ball = [
+        Vec3::new(30.0, 40.0, 0.0),
+        Vec3::new(40.0, 40.0, -10.0),
+        Vec3::new(30.0, 50.0, -10.0),
+        Vec3::new(20.0, 40.0, -10.0),
+    ];
+    let mesh = &mut rig.meshes[0].mesh;
+    let first = mesh.positions.len() as u32;
+    mesh.positions.extend(ball);
+    for t in [[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]] {
+        mesh.polygons.push(&t.map(|k| first + k));
+    }
+    let turn = glam::Quat::from_axis_angle(Vec3::Y, 0.3);
+    rig.shapes.push(BlendShape {
+        name: "eyeLookOut_L".into(),
+        default_weight: 0.0,
+        deltas: vec![ShapeDelta {
+            mesh: 0,
+            vertices: (first..first + 4).collect(),
+            offsets: ball.iter().map(|&p| turn * (p - c) + c - p).collect(),
+        }],
+    });
+    let mut pupil = FeaturePoint::at(fp("3.5"), ball[0]);
+    pupil.binding = Some(VertexBinding::vertex(first));
+    points.insert(pupil);
+    let (face, report) = face_from_rig(&rig, Some(points), &FapMap::arkit()).unwrap();
+    let yaw = report
+        .calibrated
+        .iter()
+        .find(|c| c.fap == "yaw_l_eyeball")
+        .expect("yaw_l_eyeball calibrated");
+    assert_eq!(yaw.unit, "AU");
+    assert!((yaw.value - 30_000.0).abs() < 1.0, "{}", yaw.value);
+    assert!(face.fat.table(key("yaw_l_eyeball")).is_some());
+    // Looking in is absent from this rig: reported.
+    assert!(report.unmapped.iter().any(|u| u.key == "yaw_l_eyeball (-)"));
+}
+
+#[test]
 fn without_feature_points_only_named_high_level_keys() {
     let (rig, _) = synthetic_rig();
     let (face, report) = face_from_rig(&rig, None, &FapMap::arkit()).unwrap();
