@@ -102,6 +102,9 @@ pub struct RigFatReport {
     pub unused_shapes: Vec<String>,
 }
 
+/// Motion of `(mesh, vertex)` pairs.
+type SparseMotion = BTreeMap<(usize, u32), Vec3>;
+
 /// One side of one FAP waiting for calibration.
 struct Use {
     fap: FapId,
@@ -210,7 +213,7 @@ pub fn face_from_rig(
 
     // 2. Partition shared shapes, calibrate, drop failures, repeat until stable.
     let mut components: HashMap<usize, Vec<u32>> = HashMap::new();
-    let mut calibrated: Vec<(usize, f64, BTreeMap<(usize, u32), Vec3>)> = Vec::new();
+    let mut calibrated: Vec<(usize, f64, SparseMotion)> = Vec::new();
     let mut alive: Vec<bool> = vec![true; uses.len()];
     for _round in 0..8 {
         calibrated.clear();
@@ -410,7 +413,7 @@ fn rotation_axis(fap: FapId) -> Option<Vec3> {
 fn add_shapes(
     rig: &Rig,
     terms: &[(usize, f64)],
-    delta: &mut BTreeMap<(usize, u32), Vec3>,
+    delta: &mut SparseMotion,
     share: impl Fn(usize, Vec3) -> f32,
 ) {
     for &(s, w) in terms {
@@ -428,7 +431,7 @@ fn add_shapes(
 
 /// Each live use's motion, shared shapes split by inverse-square distance to the feature
 /// points of the live uses sharing them (module docs).
-fn partition(rig: &Rig, uses: &[Use], alive: &[bool]) -> Vec<BTreeMap<(usize, u32), Vec3>> {
+fn partition(rig: &Rig, uses: &[Use], alive: &[bool]) -> Vec<SparseMotion> {
     let mut sharers: HashMap<usize, Vec<usize>> = HashMap::new();
     for (u, use_) in uses.iter().enumerate() {
         if alive[u] {
@@ -480,7 +483,7 @@ fn morph_target(
     rig: &Rig,
     key: TableKey,
     value: f64,
-    delta: &BTreeMap<(usize, u32), Vec3>,
+    delta: &SparseMotion,
 ) -> MorphTarget {
     let mut meshes: Vec<MorphMesh> = Vec::new();
     for (&(mi, v), &o) in delta {
@@ -510,7 +513,7 @@ fn morph_target(
 fn high_level_table(
     rig: &Rig,
     key: TableKey,
-    delta: &BTreeMap<(usize, u32), Vec3>,
+    delta: &SparseMotion,
 ) -> FaceDefTable {
     let mut t = FaceDefTable::new(key);
     let full = HIGH_LEVEL_FULL as f32;
@@ -570,7 +573,7 @@ fn connected_components(mesh: &crate::mesh::Mesh) -> Vec<u32> {
 fn eyeball_angle(
     rig: &Rig,
     use_: &Use,
-    delta: &BTreeMap<(usize, u32), Vec3>,
+    delta: &SparseMotion,
     components: &[u32],
 ) -> std::result::Result<f64, String> {
     let axis = rotation_axis(use_.fap).ok_or("no eyeball axis")?;
