@@ -412,3 +412,25 @@ fn ict_rig_becomes_a_compliant_fat_face() {
     // Every viseme and expression has a table.
     assert_eq!(report.high_level.len(), 20, "{:?}", report.high_level);
 }
+
+#[test]
+fn custom_map_lists_faps_it_has_no_row_for() {
+    let (rig, points) = synthetic_rig();
+    let p = Path::new("custom.csv");
+    let map = parse_fap_map(
+        p,
+        "fap,positive,negative,reasoning\nopen_jaw,jawOpen,,the jaw\nviseme_10,aa,,VRM aa\n",
+    )
+    .unwrap();
+    map.check_against(&rig, p).unwrap();
+    let (face, report) = face_from_rig(&rig, Some(points), &map).unwrap();
+    assert_eq!(report.calibrated.len(), 1);
+    assert!(face.fat.table(key("open_jaw")).is_some());
+    let no_row = report
+        .unmapped
+        .iter()
+        .filter(|u| u.reason == "no row in the map")
+        .count();
+    assert_eq!(no_row, 65);
+    assert!(report.unused_shapes.contains(&"mouthSmile_L".to_string()));
+}

@@ -148,7 +148,8 @@ pub struct ShapeLookup {
 }
 
 impl ShapeLookup {
-    /// The lookup for `rig` (exact names first, then normalised ones).
+    /// The lookup for `rig` by normalised name (when two shapes normalise alike, the first
+    /// in the rig wins).
     pub fn new(rig: &Rig) -> Self {
         let mut by_name = HashMap::new();
         for (i, s) in rig.shapes.iter().enumerate() {

@@ -211,6 +211,15 @@ pub fn face_from_rig(
         }
     }
 
+    for fap in FapId::low_level().filter(|f| !f.is_high_level()) {
+        if map.row(TableKey::LowLevel(fap)).is_none() {
+            report.unmapped.push(Unmapped {
+                key: fap.name().into(),
+                reason: "no row in the map".into(),
+            });
+        }
+    }
+
     // 2. Partition shared shapes, calibrate, drop failures, repeat until stable.
     let mut components: HashMap<usize, Vec<u32>> = HashMap::new();
     let mut calibrated: Vec<(usize, f64, SparseMotion)> = Vec::new();
@@ -479,12 +488,7 @@ fn share_of(u: usize, list: &[usize], uses: &[Use], p: Vec3) -> f32 {
 }
 
 /// The morph target of `key` at `value` from a sparse delta.
-fn morph_target(
-    rig: &Rig,
-    key: TableKey,
-    value: f64,
-    delta: &SparseMotion,
-) -> MorphTarget {
+fn morph_target(rig: &Rig, key: TableKey, value: f64, delta: &SparseMotion) -> MorphTarget {
     let mut meshes: Vec<MorphMesh> = Vec::new();
     for (&(mi, v), &o) in delta {
         if o == Vec3::ZERO {
@@ -510,11 +514,7 @@ fn morph_target(
 }
 
 /// A high-level table `[0, 63]` showing `delta` at full strength.
-fn high_level_table(
-    rig: &Rig,
-    key: TableKey,
-    delta: &SparseMotion,
-) -> FaceDefTable {
+fn high_level_table(rig: &Rig, key: TableKey, delta: &SparseMotion) -> FaceDefTable {
     let mut t = FaceDefTable::new(key);
     let full = HIGH_LEVEL_FULL as f32;
     for (&(mi, v), &o) in delta {

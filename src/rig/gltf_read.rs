@@ -84,7 +84,14 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
             return Err(located(path, &at, "non-finite transform"));
         }
         if let Some(mesh) = node.mesh() {
-            reader.mesh_instance(&node, &mesh, world)?;
+            // A skinned mesh ignores its node's transform (glTF 2.0, 3.7.3): its vertices are
+            // read in the bind pose.
+            let placed = if node.skin().is_some() {
+                Mat4::IDENTITY
+            } else {
+                world
+            };
+            reader.mesh_instance(&node, &mesh, placed)?;
         }
         let children: Vec<_> = node.children().collect();
         for c in children.into_iter().rev() {
