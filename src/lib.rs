@@ -15,6 +15,8 @@
 //! - [`candide`]: the CANDIDE-3 parameterised face (`.wfm` reader, shape and animation units).
 //! - [`player`]: plays FAP streams on faces (FAT evaluation per frame, one frame at a time).
 //! - [`face`]: complete face models (meshes, transforms, feature points, FAT) and VRML face files.
+//! - [`rig`]: blendshape rigs (glTF morph targets, OBJ shape folders such as the ICT-FaceKit)
+//!   read into neutral meshes plus named shapes.
 //! - [`render`]: CPU software renderer: shaded PNG frames, turntables, contact sheets and the
 //!   cloning grid.
 //! - [`export`]: outputs — glTF with morph targets and animation, OBJ frame sequences,
@@ -46,6 +48,7 @@ pub mod mesh;
 pub mod player;
 pub mod prelude;
 pub mod render;
+pub mod rig;
 pub mod spec;
 pub mod speech;
 pub mod synth;

@@ -68,6 +68,23 @@ pub enum FaceCommand {
                       fbakit face export samples/faces/bruno.wrl.gz -o bruno.gltf"
     )]
     Export(super::face_export::FaceExportArgs),
+    /// Build a face with a FAP-compliant FAT from a blendshape rig (ARKit names by default).
+    #[command(
+        long_about = "Build a face with a FAT from a blendshape rig (glTF morph targets or a \
+                      folder of shape OBJs). A mapping table says which shapes realise which \
+                      FAP and with which sign (--map arkit: the built-in ARKit-52 table, \
+                      specs/arkit-fap-map.csv; or a CSV with the columns \
+                      fap,positive,negative,reasoning). Each FAP is calibrated on the rig: how \
+                      far its feature point moves at shape weight 1 along the FAP's direction, \
+                      in the face's FAP unit, so the FAT is FAP-compliant (smile/frown become \
+                      the two intervals of one FAP). Eyeball FAPs are measured as rotations. \
+                      Visemes and expressions come from named shapes (VRM aa, happy, ...) or \
+                      from low-level FAPs. Keys not realised and shapes not used are listed.",
+        after_help = "Examples:\n  fbakit face from-rig ../shared/data/ict-facekit --fp ict-fp.csv -o ict.wrl\n  \
+                      fbakit face from-rig avatar.glb --fp avatar.xml -o avatar-fat.glb --json\n  \
+                      fbakit face from-rig head/ --map my-map.csv --fp head.csv -o head.wrl"
+    )]
+    FromRig(super::face_from_rig::FromRigArgs),
 }
 
 /// Arguments of `face info`.
@@ -148,6 +165,7 @@ pub fn run(cmd: FaceCommand) -> Result<u8> {
         FaceCommand::FromMorphs(a) => from_morphs(a),
         FaceCommand::ToMorphs(a) => to_morphs(a),
         FaceCommand::Export(a) => super::face_export::run_face_export(a),
+        FaceCommand::FromRig(a) => super::face_from_rig::run(a),
     }
 }
 

@@ -12,10 +12,12 @@ mod candide;
 mod clone;
 pub mod face;
 pub mod face_export;
+mod face_from_rig;
 pub mod fap;
 mod fapu;
 pub mod play;
 mod render;
+mod rig;
 mod show;
 mod speak;
 mod view;
@@ -222,6 +224,12 @@ pub enum Command {
                       fbakit speak \"Hello\" --mouth faps -o hello-candide.fap --json"
     )]
     Speak(speak::SpeakArgs),
+    /// Read blendshape rigs (glTF morph targets, OBJ shape folders such as the ICT-FaceKit).
+    #[command(
+        subcommand,
+        after_help = "Example:\n  fbakit rig info ../shared/data/ict-facekit"
+    )]
+    Rig(rig::RigCommand),
 }
 
 #[derive(Debug, clap::Args)]
@@ -251,6 +259,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::View(args) => view::run(args),
         Command::Render(args) => render::run(args),
         Command::Speak(args) => speak::run(args),
+        Command::Rig(cmd) => rig::run(cmd),
     };
     match result {
         Ok(code) => ExitCode::from(code),

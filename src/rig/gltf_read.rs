@@ -1,0 +1,788 @@
+//! glTF 2.0 rigs: `.glb`, and `.gltf` with external or `data:` URI buffers, read with the
+//! maintained `gltf` crate.
+//!
+//! Every mesh instance of the default scene (or the first scene) becomes one [`RigMesh`] per
+//! triangle primitive, in world space (node transforms applied to positions, normals and
+//! morph deltas). Morph targets are named by `mesh.extras.targetNames` (the convention
+//! Blender and three.js write; a primitive's own `extras.targetNames` is accepted too);
+//! targets of the same name on several meshes are one [`BlendShape`]. Default weights come
+//! from `node.weights`, else `mesh.weights`. Sparse accessors are read through the crate.
+//!
+//! The reader is bounded and never trusts counts: before the crate touches an accessor, its
+//! type, count and byte ranges are checked against the buffers actually loaded, so a hostile
+//! file is an error naming the file and the JSON path (`meshes[0].primitives[1].targets[3]`),
+//! never a panic or a huge allocation. Points and lines are skipped with a warning; strips and
+//! fans are turned into triangles.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::buffer::Source;
+use ::gltf::mesh::{Mode, Semantic};
+use ::gltf::{Accessor, Document, Gltf};
+use glam::{Mat3, Mat4, Vec2, Vec3};
+
+use super::{BlendShape, Rig, RigMesh, ShapeDelta, MAX_RIG_SHAPES, MAX_RIG_VERTICES};
+use crate::error::{Error, Result};
+use crate::mesh::{FaceGroup, Mesh, Polygons};
+
+/// Largest glTF file (and each external buffer) read: 1 GiB.
+pub const MAX_GLTF_BYTES: u64 = 1 << 30;
+
+/// Most elements one accessor may declare.
+pub const MAX_ACCESSOR_COUNT: usize = 16 << 20;
+
+/// Deepest node hierarchy followed.
+const MAX_NODE_DEPTH: usize = 256;
+
+/// Reads a glTF rig from `path` (`.glb` or `.gltf`). A file without morph targets reads as a
+/// rig without shapes (use [`super::read_rig`] to require them).
+pub fn read_gltf(path: &Path) -> Result<Rig> {
+    let bytes = crate::io::read_bounded(path, MAX_GLTF_BYTES)?;
+    read_gltf_bytes(&bytes, path)
+}
+
+/// Reads a glTF rig from memory; `path` names the file in errors and locates external buffers.
+pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
+    let gltf = Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(path, e))?;
+    validate(&gltf.document, path)?;
+    let buffers = load_buffers(&gltf, path)?;
+    let mut reader = Reader {
+        file: path,
+        doc: &gltf.document,
+        buffers: &buffers,
+        rig: Rig {
+            name: super::rig_name(path),
+            meshes: Vec::new(),
+            shapes: Vec::new(),
+            warnings: Vec::new(),
+        },
+        shape_by_name: HashMap::new(),
+        vertices: 0,
+        mesh_names: HashMap::new(),
+    };
+    reader.check_views()?;
+    let scene = gltf
+        .default_scene()
+        .or_else(|| gltf.scenes().next())
+        .ok_or_else(|| located(path, "scenes", "no scene to read"))?;
+    let mut stack: Vec<(::gltf::Node, Mat4, usize)> =
+        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    stack.reverse();
+    let mut seen = vec![false; gltf.nodes().len()];
+    while let Some((node, parent, depth)) = stack.pop() {
+        let at = format!("nodes[{}]", node.index());
+        if std::mem::replace(&mut seen[node.index()], true) {
+            return Err(located(path, &at, "appears twice in the scene's node tree"));
+        }
+        if depth > MAX_NODE_DEPTH {
+            return Err(located(path, &at, "node tree deeper than 256 levels"));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(located(path, &at, "non-finite transform"));
+        }
+        if let Some(mesh) = node.mesh() {
+            // A skinned mesh ignores its node's transform (glTF 2.0, 3.7.3): its vertices are
+            // read in the bind pose.
+            let placed = if node.skin().is_some() {
+                Mat4::IDENTITY
+            } else {
+                world
+            };
+            reader.mesh_instance(&node, &mesh, placed)?;
+        }
+        let children: Vec<_> = node.children().collect();
+        for c in children.into_iter().rev() {
+            stack.push((c, world, depth + 1));
+        }
+    }
+    reader.rig.check()?;
+    Ok(reader.rig)
+}
+
+/// An error at JSON path `at` of `file`.
+fn located(file: &Path, at: &str, what: impl std::fmt::Display) -> Error {
+    Error::Invalid(format!("{}: {at}: {what}", file.display()))
+}
+
+/// The `gltf` crate's validation, less two findings that valid files trigger: accessors
+/// without `min`/`max` (only required for positions, unused here) and accessors without a
+/// `bufferView` (allowed by the glTF spec: they read as zeros, see [`Reader::check_accessor`]).
+fn validate(doc: &Document, file: &Path) -> Result<()> {
+    use ::gltf::json::validation::{Error as V, Validate};
+    let mut errors = Vec::new();
+    doc.as_json().validate(
+        doc.as_json(),
+        ::gltf::json::Path::new,
+        &mut |path, error| {
+            let p = path();
+            let s = p.as_str();
+            let benign = error == V::Missing
+                && (s.ends_with(".min")
+                    || s.ends_with(".max")
+                    || (s.starts_with("accessors[") && s.ends_with("].bufferView")));
+            if !benign {
+                errors.push((p, error));
+            }
+        },
+    );
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(gltf_error(file, ::gltf::Error::Validation(errors)))
+    }
+}
+
+fn gltf_error(file: &Path, e: ::gltf::Error) -> Error {
+    match e {
+        ::gltf::Error::Validation(list) => {
+            let shown: Vec<String> = list
+                .iter()
+                .take(5)
+                .map(|(p, e)| format!("{p}: {e}"))
+                .collect();
+            let more = list.len().saturating_sub(5);
+            Error::Invalid(format!(
+                "{}: invalid glTF: {}{}",
+                file.display(),
+                shown.join("; "),
+                if more > 0 {
+                    format!(" (and {more} more)")
+                } else {
+                    String::new()
+                }
+            ))
+        }
+        ::gltf::Error::Io(io) => Error::io(file, io),
+        other => Error::Invalid(format!(
+            "{}: not a readable glTF file: {other}",
+            file.display()
+        )),
+    }
+}
+
+/// The bytes of every buffer, checked against the declared `byteLength`.
+fn load_buffers(gltf: &Gltf, file: &Path) -> Result<Vec<Vec<u8>>> {
+    let mut out = Vec::new();
+    for b in gltf.buffers() {
+        let at = format!("buffers[{}]", b.index());
+        let data = match b.source() {
+            Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| located(file, &at, "refers to a GLB binary chunk the file lacks"))?,
+            Source::Uri(uri) => buffer_from_uri(file, &at, uri)?,
+        };
+        if data.len() < b.length() {
+            return Err(located(
+                file,
+                &at,
+                format!(
+                    "byteLength is {} but the data has {} bytes",
+                    b.length(),
+                    data.len()
+                ),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+fn buffer_from_uri(file: &Path, at: &str, uri: &str) -> Result<Vec<u8>> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, payload) = rest
+            .split_once(";base64,")
+            .ok_or_else(|| located(file, at, "a data URI must be base64 (`;base64,`)"))?;
+        return crate::gltf::container::base64_decode(payload)
+            .ok_or_else(|| located(file, at, "the data URI is not valid base64"));
+    }
+    if uri.contains("://") || uri.starts_with('/') || uri.starts_with('\\') {
+        return Err(located(
+            file,
+            at,
+            format!("buffer `{uri}` is not a relative file reference (only local files and data URIs are read)"),
+        ));
+    }
+    let rel = percent_decode(uri)
+        .ok_or_else(|| located(file, at, format!("`{uri}` is not a valid URI")))?;
+    let dir = file.parent().unwrap_or(Path::new("."));
+    let target: PathBuf = dir.join(rel);
+    crate::io::read_bounded(&target, MAX_GLTF_BYTES)
+}
+
+/// `%XX` decoding of a relative URI (UTF-8); `None` for malformed escapes.
+fn percent_decode(s: &str) -> Option<String> {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' {
+            let hex = std::str::from_utf8(b.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+struct Reader<'a> {
+    file: &'a Path,
+    doc: &'a Document,
+    buffers: &'a [Vec<u8>],
+    rig: Rig,
+    shape_by_name: HashMap<String, usize>,
+    vertices: usize,
+    mesh_names: HashMap<String, usize>,
+}
+
+/// The element an accessor must hold for the crate's typed readers.
+#[derive(Clone, Copy)]
+enum Want {
+    /// `VEC3` of `f32` (positions, normals, morph deltas).
+    Vec3F32,
+    /// `VEC2` of `f32`, or normalised `u8`/`u16` (texture coordinates).
+    TexCoord,
+    /// `SCALAR` `u8`/`u16`/`u32` (indices).
+    Index,
+}
+
+impl Reader<'_> {
+    fn err(&self, at: &str, what: impl std::fmt::Display) -> Error {
+        located(self.file, at, what)
+    }
+
+    /// Every buffer view lies inside its buffer's loaded data.
+    fn check_views(&self) -> Result<()> {
+        for v in self.doc.views() {
+            let end = v.offset().checked_add(v.length());
+            let len = self.buffers[v.buffer().index()].len();
+            if end.is_none_or(|e| e > len) {
+                return Err(self.err(
+                    &format!("bufferViews[{}]", v.index()),
+                    format!("byte range past the end of buffer {}", v.buffer().index()),
+                ));
+            }
+            if v.stride().is_some_and(|s| !(4..=252).contains(&s)) {
+                return Err(self.err(
+                    &format!("bufferViews[{}]", v.index()),
+                    "byteStride must lie in 4..=252",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks type, count and byte ranges of `acc` (at JSON path `at`) so the crate's
+    /// iterators stay in bounds; `count` is the element count required, if any.
+    fn check_accessor(
+        &self,
+        acc: &Accessor,
+        at: &str,
+        want: Want,
+        count: Option<usize>,
+    ) -> Result<()> {
+        let at = format!("{at} (accessors[{}])", acc.index());
+        let ok_type = match want {
+            Want::Vec3F32 => {
+                acc.dimensions() == Dimensions::Vec3 && acc.data_type() == DataType::F32
+            }
+            Want::TexCoord => {
+                acc.dimensions() == Dimensions::Vec2
+                    && match acc.data_type() {
+                        DataType::F32 => true,
+                        DataType::U8 | DataType::U16 => acc.normalized(),
+                        _ => false,
+                    }
+            }
+            Want::Index => {
+                acc.dimensions() == Dimensions::Scalar
+                    && matches!(
+                        acc.data_type(),
+                        DataType::U8 | DataType::U16 | DataType::U32
+                    )
+            }
+        };
+        if !ok_type {
+            let wanted = match want {
+                Want::Vec3F32 => "VEC3 of FLOAT",
+                Want::TexCoord => "VEC2 of FLOAT (or normalised unsigned byte/short)",
+                Want::Index => "SCALAR unsigned byte/short/int",
+            };
+            return Err(self.err(
+                &at,
+                format!(
+                    "expected {wanted}, found {:?} of {:?}",
+                    acc.dimensions(),
+                    acc.data_type()
+                ),
+            ));
+        }
+        let n = acc.count();
+        if n == 0 || n > MAX_ACCESSOR_COUNT {
+            return Err(self.err(&at, format!("count {n} outside 1..={MAX_ACCESSOR_COUNT}")));
+        }
+        if let Some(c) = count {
+            if n != c {
+                return Err(self.err(&at, format!("count {n}, expected {c} (one per vertex)")));
+            }
+        }
+        let elem = acc.size();
+        if let Some(view) = acc.view() {
+            self.check_range(&at, view.length(), view.stride(), acc.offset(), n, elem)?;
+        }
+        if let Some(sparse) = acc.sparse() {
+            let k = sparse.count();
+            if k == 0 || k > n {
+                return Err(self.err(
+                    &format!("{at}.sparse"),
+                    format!("count {k} outside 1..={n}"),
+                ));
+            }
+            let idx = sparse.indices();
+            let isize = idx.index_type().size();
+            self.check_range(
+                &format!("{at}.sparse.indices"),
+                idx.view().length(),
+                idx.view().stride(),
+                idx.offset(),
+                k,
+                isize,
+            )?;
+            let vals = sparse.values();
+            self.check_range(
+                &format!("{at}.sparse.values"),
+                vals.view().length(),
+                vals.view().stride(),
+                vals.offset(),
+                k,
+                elem,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// `count` elements of `elem` bytes every `stride` bytes from `offset` fit in `len` bytes.
+    fn check_range(
+        &self,
+        at: &str,
+        len: usize,
+        stride: Option<usize>,
+        offset: usize,
+        count: usize,
+        elem: usize,
+    ) -> Result<()> {
+        let stride = stride.unwrap_or(elem);
+        if stride < elem {
+            return Err(self.err(
+                at,
+                format!("byteStride {stride} is below the element size {elem}"),
+            ));
+        }
+        let end = stride
+            .checked_mul(count - 1)
+            .and_then(|x| x.checked_add(elem))
+            .and_then(|x| x.checked_add(offset));
+        if end.is_none_or(|e| e > len) {
+            return Err(self.err(at, "data runs past the end of its bufferView"));
+        }
+        Ok(())
+    }
+
+    fn unique_mesh_name(&mut self, base: String) -> String {
+        let n = self.mesh_names.entry(base.clone()).or_insert(0);
+        *n += 1;
+        if *n == 1 {
+            base
+        } else {
+            format!("{base}_{n}")
+        }
+    }
+
+    /// Target names of `mesh`: `mesh.extras.targetNames`, else the first primitive's.
+    fn target_names(&self, mesh: &::gltf::Mesh, targets: usize) -> Result<Option<Vec<String>>> {
+        let m = mesh.index();
+        let mut sources = vec![(format!("meshes[{m}].extras.targetNames"), mesh.extras())];
+        if let Some(p) = mesh.primitives().next() {
+            sources.push((
+                format!("meshes[{m}].primitives[0].extras.targetNames"),
+                p.extras(),
+            ));
+        }
+        for (at, extras) in sources {
+            let Some(raw) = extras else { continue };
+            let value: serde_json::Value = serde_json::from_str(raw.get())
+                .map_err(|e| self.err(&at, format!("extras are not JSON: {e}")))?;
+            let Some(names) = value.get("targetNames") else {
+                continue;
+            };
+            let arr = names
+                .as_array()
+                .ok_or_else(|| self.err(&at, "must be an array of strings"))?;
+            let mut out = Vec::with_capacity(arr.len().min(MAX_RIG_SHAPES));
+            for (i, n) in arr.iter().enumerate() {
+                match n.as_str() {
+                    Some(s) if !s.trim().is_empty() => out.push(s.to_string()),
+                    _ => {
+                        return Err(self.err(
+                            &format!("{at}[{i}]"),
+                            "a morph target needs a non-empty name",
+                        ))
+                    }
+                }
+            }
+            if out.len() != targets {
+                return Err(self.err(
+                    &at,
+                    format!(
+                        "{} names for {targets} morph targets (the counts must match)",
+                        out.len()
+                    ),
+                ));
+            }
+            return Ok(Some(out));
+        }
+        Ok(None)
+    }
+
+    fn mesh_instance(
+        &mut self,
+        node: &::gltf::Node,
+        mesh: &::gltf::Mesh,
+        world: Mat4,
+    ) -> Result<()> {
+        let m = mesh.index();
+        let prims: Vec<_> = mesh.primitives().collect();
+        let targets = prims.first().map_or(0, |p| p.morph_targets().len());
+        for (p, prim) in prims.iter().enumerate() {
+            if prim.morph_targets().len() != targets {
+                return Err(self.err(
+                    &format!("meshes[{m}].primitives[{p}].targets"),
+                    format!(
+                        "{} morph targets, but primitive 0 has {targets} (all primitives of a mesh must have the same)",
+                        prim.morph_targets().len()
+                    ),
+                ));
+            }
+        }
+        let names = if targets > 0 {
+            match self.target_names(mesh, targets)? {
+                Some(n) => n,
+                None => {
+                    return Err(self.err(
+                        &format!("meshes[{m}].extras.targetNames"),
+                        format!(
+                            "{targets} morph targets but no names (a rig's shapes must be named)"
+                        ),
+                    ))
+                }
+            }
+        } else {
+            Vec::new()
+        };
+        let mut seen = HashMap::new();
+        for (i, n) in names.iter().enumerate() {
+            if let Some(j) = seen.insert(n.as_str(), i) {
+                return Err(self.err(
+                    &format!("meshes[{m}].extras.targetNames[{i}]"),
+                    format!("`{n}` also names target {j}"),
+                ));
+            }
+        }
+        let weights = match node.weights().or(mesh.weights()) {
+            Some(w) if w.len() != targets => {
+                let at = if node.weights().is_some() {
+                    format!("nodes[{}].weights", node.index())
+                } else {
+                    format!("meshes[{m}].weights")
+                };
+                return Err(self.err(
+                    &at,
+                    format!("{} weights for {targets} morph targets", w.len()),
+                ));
+            }
+            Some(w) => w.to_vec(),
+            None => vec![0.0; targets],
+        };
+        if let Some(i) = weights.iter().position(|w| !w.is_finite()) {
+            return Err(self.err(&format!("meshes[{m}].weights[{i}]"), "non-finite weight"));
+        }
+        // Shape indices for this mesh's targets, creating shapes on first sight.
+        let mut shape_ids = Vec::with_capacity(targets);
+        for (t, name) in names.iter().enumerate() {
+            let id = match self.shape_by_name.get(name) {
+                Some(&id) => id,
+                None => {
+                    if self.rig.shapes.len() >= MAX_RIG_SHAPES {
+                        return Err(self.err(
+                            &format!("meshes[{m}]"),
+                            format!("more than {MAX_RIG_SHAPES} blend shapes"),
+                        ));
+                    }
+                    self.rig.shapes.push(BlendShape {
+                        name: name.clone(),
+                        default_weight: weights[t],
+                        deltas: Vec::new(),
+                    });
+                    self.shape_by_name
+                        .insert(name.clone(), self.rig.shapes.len() - 1);
+                    self.rig.shapes.len() - 1
+                }
+            };
+            shape_ids.push(id);
+        }
+        let base = node
+            .name()
+            .or(mesh.name())
+            .map_or_else(|| format!("mesh{m}"), str::to_string);
+        for (p, prim) in prims.iter().enumerate() {
+            let at = format!("meshes[{m}].primitives[{p}]");
+            let name = if prims.len() > 1 {
+                format!("{base}.{p}")
+            } else {
+                base.clone()
+            };
+            self.primitive(prim, &at, name, world, &shape_ids)?;
+        }
+        Ok(())
+    }
+
+    fn primitive(
+        &mut self,
+        prim: &::gltf::Primitive,
+        at: &str,
+        name: String,
+        world: Mat4,
+        shape_ids: &[usize],
+    ) -> Result<()> {
+        match prim.mode() {
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan => {}
+            other => {
+                self.rig.warnings.push(format!(
+                    "{}: {at}: {other:?} primitive skipped (only triangles are faces)",
+                    self.file.display()
+                ));
+                return Ok(());
+            }
+        }
+        let pos_acc = prim
+            .get(&Semantic::Positions)
+            .ok_or_else(|| self.err(&format!("{at}.attributes"), "no POSITION"))?;
+        self.check_accessor(
+            &pos_acc,
+            &format!("{at}.attributes.POSITION"),
+            Want::Vec3F32,
+            None,
+        )?;
+        let n = pos_acc.count();
+        if self.vertices + n > MAX_RIG_VERTICES {
+            return Err(self.err(at, format!("the rig exceeds {MAX_RIG_VERTICES} vertices")));
+        }
+        self.vertices += n;
+        let normal_acc = prim.get(&Semantic::Normals);
+        if let Some(a) = &normal_acc {
+            self.check_accessor(
+                a,
+                &format!("{at}.attributes.NORMAL"),
+                Want::Vec3F32,
+                Some(n),
+            )?;
+        }
+        let uv_acc = prim.get(&Semantic::TexCoords(0));
+        if let Some(a) = &uv_acc {
+            self.check_accessor(
+                a,
+                &format!("{at}.attributes.TEXCOORD_0"),
+                Want::TexCoord,
+                Some(n),
+            )?;
+        }
+        if let Some(a) = prim.indices() {
+            self.check_accessor(&a, &format!("{at}.indices"), Want::Index, None)?;
+        }
+        let targets: Vec<_> = prim.morph_targets().collect();
+        for (t, target) in targets.iter().enumerate() {
+            if let Some(a) = target.positions() {
+                self.check_accessor(
+                    &a,
+                    &format!("{at}.targets[{t}].POSITION"),
+                    Want::Vec3F32,
+                    Some(n),
+                )?;
+            }
+        }
+
+        let buffers = self.buffers;
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|v| v.as_slice()));
+        let linear = Mat3::from_mat4(world);
+        let normal_m = linear.inverse().transpose();
+        // No bufferView and no sparse values: all zeros (glTF 2.0, 3.6.2.3).
+        let local: Vec<Vec3> = reader
+            .read_positions()
+            .map_or_else(|| vec![Vec3::ZERO; n], |r| r.map(Vec3::from).collect());
+        if let Some(i) = local.iter().position(|p| !p.is_finite()) {
+            return Err(self.err(
+                &format!("{at}.attributes.POSITION"),
+                format!("vertex {i} has a non-finite coordinate"),
+            ));
+        }
+        let positions: Vec<Vec3> = local.iter().map(|&p| world.transform_point3(p)).collect();
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(r) => r.into_u32().collect(),
+            None => (0..n as u32).collect(),
+        };
+        if let Some(i) = indices.iter().position(|&i| i as usize >= n) {
+            return Err(self.err(
+                &format!("{at}.indices"),
+                format!("index {} at {i} is past the {n} vertices", indices[i]),
+            ));
+        }
+        let triangles = triangles(prim.mode(), &indices);
+        if prim.mode() == Mode::Triangles && indices.len() % 3 != 0 {
+            self.rig.warnings.push(format!(
+                "{}: {at}: {} indices is not a multiple of 3; the last {} ignored",
+                self.file.display(),
+                indices.len(),
+                indices.len() % 3
+            ));
+        }
+        // glTF winding is counter-clockwise; a mirroring transform flips it.
+        let flip = linear.determinant() < 0.0;
+        let polygons =
+            Polygons::from_lists(triangles.iter().map(
+                |t| {
+                    if flip {
+                        [t[0], t[2], t[1]]
+                    } else {
+                        *t
+                    }
+                },
+            ));
+        let mut mesh = Mesh {
+            name: name.clone(),
+            positions,
+            polygons: polygons.clone(),
+            ..Mesh::default()
+        };
+        if normal_acc.is_some() {
+            if let Some(r) = reader.read_normals() {
+                let normals: Vec<Vec3> = r
+                    .map(|v| (normal_m * Vec3::from(v)).normalize_or_zero())
+                    .collect();
+                if normals.iter().all(|v| v.is_finite()) {
+                    mesh.normals = normals;
+                    mesh.normal_polygons = Some(polygons.clone());
+                }
+            }
+        }
+        if uv_acc.is_some() {
+            if let Some(r) = reader.read_tex_coords(0) {
+                let uvs: Vec<Vec2> = r.into_f32().map(Vec2::from).collect();
+                if uvs.iter().all(|v| v.is_finite()) {
+                    mesh.uvs = uvs;
+                    mesh.uv_polygons = Some(polygons.clone());
+                }
+            }
+        }
+        if let Some(material) = prim.material().name() {
+            mesh.groups.push(FaceGroup {
+                material: Some(material.to_string()),
+                ..FaceGroup::default()
+            });
+        }
+        let mesh_index = self.rig.meshes.len();
+        let unique = self.unique_mesh_name(name);
+        mesh.name = unique.clone();
+
+        for (t, morph) in reader.read_morph_targets().enumerate() {
+            let Some(deltas) = morph.0 else { continue };
+            let deltas: Vec<Vec3> = deltas.map(Vec3::from).collect();
+            if let Some(i) = deltas.iter().position(|p| !p.is_finite()) {
+                return Err(self.err(
+                    &format!("{at}.targets[{t}].POSITION"),
+                    format!("vertex {i} has a non-finite offset"),
+                ));
+            }
+            let mut delta = ShapeDelta {
+                mesh: mesh_index,
+                vertices: Vec::new(),
+                offsets: Vec::new(),
+            };
+            for (v, &d) in deltas.iter().enumerate() {
+                if d != Vec3::ZERO {
+                    delta.vertices.push(v as u32);
+                    delta.offsets.push(linear * d);
+                }
+            }
+            if !delta.vertices.is_empty() {
+                self.rig.shapes[shape_ids[t]].deltas.push(delta);
+            }
+        }
+        self.rig.meshes.push(RigMesh { name: unique, mesh });
+        Ok(())
+    }
+}
+
+/// Triangles of an index list drawn in `mode` (strips alternate winding; fans share corner 0).
+fn triangles(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    let mut out = Vec::new();
+    match mode {
+        Mode::TriangleStrip => {
+            for i in 2..idx.len() {
+                let t = if i % 2 == 0 {
+                    [idx[i - 2], idx[i - 1], idx[i]]
+                } else {
+                    [idx[i - 1], idx[i - 2], idx[i]]
+                };
+                out.push(t);
+            }
+        }
+        Mode::TriangleFan => {
+            for i in 2..idx.len() {
+                out.push([idx[0], idx[i - 1], idx[i]]);
+            }
+        }
+        _ => {
+            for c in idx.chunks_exact(3) {
+                out.push([c[0], c[1], c[2]]);
+            }
+        }
+    }
+    // Degenerate triangles (repeated corners) are common in strips and carry no surface.
+    out.retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percent_decoding() {
+        assert_eq!(percent_decode("a%20b.bin").as_deref(), Some("a b.bin"));
+        assert_eq!(percent_decode("plain.bin").as_deref(), Some("plain.bin"));
+        assert_eq!(percent_decode("bad%2"), None);
+        assert_eq!(percent_decode("bad%zz"), None);
+    }
+
+    #[test]
+    fn strips_and_fans_become_triangles() {
+        assert_eq!(
+            triangles(Mode::TriangleStrip, &[0, 1, 2, 3]),
+            vec![[0, 1, 2], [2, 1, 3]]
+        );
+        assert_eq!(
+            triangles(Mode::TriangleFan, &[0, 1, 2, 3]),
+            vec![[0, 1, 2], [0, 2, 3]]
+        );
+        assert_eq!(
+            triangles(Mode::Triangles, &[0, 1, 2, 2, 2, 3, 4]),
+            vec![[0, 1, 2]]
+        );
+    }
+}
