@@ -124,15 +124,15 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
             format!("{} vertex order", args.mesh.display()),
         ),
     };
-    ids.check(scheme.landmark_count(), mesh.positions.len(), &ids_name)
-        .map_err(|e| match (&ids_path, e) {
-            // An identity list fails only on the count: name the mesh.
-            (None, Error::Invalid(m)) => Error::Invalid(format!(
-                "{m}; the mesh's vertex order is used as the landmark order, so it needs at least {} vertices",
-                scheme.landmark_count()
-            )),
-            (_, e) => e,
-        })?;
+    if ids_path.is_none() && mesh.positions.len() < scheme.landmark_count() {
+        return Err(Error::Invalid(format!(
+            "{} has {} vertices; without landmark ids its vertex order is the landmark order, so it needs at least {}",
+            args.mesh.display(),
+            mesh.positions.len(),
+            scheme.landmark_count()
+        )));
+    }
+    ids.check(scheme.landmark_count(), mesh.positions.len(), &ids_name)?;
     let found = feature_points_from_landmarks(mesh, scheme, &ids.ids)
         .map_err(|e| Error::Invalid(format!("{}: {e}", args.mesh.display())))?;
     let set = found.feature_point_set();

@@ -551,26 +551,30 @@ impl Ctx<'_> {
         )
     }
 
-    /// Head depth check shared by the skull rules.
-    fn skull(&self) -> Result<(f32, f32, f32), String> {
-        let (es, ens) = self.scale()?;
-        let (lo, hi) = self
+    /// The skull rules run only on a mesh that has the back of the head: midline skin at
+    /// least 1.5 eye separations behind the eyes.
+    fn skull(&self) -> Result<f32, String> {
+        let (es, _) = self.scale()?;
+        let x = self.local(fp("9.3"))?.x;
+        let deepest = self
             .skin
             .skin_vertices()
             .iter()
-            .map(|&v| self.skin.local[v as usize].z)
-            .fold((f32::MAX, f32::MIN), |(a, b), z| (a.min(z), b.max(z)));
-        let depth = hi - lo;
-        if depth < 1.5 * es {
+            .map(|&v| self.skin.local[v as usize])
+            .filter(|p| (p.x - x).abs() < 0.05 * es)
+            .map(|p| p.z)
+            .fold(f32::MAX, f32::min);
+        if deepest > -1.5 * es {
             return Err(format!(
-                "the mesh does not include the skull (skin depth {depth:.3} is less than 1.5 eye separations)"
+                "the mesh does not include the skull (no midline skin 1.5 eye separations behind the eyes; the deepest is {:.3} behind)",
+                -deepest
             ));
         }
-        Ok((es, ens, depth))
+        Ok(es)
     }
 
     fn top_of_skull(&self) -> RuleResult {
-        let (es, _, _) = self.skull()?;
+        let es = self.skull()?;
         let x = self.local(fp("9.3"))?.x;
         let v = self
             .skin
@@ -588,7 +592,7 @@ impl Ctx<'_> {
     }
 
     fn back_of_skull(&self) -> RuleResult {
-        let (es, _, _) = self.skull()?;
+        let es = self.skull()?;
         let x = self.local(fp("9.3"))?.x;
         let eyes = (self.eye_centre(Side::Left)? + self.eye_centre(Side::Right)?) * 0.5;
         let (lo, hi) = self
