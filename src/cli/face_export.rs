@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use fbakit::error::{Error, Result};
-use fbakit::player::gltf::export_face;
+use fbakit::player::gltf::export_face_with_units;
 use fbakit::player::load_face;
 use serde::Serialize;
 
@@ -22,6 +22,10 @@ pub struct FaceExportArgs {
     /// Export as glTF 2.0 (the export format; binary or text by OUT's extension).
     #[arg(long)]
     pub gltf: bool,
+    /// Length unit of the face's coordinates (default: guessed from its size); glTF output
+    /// is scaled from it to metres.
+    #[arg(long, value_name = "mm|cm|m")]
+    pub units: Option<fbakit::face::units::LengthUnit>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -54,7 +58,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         }
     };
     let face = load_face(&a.face)?;
-    let export = export_face(&face, None)?;
+    let export = export_face_with_units(&face, None, a.units)?;
     if glb {
         export.document.write_glb(&a.output)?;
     } else {

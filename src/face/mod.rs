@@ -13,6 +13,7 @@
 pub mod morphs;
 pub mod obj_io;
 pub mod summary;
+pub mod units;
 pub mod validate;
 pub mod vrml_io;
 
