@@ -55,13 +55,13 @@ fn bad_rigs_exit_2_with_one_located_line() {
     let doc = fbakit::gltf::SceneBuilder::new("plain");
     let mut doc = doc;
     let m = doc
-        .add_mesh(fbakit::gltf::builder::MeshData::new(
+        .add_mesh(fbakit::gltf::MeshData::new(
             "m",
             vec![glam::Vec3::ZERO, glam::Vec3::X, glam::Vec3::Y],
             vec![[0u32, 1, 2]],
         ))
         .unwrap();
-    doc.add_node(fbakit::gltf::builder::NodeData::new("n").with_mesh(m))
+    doc.add_node(fbakit::gltf::NodeData::new("n").with_mesh(m))
         .unwrap();
     doc.build().unwrap().write(&gltf).unwrap();
     let o = fbakit(&["rig", "info", gltf.to_str().unwrap()]);

@@ -95,6 +95,10 @@ pub struct InfoArgs {
     /// Feature-point file (.xml, .fdp, .csv) whose points replace the face's.
     #[arg(long, value_name = "FILE")]
     pub fp: Option<PathBuf>,
+    /// Length unit of the face's coordinates (default: guessed from its eye separation or
+    /// height).
+    #[arg(long, value_name = "mm|cm|m")]
+    pub units: Option<fbakit::face::units::LengthUnit>,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -174,7 +178,10 @@ fn info(a: InfoArgs) -> Result<u8> {
         &a.file,
         &FaceReadOptions::with_feature_points(a.fp.as_deref()),
     )?;
-    let summary = summarize(&face, Some(&report));
+    let mut summary = summarize(&face, Some(&report));
+    if a.units.is_some() {
+        summary.units = fbakit::face::units::unit_of(&face, a.units);
+    }
     if a.json {
         print_json(&summary)?;
     } else {

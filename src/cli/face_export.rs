@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use fbakit::error::Result;
-use fbakit::export::gltf::export_face;
+use fbakit::export::gltf::export_face_with_units;
 use fbakit::format::OutputFormat;
 use serde::Serialize;
 
@@ -22,6 +22,10 @@ pub struct FaceExportArgs {
     /// Export as glTF 2.0 (the export format; binary or text by OUT's extension).
     #[arg(long)]
     pub gltf: bool,
+    /// Length unit of the face's coordinates (default: guessed from its size); glTF output
+    /// is scaled from it to metres.
+    #[arg(long, value_name = "mm|cm|m")]
+    pub units: Option<fbakit::face::units::LengthUnit>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -44,7 +48,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         "`face export` output",
     )?;
     let face = fbakit::face::read(&a.face)?;
-    let export = export_face(&face, None)?;
+    let export = export_face_with_units(&face, None, a.units)?;
     if format == OutputFormat::Glb {
         export.document.write_glb(&a.output)?;
     } else {

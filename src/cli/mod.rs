@@ -15,6 +15,7 @@ pub mod face_export;
 mod face_from_rig;
 pub mod fap;
 mod fapu;
+mod fp;
 pub mod play;
 mod render;
 mod rig;
@@ -79,6 +80,12 @@ pub enum Command {
         after_help = "Examples:\n  fbakit fapu samples/feature-points-example.xml\n  fbakit fapu alice.fdp --json"
     )]
     Fapu(fapu::FapuArgs),
+    /// Feature-point files from landmarks (iBUG-68, MediaPipe-468).
+    #[command(
+        subcommand,
+        after_help = "Example:\n  fbakit fp from-landmarks generic_neutral_mesh.obj --ibug68 vertex_indices.json -o fp.csv"
+    )]
+    Fp(fp::FpCommand),
     /// Inspect, validate and convert ASCII FAP streams (`.fap`, `.json`).
     #[command(
         subcommand,
@@ -248,6 +255,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Spec(args) => spec(args),
         Command::Fapu(args) => fapu::run(args),
         Command::Fap(cmd) => fap::run(cmd),
+        Command::Fp(cmd) => fp::run(cmd),
         Command::Play(args) => play::run(args),
         Command::Face(cmd) => face::run(cmd),
         Command::Candide(args) => candide::run(args),

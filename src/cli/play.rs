@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use fbakit::error::{Error, Result};
-use fbakit::export::gltf::export_face;
+use fbakit::export::gltf::export_face_with_units;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
 use fbakit::fap::{read_stream_file, ReadOptions};
@@ -68,6 +68,10 @@ pub struct PlayArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Length unit of the face's coordinates (default: guessed from its size); glTF output
+    /// is scaled from it to metres.
+    #[arg(long, value_name = "mm|cm|m")]
+    pub units: Option<fbakit::face::units::LengthUnit>,
 }
 
 /// Largest image side `--size` accepts.
@@ -191,7 +195,7 @@ pub fn run(a: PlayArgs) -> Result<u8> {
         PlayFormat::Glb | PlayFormat::Gltf => {
             let anim = player.animation()?;
             bar.set_position(anim.len() as u64);
-            let export = export_face(&face, Some(&anim))?;
+            let export = export_face_with_units(&face, Some(&anim), a.units)?;
             warnings.extend(export.warnings);
             match format {
                 PlayFormat::Glb => export.document.write_glb(&a.output)?,

@@ -223,11 +223,32 @@ pub fn face_to_gltf(face: &FaceModel, anim: Option<&[AnimationFrame]>) -> Result
     export_face(face, anim).map(|e| e.document)
 }
 
-/// [`face_to_gltf`] with the warnings.
+/// [`face_to_gltf`] with the warnings; the face's unit is detected
+/// ([`crate::face::units::detect_unit`]) and the output is in metres.
 pub fn export_face(face: &FaceModel, anim: Option<&[AnimationFrame]>) -> Result<GltfExport> {
+    export_face_with_units(face, anim, None)
+}
+
+/// [`export_face`] with the face's length unit given (`None`: detected). glTF lengths are
+/// metres, so one factor (metres per model unit) scales every position, morph offset,
+/// translation and pivot; rotations and scales are unit-free.
+pub fn export_face_with_units(
+    face: &FaceModel,
+    anim: Option<&[AnimationFrame]>,
+    units: Option<crate::face::units::LengthUnit>,
+) -> Result<GltfExport> {
     face.check_structure()?;
     let morphs = FaceMorphs::new(face)?;
     let mut warnings = Vec::new();
+    let k = match crate::face::units::unit_of(face, units) {
+        Some(g) => g.unit.metres(),
+        None => {
+            warnings.push(
+                "the face's length unit cannot be guessed (no size); written as metres".into(),
+            );
+            1.0
+        }
+    };
     let mut scene = SceneBuilder::new(face.name.clone());
 
     // Transform nodes: A (t + c, r, s) and, when c ≠ 0, pivot B (−c) holding the children.
@@ -243,7 +264,7 @@ pub fn export_face(face: &FaceModel, anim: Option<&[AnimationFrame]>) -> Result<
             ));
         }
         let mut a = NodeData::new(t.name.clone())
-            .with_translation(t.translation + t.center)
+            .with_translation((t.translation + t.center) * k)
             .with_rotation(t.rotation.normalize())
             .with_scale(t.scale);
         if let Some(p) = t.parent {
@@ -256,12 +277,25 @@ pub fn export_face(face: &FaceModel, anim: Option<&[AnimationFrame]>) -> Result<
         } else {
             let b = NodeData::new(format!("{}_pivot", t.name))
                 .with_parent(a)
-                .with_translation(-t.center);
+                .with_translation(-t.center * k);
             holder.push(scene.add_node(b)?);
         }
     }
 
-    // Meshes.
+    // Meshes, scaled to metres (the scene borrows the buffers until it is built).
+    let scaled: Vec<(Vec<Vec3>, Vec<Vec<Vec3>>)> = face
+        .meshes
+        .iter()
+        .enumerate()
+        .map(|(mi, m)| {
+            let positions = m.mesh.positions.iter().map(|&p| p * k).collect();
+            let offsets = morphs.meshes[mi]
+                .iter()
+                .map(|p| p.offsets.iter().map(|&d| d * k).collect())
+                .collect();
+            (positions, offsets)
+        })
+        .collect();
     let mut mesh_nodes: Vec<Option<NodeId>> = Vec::with_capacity(face.meshes.len());
     for (mi, m) in face.meshes.iter().enumerate() {
         let triangles = m.mesh.triangles();
@@ -274,8 +308,9 @@ pub fn export_face(face: &FaceModel, anim: Option<&[AnimationFrame]>) -> Result<
             continue;
         }
         let [r, g, b] = m.color.unwrap_or([0.8, 0.8, 0.8]);
-        let mut data = MeshData::new(m.name.clone(), &m.mesh.positions[..], triangles)
-            .with_material(MaterialData {
+        let (positions, offsets) = &scaled[mi];
+        let mut data =
+            MeshData::new(m.name.clone(), &positions[..], triangles).with_material(MaterialData {
                 base_color: [r.clamp(0.0, 1.0), g.clamp(0.0, 1.0), b.clamp(0.0, 1.0), 1.0],
                 double_sided: true,
                 ..MaterialData::default()
@@ -285,8 +320,8 @@ pub fn export_face(face: &FaceModel, anim: Option<&[AnimationFrame]>) -> Result<
         if per_vertex_uvs {
             data = data.with_uvs(&m.mesh.uvs[..]);
         }
-        for p in &morphs.meshes[mi] {
-            data = data.with_sparse_target(p.name.clone(), &p.vertices[..], &p.offsets[..]);
+        for (p, offsets) in morphs.meshes[mi].iter().zip(offsets) {
+            data = data.with_sparse_target(p.name.clone(), &p.vertices[..], &offsets[..]);
         }
         let id = scene.add_mesh(data)?;
         let mut node = NodeData::new(m.name.clone()).with_mesh(id);
@@ -297,7 +332,7 @@ pub fn export_face(face: &FaceModel, anim: Option<&[AnimationFrame]>) -> Result<
     }
 
     if let Some(frames) = anim.filter(|f| !f.is_empty()) {
-        let channels = animation_channels(face, &morphs, &node_a, &mesh_nodes, frames)?;
+        let channels = animation_channels(face, &morphs, &node_a, &mesh_nodes, frames, k)?;
         if !channels.is_empty() {
             scene.add_animation(AnimationData {
                 name: "play".into(),
@@ -317,6 +352,7 @@ fn animation_channels(
     node_a: &[NodeId],
     mesh_nodes: &[Option<NodeId>],
     frames: &[AnimationFrame],
+    k: f32,
 ) -> Result<Vec<ChannelData>> {
     let t0 = frames[0].time;
     let times: Vec<f32> = frames.iter().map(|f| (f.time - t0) as f32).collect();
@@ -385,7 +421,7 @@ fn animation_channels(
         if tr {
             let values = frames
                 .iter()
-                .map(|f| t.translation + delta(f).translation + t.center)
+                .map(|f| (t.translation + delta(f).translation + t.center) * k)
                 .collect();
             channels.push(ChannelData {
                 node: node_a[i],

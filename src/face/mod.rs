@@ -20,6 +20,7 @@ pub mod parts;
 pub mod pose;
 pub mod read;
 pub mod summary;
+pub mod units;
 pub mod validate;
 pub mod vrml;
 pub mod write;

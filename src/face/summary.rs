@@ -108,6 +108,8 @@ pub struct FaceSummary {
     pub feature_points: FeaturePointSummary,
     /// FAPU.
     pub fapu: FapuSummary,
+    /// The length unit assumed for the face (glTF export scales it to metres).
+    pub units: Option<crate::face::units::UnitGuess>,
     /// FAT coverage.
     pub fat: FatSummary,
     /// Feature points matched to vertices, when the reader matched any.
@@ -260,6 +262,7 @@ pub fn summarize(face: &FaceModel, report: Option<&FaceReadReport>) -> FaceSumma
         vertices: face.vertex_count(),
         feature_points,
         fapu,
+        units: crate::face::units::detect_unit(face),
         fat,
         fp_matches,
         diagnostics: report
@@ -381,6 +384,9 @@ impl FaceSummary {
                 let _ = writeln!(s, "\nFAPU: not measurable: {e}");
             }
             _ => {}
+        }
+        if let Some(u) = &self.units {
+            let _ = writeln!(s, "Units: {u}");
         }
         let f = &self.fat;
         let low = f

@@ -4,10 +4,13 @@
 //! - [`fapu`]: [`Fapu`] and [`FapuDistances`], also measured from feature points.
 //! - [`xml`], [`xface`], [`csv`]: the three feature-point file formats; [`read_feature_points`]
 //!   picks one by extension or content.
+//! - [`landmarks`]: feature points from iBUG-68 / MediaPipe-468 landmarks plus points derived
+//!   from the mesh.
 
 pub mod fapu;
 pub mod feature_points;
 pub mod file;
+pub mod landmarks;
 
 pub use fapu::{Fapu, FapuDistances, FapuMeasurement};
 pub use feature_points::{FeaturePoint, FeaturePointSet, VertexBinding};

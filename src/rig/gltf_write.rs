@@ -10,8 +10,8 @@
 use std::borrow::Cow;
 
 use crate::error::Result;
-use crate::gltf::builder::{MeshData, MorphOffsets, MorphTargetData, NodeData, SceneBuilder};
 use crate::gltf::GltfDocument;
+use crate::gltf::{MeshData, MorphOffsets, MorphTargetData, NodeData, SceneBuilder};
 
 use super::Rig;
 

@@ -1,0 +1,221 @@
+//! `fbakit fp ...`: feature-point files from other descriptions of a face.
+
+use std::path::{Path, PathBuf};
+
+use fbakit::error::{Error, Result};
+use fbakit::fdp::landmarks::{
+    feature_points_from_landmarks, read_landmark_ids, AbsentPoint, LandmarkIds, LandmarkScheme,
+    PlacedPoint,
+};
+use fbakit::fdp::{Fapu, FapuDistances};
+use serde::Serialize;
+
+use super::{print_json, EXIT_OK};
+
+#[derive(Debug, clap::Subcommand)]
+pub enum FpCommand {
+    /// Place MPEG-4 feature points on a mesh from its landmarks (iBUG-68 or MediaPipe-468),
+    /// deriving the points the landmarks do not give from the mesh.
+    #[command(
+        long_about = "Place MPEG-4 feature points on a mesh from its landmarks. The preset \
+                      table (specs/landmarks-ibug68.csv or specs/landmarks-mediapipe468.csv) \
+                      maps landmarks to feature points; the points no landmark gives are \
+                      derived from the mesh: eyelid centres on the visible lid margin, pupils \
+                      at the front of the eyeball (or the lid contour's centre), chin boss, \
+                      cheeks, cheek bones, nose wings, nose bump, top and back of the skull \
+                      when the mesh has one. Every point is bound to a mesh vertex and printed \
+                      with its provenance. OUT is .csv (fp,vertices,combine,description with \
+                      the provenance) or fbakit .xml. Exit codes: 0 ok, 2 bad input (ids out \
+                      of range or repeated, wrong count, unreadable mesh, unknown output \
+                      extension).",
+        after_help = "Examples:\n  fbakit fp from-landmarks generic_neutral_mesh.obj --ibug68 vertex_indices.json -o ict-fp.csv\n  \
+                      fbakit fp from-landmarks head.obj --ibug68 landmarks.csv -o head.xml --json\n  \
+                      fbakit fp from-landmarks canonical_face_model.obj --mediapipe468 -o mp-fp.csv"
+    )]
+    FromLandmarks(FromLandmarksArgs),
+}
+
+#[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("scheme").required(true).args(["ibug68", "mediapipe468"])))]
+pub struct FromLandmarksArgs {
+    /// The mesh (.obj, or a one-mesh .wrl / .wrl.gz face) the landmark ids index.
+    pub mesh: PathBuf,
+    /// The 68 iBUG landmark vertex ids: ICT-FaceKit's vertex_indices.json (key
+    /// idx_to_landmark_verts), a JSON array, or a CSV / text list of vertex ids.
+    #[arg(long, value_name = "IDS")]
+    pub ibug68: Option<PathBuf>,
+    /// MediaPipe-468 landmarks: the vertex ids like --ibug68, or none when the mesh's own
+    /// vertex order is the landmark order (MediaPipe's canonical face).
+    #[arg(long, value_name = "IDS", num_args = 0..=1)]
+    pub mediapipe468: Option<Option<PathBuf>>,
+    /// Output feature-point file: .csv or .xml.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize)]
+struct Report<'a> {
+    mesh: String,
+    scheme: LandmarkScheme,
+    landmarks: String,
+    output: String,
+    points: &'a [PlacedPoint],
+    absent: &'a [AbsentPoint],
+    notes: &'a [String],
+    fapu: Option<FapuDistances>,
+    warnings: Vec<String>,
+}
+
+pub fn run(cmd: FpCommand) -> Result<u8> {
+    match cmd {
+        FpCommand::FromLandmarks(args) => from_landmarks(args),
+    }
+}
+
+#[derive(Clone, Copy)]
+enum OutFormat {
+    Csv,
+    Xml,
+}
+
+fn out_format(path: &Path) -> Result<OutFormat> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("csv") => Ok(OutFormat::Csv),
+        Some("xml") => Ok(OutFormat::Xml),
+        Some("fdp") => Err(Error::Unsupported(format!(
+            "{}: fbakit reads Xface .fdp files but does not write them; write .xml or .csv",
+            path.display()
+        ))),
+        _ => Err(Error::Unsupported(format!(
+            "{}: unknown output extension (expected .csv or .xml)",
+            path.display()
+        ))),
+    }
+}
+
+fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
+    // Refuse a bad output before reading anything.
+    let format = out_format(&args.output)?;
+    let (scheme, ids_path) = match (&args.ibug68, &args.mediapipe468) {
+        (Some(p), _) => (LandmarkScheme::Ibug68, Some(p.clone())),
+        (None, Some(p)) => (LandmarkScheme::MediaPipe468, p.clone()),
+        (None, None) => unreachable!("clap requires one scheme"),
+    };
+    let face = fbakit::face::read(&args.mesh)?;
+    let [only] = face.meshes.as_slice() else {
+        return Err(Error::Invalid(format!(
+            "{}: landmark ids index one mesh, but this face has {} meshes",
+            args.mesh.display(),
+            face.meshes.len()
+        )));
+    };
+    let mesh = &only.mesh;
+    let (ids, ids_name) = match &ids_path {
+        Some(p) => (read_landmark_ids(p)?, p.display().to_string()),
+        None => (
+            LandmarkIds::identity(scheme.landmark_count()),
+            format!("{} vertex order", args.mesh.display()),
+        ),
+    };
+    if ids_path.is_none() && mesh.positions.len() < scheme.landmark_count() {
+        return Err(Error::Invalid(format!(
+            "{} has {} vertices; without landmark ids its vertex order is the landmark order, so it needs at least {}",
+            args.mesh.display(),
+            mesh.positions.len(),
+            scheme.landmark_count()
+        )));
+    }
+    ids.check(scheme.landmark_count(), mesh.positions.len(), &ids_name)?;
+    let found = feature_points_from_landmarks(mesh, scheme, &ids.ids)
+        .map_err(|e| Error::Invalid(format!("{}: {e}", args.mesh.display())))?;
+    let set = found.feature_point_set();
+    let mut warnings = Vec::new();
+    let fapu = match Fapu::from_feature_points(&set) {
+        Ok(f) => Some(f.distances),
+        Err(e) => {
+            warnings.push(format!("FAP units: {e}"));
+            None
+        }
+    };
+    match format {
+        OutFormat::Csv => fbakit::fdp::csv::write_csv_file(&args.output, &found.table())?,
+        OutFormat::Xml => fbakit::fdp::xml::write_xml_file(
+            &args.output,
+            &fbakit::fdp::xml::FeaturePointDocument {
+                units: None,
+                fapu: None,
+                points: set,
+            },
+        )?,
+    }
+    let report = Report {
+        mesh: args.mesh.display().to_string(),
+        scheme,
+        landmarks: ids_name,
+        output: args.output.display().to_string(),
+        points: &found.points,
+        absent: &found.absent,
+        notes: &found.notes,
+        fapu,
+        warnings,
+    };
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    if args.json {
+        print_json(&report)?;
+    } else {
+        print!("{}", text(&report));
+    }
+    Ok(EXIT_OK)
+}
+
+fn text(r: &Report<'_>) -> String {
+    use std::fmt::Write as _;
+    let mut s = format!(
+        "{} feature points on {} from {} landmarks ({}) -> {}\n",
+        r.points.len(),
+        r.mesh,
+        r.scheme,
+        r.landmarks,
+        r.output
+    );
+    let _ = writeln!(s, "{:<6} {:<14} provenance", "fp", "vertex");
+    for p in r.points {
+        let v: Vec<String> = p.vertices.iter().map(u32::to_string).collect();
+        let _ = writeln!(
+            s,
+            "{:<6} {:<14} {}",
+            p.id.to_string(),
+            v.join(";"),
+            p.provenance
+        );
+    }
+    for a in r.absent {
+        let _ = writeln!(
+            s,
+            "absent {:<6} ({}): {}",
+            a.id.to_string(),
+            a.rule,
+            a.reason
+        );
+    }
+    for n in r.notes {
+        let _ = writeln!(s, "note: {n}");
+    }
+    if let Some(f) = r.fapu {
+        let _ = writeln!(
+            s,
+            "FAPU distances: IRISD0 {:.4}  ES0 {:.4}  ENS0 {:.4}  MNS0 {:.4}  MW0 {:.4}",
+            f.irisd0, f.es0, f.ens0, f.mns0, f.mw0
+        );
+    }
+    s
+}
