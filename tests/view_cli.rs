@@ -76,7 +76,7 @@ fn writes_a_page_and_reports_it() {
 fn refuses_bad_usage_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let cases: [(&[&str], &str, &str); 4] = [
-        (&["bruno"], "face.wrl", "writes an .html page"),
+        (&["bruno"], "face.wrl", "the viewer page must be .html"),
         (&["missing-face.wrl"], "a.html", "missing-face.wrl"),
         (&["alma", "--fps", "30"], "b.html", "need a STREAM"),
         (
