@@ -11,6 +11,10 @@ fn fbakit(args: &[&str]) -> Output {
         .expect("run fbakit")
 }
 
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
@@ -116,6 +120,42 @@ fn convert_round_trips_through_json() {
     assert_eq!(std::fs::read_to_string(&fap).unwrap(), canonical);
     let o = fbakit(&["fap", "convert", "missing.fap", fap.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn convert_refuses_unknown_outputs_and_its_own_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let xyz = dir.path().join("out.xyz");
+    let o = fbakit(&[
+        "fap",
+        "convert",
+        "samples/speech.fap",
+        xyz.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o)
+            .contains("`fap convert` output must be .fap, .json; found unknown extension `.xyz`"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!xyz.exists(), "nothing written");
+    let own = dir.path().join("own.fap");
+    std::fs::copy("samples/speech.fap", &own).unwrap();
+    let before = std::fs::read(&own).unwrap();
+    let o = fbakit(&[
+        "fap",
+        "convert",
+        own.to_str().unwrap(),
+        own.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("refusing to write over the input"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&own).unwrap(), before, "input untouched");
 }
 
 #[test]

@@ -175,6 +175,15 @@ fn validate(a: ValidateArgs) -> Result<u8> {
 }
 
 fn convert(a: ConvertArgs) -> Result<u8> {
+    fbakit::format::OutputFormat::resolve(
+        &a.output,
+        &[
+            fbakit::format::OutputFormat::Fap,
+            fbakit::format::OutputFormat::Json,
+        ],
+        "`fap convert` output",
+    )?;
+    fbakit::format::refuse_overwriting_input(&a.output, &[&a.input])?;
     let (stream, warnings) = read_stream_file(&a.input, &options(a.strict))?;
     for w in &warnings {
         eprintln!("{w}");

@@ -56,7 +56,13 @@ pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, V
 
 /// Writes `stream` atomically as JSON (pretty) or canonical `.fap`, by the extension of `path`.
 pub fn write_stream_file(path: &Path, stream: &FapStream) -> Result<()> {
-    if is_json_path(path) {
+    use crate::format::OutputFormat;
+    let format = OutputFormat::resolve(
+        path,
+        &[OutputFormat::Fap, OutputFormat::Json],
+        "a FAP stream",
+    )?;
+    if format == OutputFormat::Json {
         let text = serde_json::to_string_pretty(stream)
             .map_err(|e| Error::Invalid(format!("cannot encode JSON: {e}")))?;
         crate::io::write_atomic(path, format!("{text}\n").as_bytes())
