@@ -35,7 +35,7 @@ use glam::{Quat, Vec3};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::export::gltf::{export_face, FaceMorphs};
+use crate::export::gltf::{export_face_with_units, FaceMorphs};
 use crate::face::FaceModel;
 use crate::fat::morph::default_value;
 use crate::fat::{TableKey, TransformField, HIGH_LEVEL_FULL};
@@ -263,7 +263,13 @@ impl ViewerPage {
                 )));
             }
         }
-        let export = export_face(face, animation.map(|a| a.frames))?;
+        // The page places the camera, the feature points and the FAPU in the face's own
+        // units, so the embedded glb keeps them unscaled (factor 1, as if in metres).
+        let export = export_face_with_units(
+            face,
+            animation.map(|a| a.frames),
+            Some(crate::face::units::LengthUnit::M),
+        )?;
         let mut warnings = export.warnings;
         let model = ViewerModel::new(face, &export.document, animation)?;
         if let Some(note) = &model.fapu_note {
@@ -288,7 +294,7 @@ impl ViewerPage {
 
 impl ViewerModel {
     /// The data for `face` exported as `document` (whose nodes are found by name, as
-    /// [`export_face`] names them), with `animation` if given.
+    /// [`crate::export::gltf::export_face`] names them), with `animation` if given.
     pub fn new(
         face: &FaceModel,
         document: &GltfDocument,

@@ -1,13 +1,11 @@
 //! Putting feature points from a separate file on a face's meshes: bound points on their
 //! vertices, position-only points on the nearest vertex.
 
-use glam::Vec3;
-
 use super::vrml::FeaturePointMatch;
 use super::FaceModel;
 use crate::error::{Error, Result};
+use crate::face::vertex_index::FaceVertexIndex;
 use crate::fdp::{FeaturePointSet, VertexBinding};
-use crate::mesh::VertexIndex;
 
 /// Puts `points` on `face`: bound points are placed on their vertices, position-only points
 /// are bound to the nearest vertex (returned with the distance). On a single-mesh face a
@@ -52,16 +50,7 @@ pub fn attach_feature_points(
     face.resolve_feature_points()?;
 
     // Position-only points: bind to the nearest vertex of any mesh.
-    let frames = face.frames();
-    let mut owners: Vec<(usize, u32)> = Vec::new();
-    let mut world: Vec<Vec3> = Vec::new();
-    for (mi, m) in face.meshes.iter().enumerate() {
-        for (vi, p) in m.mesh.positions.iter().enumerate() {
-            owners.push((mi, vi as u32));
-            world.push(frames.meshes[mi].transform_point3(*p));
-        }
-    }
-    let index = VertexIndex::new(&world);
+    let index = FaceVertexIndex::new(face);
     let mut matches = Vec::new();
     let unbound: Vec<_> = face
         .feature_points
@@ -75,10 +64,9 @@ pub fn attach_feature_points(
                 "feature point {id} has a non-finite position"
             )));
         }
-        let Some((nearest, distance)) = index.nearest_vertex(pos) else {
+        let Some((mi, vi, distance)) = index.nearest(pos) else {
             continue;
         };
-        let (mi, vi) = owners[nearest as usize];
         let mesh = face.meshes[mi].name.clone();
         if let Some(p) = face.feature_points.get_mut(id) {
             p.binding = Some(VertexBinding {
@@ -103,6 +91,7 @@ mod tests {
     use crate::fdp::FeaturePoint;
     use crate::mesh::Mesh;
     use crate::spec::FeaturePointId;
+    use glam::Vec3;
 
     fn fp(s: &str) -> FeaturePointId {
         s.parse().unwrap()

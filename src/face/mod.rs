@@ -22,6 +22,7 @@ pub mod read;
 pub mod summary;
 pub mod units;
 pub mod validate;
+pub mod vertex_index;
 pub mod vrml;
 pub mod write;
 

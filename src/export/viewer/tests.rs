@@ -1,3 +1,4 @@
+use crate::export::gltf::export_face;
 use std::path::Path;
 use std::sync::OnceLock;
 

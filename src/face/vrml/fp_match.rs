@@ -1,12 +1,12 @@
 //! Binding `featurePointsCoord` entries to their nearest mesh vertex when a file has no
 //! fbakit record, and the report of each match.
 
+use crate::face::vertex_index::FaceVertexIndex;
 use glam::Vec3;
 use serde::Serialize;
 
 use crate::face::FaceModel;
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
-use crate::mesh::VertexIndex;
 use crate::spec::FeaturePointId;
 
 /// How a `featurePointsCoord` entry was matched to a mesh vertex.
@@ -30,16 +30,7 @@ pub(super) fn bind_to_nearest_vertices(
     matches: &mut Vec<FeaturePointMatch>,
 ) -> FeaturePointSet {
     let mut set = FeaturePointSet::new();
-    let frames = model.frames();
-    let mut owners: Vec<(usize, u32)> = Vec::new();
-    let mut world: Vec<Vec3> = Vec::new();
-    for (mi, m) in model.meshes.iter().enumerate() {
-        for (vi, p) in m.mesh.positions.iter().enumerate() {
-            owners.push((mi, vi as u32));
-            world.push(frames.meshes[mi].transform_point3(*p));
-        }
-    }
-    let index = VertexIndex::new(&world);
+    let index = FaceVertexIndex::new(model);
     for (ordinal, p) in points
         .iter()
         .enumerate()
@@ -50,8 +41,7 @@ pub(super) fn bind_to_nearest_vertices(
         };
         let pos = Vec3::from_array(*p);
         let mut point = FeaturePoint::at(id, pos);
-        if let Some((nearest, distance)) = index.nearest_vertex(pos) {
-            let (mi, vi) = owners[nearest as usize];
+        if let Some((mi, vi, distance)) = index.nearest(pos) {
             let mesh = model.meshes[mi].name.clone();
             point.binding = Some(VertexBinding {
                 mesh: Some(mesh.clone()),

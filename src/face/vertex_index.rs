@@ -1,0 +1,41 @@
+//! Nearest-vertex queries over every mesh of a face at once, in the face frame — how feature
+//! points given by position are bound to the face's vertices.
+
+use glam::Vec3;
+
+use super::FaceModel;
+use crate::mesh::VertexIndex;
+
+/// A spatial index over the neutral face-frame positions of all meshes of a face.
+pub struct FaceVertexIndex {
+    /// Index item → (mesh, vertex).
+    owners: Vec<(usize, u32)>,
+    index: VertexIndex,
+}
+
+impl FaceVertexIndex {
+    /// Indexes every vertex of `face` at neutral, placed by its mesh's transform chain.
+    pub fn new(face: &FaceModel) -> FaceVertexIndex {
+        let frames = face.frames();
+        let mut owners = Vec::with_capacity(face.vertex_count());
+        let mut world = Vec::with_capacity(face.vertex_count());
+        for (mi, m) in face.meshes.iter().enumerate() {
+            for (vi, p) in m.mesh.positions.iter().enumerate() {
+                owners.push((mi, vi as u32));
+                world.push(frames.meshes[mi].transform_point3(*p));
+            }
+        }
+        FaceVertexIndex {
+            owners,
+            index: VertexIndex::new(&world),
+        }
+    }
+
+    /// The (mesh, vertex) nearest to `point` and its distance; `None` for an empty face or a
+    /// non-finite point.
+    pub fn nearest(&self, point: Vec3) -> Option<(usize, u32, f32)> {
+        let (i, distance) = self.index.nearest_vertex(point)?;
+        let (mesh, vertex) = self.owners[i as usize];
+        Some((mesh, vertex, distance))
+    }
+}
