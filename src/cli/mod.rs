@@ -41,6 +41,14 @@ impl From<MethodArg> for fbakit::clone::face::Method {
     }
 }
 
+/// Parses an output frame rate (`--fps` of `render` and `speak`): finite, 0 < fps <= 240.
+pub fn parse_fps(s: &str) -> std::result::Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 240.0 => Ok(v),
+        _ => Err(format!("`{s}` is not a frame rate between 0 and 240")),
+    }
+}
+
 /// Exit code for success.
 pub const EXIT_OK: u8 = 0;
 /// Exit code for a failed operation.

@@ -12,7 +12,7 @@ use fbakit::fap::{read_stream_file, ReadOptions};
 use serde::Serialize;
 
 use super::play::{parse_size, progress};
-use super::{print_json, EXIT_OK};
+use super::{parse_fps, print_json, EXIT_OK};
 
 /// Arguments of `render`.
 #[derive(Debug, Args)]
@@ -41,14 +41,6 @@ pub struct RenderArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
-}
-
-/// Parses `--fps` (finite, 0 < fps <= 240).
-fn parse_fps(s: &str) -> std::result::Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 && v <= 240.0 => Ok(v),
-        _ => Err(format!("`{s}` is not a frame rate between 0 and 240")),
-    }
 }
 
 #[derive(Debug, Serialize)]

@@ -9,7 +9,7 @@ use fbakit::fap::write_stream_file;
 use fbakit::speech::{say, MouthFaps, SpeechOptions};
 use serde::Serialize;
 
-use super::{print_json, EXIT_OK};
+use super::{parse_fps, print_json, EXIT_OK};
 
 /// What the stream moves the mouth with (`--mouth`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -55,13 +55,6 @@ pub struct SpeakArgs {
     /// Print the report (phonemes, visemes, files) as JSON.
     #[arg(long)]
     pub json: bool,
-}
-
-fn parse_fps(s: &str) -> std::result::Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 && v <= 240.0 => Ok(v),
-        _ => Err(format!("`{s}` is not a frame rate between 0 and 240")),
-    }
 }
 
 #[derive(Debug, Serialize)]
