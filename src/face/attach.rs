@@ -5,7 +5,7 @@ use super::vrml::FeaturePointMatch;
 use super::FaceModel;
 use crate::error::{Error, Result};
 use crate::face::vertex_index::FaceVertexIndex;
-use crate::fdp::{FeaturePointSet, VertexBinding};
+use crate::fdp::FeaturePointSet;
 
 /// Puts `points` on `face`: bound points are placed on their vertices, position-only points
 /// are bound to the nearest vertex (returned with the distance). On a single-mesh face a
@@ -64,22 +64,13 @@ pub fn attach_feature_points(
                 "feature point {id} has a non-finite position"
             )));
         }
-        let Some((mi, vi, distance)) = index.nearest(pos) else {
+        let Some((binding, found)) = index.bind(face, id, pos) else {
             continue;
         };
-        let mesh = face.meshes[mi].name.clone();
         if let Some(p) = face.feature_points.get_mut(id) {
-            p.binding = Some(VertexBinding {
-                mesh: Some(mesh.clone()),
-                vertices: vec![vi],
-            });
+            p.binding = Some(binding);
         }
-        matches.push(FeaturePointMatch {
-            id,
-            mesh,
-            vertex: vi,
-            distance,
-        });
+        matches.push(found);
     }
     Ok(matches)
 }
@@ -88,7 +79,7 @@ pub fn attach_feature_points(
 mod tests {
     use super::*;
     use crate::face::FaceMesh;
-    use crate::fdp::FeaturePoint;
+    use crate::fdp::{FeaturePoint, VertexBinding};
     use crate::mesh::Mesh;
     use crate::spec::FeaturePointId;
     use glam::Vec3;

@@ -24,10 +24,9 @@ use glam::Vec3;
 
 use crate::candide::CandideModel;
 use crate::error::{Error, Result};
-use crate::face::{FaceMesh, FaceModel};
+use crate::face::FaceModel;
 use crate::fat::{FaceDefMesh, FaceDefTable, TableKey};
 use crate::fdp::{FeaturePointSet, VertexBinding};
-use crate::mesh::Mesh;
 
 /// Name of the mesh of a CANDIDE face.
 pub const CANDIDE_MESH: &str = "candide";
@@ -62,15 +61,8 @@ pub fn candide_face_with_notes(
     shape: &[(String, f32)],
 ) -> Result<CandideFace> {
     let shaped = model.with_shape(shape)?;
-    let mut face = FaceModel::new("candide");
-    let mut mesh: Mesh = shaped.to_mesh();
-    mesh.name = CANDIDE_MESH.into();
-    face.meshes.push(FaceMesh {
-        name: CANDIDE_MESH.into(),
-        transform: None,
-        mesh,
-        color: None,
-    });
+    let mut face = FaceModel::single_mesh(CANDIDE_MESH, shaped.to_mesh());
+    face.name = "candide".into();
     let mut points = fp.clone();
     let ids: Vec<_> = points.iter().map(|p| p.id).collect();
     for id in ids {

@@ -181,6 +181,21 @@ impl FaceModel {
         }
     }
 
+    /// A face of one untransformed mesh named `name` (the mesh takes the name too), as OBJ
+    /// files, morph sets and CANDIDE-3 make them.
+    pub fn single_mesh(name: impl Into<String>, mut mesh: Mesh) -> Self {
+        let name = name.into();
+        mesh.name = name.clone();
+        let mut face = FaceModel::new(name.clone());
+        face.meshes.push(FaceMesh {
+            name,
+            transform: None,
+            mesh,
+            color: None,
+        });
+        face
+    }
+
     /// Index of the mesh named `name`.
     pub fn mesh_index(&self, name: &str) -> Option<usize> {
         self.meshes.iter().position(|m| m.name == name)

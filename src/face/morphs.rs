@@ -32,7 +32,7 @@ use serde::Serialize;
 
 use super::attach::attach_feature_points;
 use super::write::merged_mesh;
-use super::{FaceMesh, FaceModel};
+use super::FaceModel;
 use crate::error::{Error, Result};
 use crate::fat::eval::Activation;
 use crate::fat::morph::{default_value, fat_from_morph_targets, MorphMesh, MorphTarget};
@@ -520,15 +520,7 @@ pub fn face_from_morph_meshes(
                 .map_err(|e| Error::Invalid(format!("morph {key} @ {value}: {e}")))?,
         );
     }
-    let mut face = FaceModel::new(name);
-    let mut mesh = neutral;
-    mesh.name = name.to_string();
-    face.meshes.push(FaceMesh {
-        name: name.to_string(),
-        transform: None,
-        mesh,
-        color: None,
-    });
+    let mut face = FaceModel::single_mesh(name, neutral);
     face.fat = fat_from_morph_targets(&targets)?;
     Ok(face)
 }

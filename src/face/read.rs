@@ -25,7 +25,7 @@ use super::attach::attach_feature_points;
 use super::bundled::BundledFace;
 use super::format::{face_name, FaceFormat};
 use super::vrml::{face_from_scene, FaceReadReport};
-use super::{FaceMesh, FaceModel};
+use super::FaceModel;
 use crate::error::{Error, Result};
 use crate::io::{gunzip_bounded, DEFAULT_MAX_INPUT_BYTES};
 
@@ -163,15 +163,7 @@ fn vrml_face(path: &Path, text: &str, name: &str) -> Result<(FaceModel, FaceRead
 fn obj_face(path: &Path, bytes: &[u8], name: &str) -> Result<(FaceModel, FaceReadReport)> {
     let text = text_of(path, bytes, "UTF-8 OBJ text")?;
     let (obj, diagnostics) = crate::mesh::obj::read_obj_str(&text, path)?;
-    let mut face = FaceModel::new(name);
-    let mut mesh = obj.mesh;
-    mesh.name = name.to_string();
-    face.meshes.push(FaceMesh {
-        name: name.to_string(),
-        transform: None,
-        mesh,
-        color: None,
-    });
+    let face = FaceModel::single_mesh(name, obj.mesh);
     let report = FaceReadReport {
         diagnostics,
         mesh_paths: vec![format!("OBJ {}", path.display())],

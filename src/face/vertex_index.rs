@@ -3,8 +3,11 @@
 
 use glam::Vec3;
 
+use super::vrml::FeaturePointMatch;
 use super::FaceModel;
+use crate::fdp::VertexBinding;
 use crate::mesh::VertexIndex;
+use crate::spec::FeaturePointId;
 
 /// A spatial index over the neutral face-frame positions of all meshes of a face.
 pub struct FaceVertexIndex {
@@ -37,5 +40,28 @@ impl FaceVertexIndex {
         let (i, distance) = self.index.nearest_vertex(point)?;
         let (mesh, vertex) = self.owners[i as usize];
         Some((mesh, vertex, distance))
+    }
+
+    /// Feature point `id` at `point` bound to the nearest vertex of `face` (the face this
+    /// index was built on): its binding and the match to report.
+    pub fn bind(
+        &self,
+        face: &FaceModel,
+        id: FeaturePointId,
+        point: Vec3,
+    ) -> Option<(VertexBinding, FeaturePointMatch)> {
+        let (mesh, vertex, distance) = self.nearest(point)?;
+        let name = face.meshes.get(mesh)?.name.clone();
+        let binding = VertexBinding {
+            mesh: Some(name.clone()),
+            vertices: vec![vertex],
+        };
+        let found = FeaturePointMatch {
+            id,
+            mesh: name,
+            vertex,
+            distance,
+        };
+        Some((binding, found))
     }
 }

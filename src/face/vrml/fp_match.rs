@@ -6,7 +6,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use crate::face::FaceModel;
-use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
+use crate::fdp::{FeaturePoint, FeaturePointSet};
 use crate::spec::FeaturePointId;
 
 /// How a `featurePointsCoord` entry was matched to a mesh vertex.
@@ -41,18 +41,9 @@ pub(super) fn bind_to_nearest_vertices(
         };
         let pos = Vec3::from_array(*p);
         let mut point = FeaturePoint::at(id, pos);
-        if let Some((mi, vi, distance)) = index.nearest(pos) {
-            let mesh = model.meshes[mi].name.clone();
-            point.binding = Some(VertexBinding {
-                mesh: Some(mesh.clone()),
-                vertices: vec![vi],
-            });
-            matches.push(FeaturePointMatch {
-                id,
-                mesh,
-                vertex: vi,
-                distance,
-            });
+        if let Some((binding, found)) = index.bind(model, id, pos) {
+            point.binding = Some(binding);
+            matches.push(found);
         }
         set.insert(point);
     }
