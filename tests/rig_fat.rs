@@ -123,9 +123,9 @@ fn synthetic_rig_calibrates_exactly() {
     let t = face.fat.table(key("raise_l_cornerlip")).unwrap();
     let borders = &t.meshes[0].interval_borders;
     assert_eq!(borders.len(), 3);
-    assert!(
-        (borders[0] + 102.4).abs() < 1e-4 && borders[1] == 0.0 && (borders[2] - 204.8).abs() < 1e-4
-    );
+    // Borders are whole FAP values (VRML's intervalBorders is MFInt32): the nearest ones to
+    // the calibrated −102.4 and 204.8, with the motion per FAP unit unchanged (below).
+    assert_eq!(borders, &vec![-102.0, 0.0, 205.0]);
     // The vertex halfway between 2.4 and 8.3 is shared half and half between FAPs 12 and 59.
     let slot = t.meshes[0]
         .coord_index

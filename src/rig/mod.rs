@@ -20,6 +20,7 @@ pub mod fat_build;
 pub mod gltf_read;
 pub mod gltf_write;
 pub mod obj_folder;
+pub mod trim;
 
 use std::collections::HashMap;
 use std::path::Path;
