@@ -1,7 +1,8 @@
 //! The end-to-end demo application (`fbakit demo`): clones the bundled `alma` onto a
-//! FAT-less `bruno`, plays the bundled speech stream on both and writes every output, with
-//! quality figures and timings. It is glue over [`crate::clone`], [`crate::player`] and
-//! [`crate::export`].
+//! FAT-less `bruno` and onto the real ICT-FaceKit head (`ict`), plays the bundled speech
+//! stream on all of them (and on the head with its own FAT, built from its ARKit shapes) and
+//! writes every output, with quality figures and timings. It is glue over [`crate::clone`],
+//! [`crate::player`] and [`crate::export`].
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -35,21 +36,22 @@ pub struct DemoOptions {
     pub grid_cell: u32,
     /// Where `speech.fap` and `faces/` are; `None` searches (see [`find_samples_dir`]).
     pub samples_dir: Option<PathBuf>,
+    /// Also clone onto the real head and show it (the bundled `ict`).
+    pub real_head: bool,
 }
 
 impl Default for DemoOptions {
-    /// The written outputs use `rbf`: on the bundled faces both methods reach the same
-    /// figures (self-clone 0 %, ~31 % against bruno's true FAT), but `fmc`'s 2D projection
-    /// leaves visible seams at the chin and the lower eyelids, so the pictures use `rbf`; the
-    /// report measures both.
+    /// The written outputs use the library's default method ([`Method::default`]); the
+    /// report measures both methods on alma→bruno.
     fn default() -> Self {
         DemoOptions {
-            method: Method::Rbf,
+            method: Method::default(),
             compare_methods: true,
             sheet_frames: 8,
             sheet_cell: 192,
             grid_cell: 256,
             samples_dir: None,
+            real_head: true,
         }
     }
 }
@@ -98,6 +100,29 @@ pub struct MethodQuality {
     pub clone_seconds: f64,
 }
 
+/// The real head part of the demo: alma's FAT cloned onto the ICT-FaceKit head.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RealHeadReport {
+    /// Where the head came from.
+    pub origin: String,
+    /// Its vertices.
+    pub vertices: usize,
+    /// Tables of its own FAT (built from its ARKit shapes).
+    pub rig_tables: usize,
+    /// Tables cloned from alma.
+    pub cloned_tables: usize,
+    /// Worst FAP compliance error of the cloned FAT (along the FAP direction, relative).
+    pub compliance_worst: f64,
+    /// Mean FAP compliance error of the cloned FAT.
+    pub compliance_mean: f64,
+    /// Displacement error of the cloned FAT against the head's own rig FAT (keys both
+    /// have), percent: how far alma's procedural motion is from the artist's shapes, not a
+    /// cloning error alone.
+    pub vs_rig_fat_percent: f64,
+    /// Seconds the alma→head clone took.
+    pub clone_seconds: f64,
+}
+
 /// What [`run_demo`] did.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DemoReport {
@@ -121,6 +146,8 @@ pub struct DemoReport {
     pub files: Vec<DemoFile>,
     /// Quality per method (the output method first).
     pub quality: Vec<MethodQuality>,
+    /// The real head, when [`DemoOptions::real_head`] is set.
+    pub real_head: Option<RealHeadReport>,
     /// Named steps and their seconds.
     pub timings: Vec<(String, f64)>,
     /// Total wall time in seconds.
@@ -141,14 +168,14 @@ pub fn find_samples_dir() -> Option<PathBuf> {
         .find(|d| d.join("speech.fap").is_file())
 }
 
-/// A bundled face: `samples/faces/NAME.wrl.gz` when present (the user may have changed it),
+/// A bundled face: its file under `samples/` when present (the user may have changed it),
 /// else the copy embedded in the library.
 fn bundled_face(samples: &Path, face: BundledFace) -> Result<(FaceModel, String)> {
-    let path = samples
-        .join("faces")
-        .join(format!("{}.wrl.gz", face.name()));
+    let path = samples.join(face.sample_file());
     if path.is_file() {
-        let mut model = crate::face::read(&path)?;
+        let fp = face.sample_feature_points().map(|f| samples.join(f));
+        let opts = crate::face::FaceReadOptions::with_feature_points(fp.as_deref());
+        let mut model = crate::face::read_with(&path, &opts)?.0;
         model.name = face.name().to_string();
         return Ok((model, path.display().to_string()));
     }
@@ -269,6 +296,48 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     let mut bruno = outcome.face;
     bruno.name = "bruno".into();
 
+    // The real head: its own FAT from its ARKit shapes, and alma's cloned onto it.
+    let mut heads: Vec<(String, FaceModel)> = Vec::new();
+    let real_head = if opts.real_head {
+        let (ict, origin) = bundled_face(&samples, BundledFace::Ict)?;
+        clock.lap("load ict-head (FAT from its rig)");
+        let clone_opts = CloneOptions {
+            method: opts.method,
+            ..CloneOptions::default()
+        };
+        let t = Instant::now();
+        let cloned = clone_face(&alma, &strip_fat(&ict), &clone_opts)?;
+        let clone_seconds = t.elapsed().as_secs_f64();
+        clock.lap(&format!("clone alma→ict-head ({})", opts.method.name()));
+        warnings.extend(
+            cloned
+                .report
+                .warnings
+                .iter()
+                .map(|w| format!("ict-head: {w}")),
+        );
+        let c = compliance(&cloned.face)?;
+        let vs_rig = ground_truth_error(&cloned.face, &ict)?;
+        clock.lap("compliance + vs rig FAT (ict-head)");
+        let report = RealHeadReport {
+            origin,
+            vertices: ict.vertex_count(),
+            rig_tables: ict.fat.tables.len(),
+            cloned_tables: cloned.face.fat.tables.len(),
+            compliance_worst: c.worst,
+            compliance_mean: c.mean,
+            vs_rig_fat_percent: vs_rig.mean_all,
+            clone_seconds,
+        };
+        let mut head_cloned = cloned.face;
+        head_cloned.name = "ict-head-cloned".into();
+        heads.push(("ict-head".into(), ict));
+        heads.push(("ict-head-cloned".into(), head_cloned));
+        Some(report)
+    } else {
+        None
+    };
+
     let mut files = Vec::new();
     let wrl = out_dir.join("bruno-cloned.wrl");
     crate::face::vrml::write_face_file(&wrl, &bruno)?;
@@ -281,7 +350,9 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
 
     let mut frames = 0;
     let mut fps = stream.frame_rate;
-    for (name, face) in [("alma", &alma), ("bruno", &bruno)] {
+    let mut played: Vec<(&str, &FaceModel)> = vec![("alma", &alma), ("bruno", &bruno)];
+    played.extend(heads.iter().map(|(n, f)| (n.as_str(), f)));
+    for &(name, face) in &played {
         let player = Player::new(face, &stream, PlayOptions::default())?;
         frames = player.frame_count();
         fps = player.fps();
@@ -293,16 +364,22 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         warnings.extend(export.warnings);
         let path = out_dir.join(format!("{name}-speech.glb"));
         export.document.write_glb(&path)?;
-        record(
-            &mut files,
-            path,
-            &format!("speech.fap played on {name} (animated glTF)"),
-        )?;
+        let what = match name {
+            "ict-head" => "speech.fap on the ICT head with its own FAT (from its ARKit shapes)",
+            "ict-head-cloned" => "speech.fap on the ICT head with alma's FAT cloned onto it",
+            _ => "",
+        };
+        let what = if what.is_empty() {
+            format!("speech.fap played on {name} (animated glTF)")
+        } else {
+            what.to_string()
+        };
+        record(&mut files, path, &what)?;
     }
     clock.lap("play + write glb");
 
     let sheet = contact_sheet_rows(
-        &[("alma", &alma), ("bruno", &bruno)],
+        &played,
         &stream,
         PlayOptions::default(),
         opts.sheet_frames,
@@ -313,7 +390,12 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     record(
         &mut files,
         path,
-        "the same speech frames on alma (top) and cloned bruno (bottom)",
+        if played.len() > 2 {
+            "the same speech frames, a row each: alma, cloned bruno, the ICT head with its own \
+             FAT, the ICT head with alma's FAT"
+        } else {
+            "the same speech frames on alma (top) and cloned bruno (bottom)"
+        },
     )?;
     clock.lap("contact sheet");
 
@@ -350,17 +432,35 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         cloned_tables: bruno.fat.tables.len(),
         files,
         quality,
+        real_head,
         timings: clock.steps,
         total_seconds: start.elapsed().as_secs_f64(),
         warnings,
     })
 }
 
+impl DemoReport {
+    /// The time of each step, one line each (the CLI prints it with `--verbose`).
+    pub fn timings_text(&self) -> String {
+        let mut out = String::from("timings:\n");
+        for (name, s) in &self.timings {
+            out.push_str(&format!("  {name:<42} {s:>7.2} s\n"));
+        }
+        out.push_str(&format!(
+            "  {:<42} {:>7.2} s\n",
+            "total", self.total_seconds
+        ));
+        out
+    }
+}
+
+/// The report without the step timings ([`DemoReport::timings_text`]) and warnings
+/// ([`DemoReport::warnings`]), which a command line prints apart.
 impl fmt::Display for DemoReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "fbakit demo: alma's FAT cloned onto bruno ({}), {} played on both",
+            "fbakit demo: alma's FAT cloned onto bruno ({}), {} played on the faces",
             self.method.name(),
             self.stream.display()
         )?;
@@ -377,7 +477,7 @@ impl fmt::Display for DemoReport {
                 || file.path.display().to_string(),
                 |n| n.to_string_lossy().into(),
             );
-            writeln!(f, "  {name:<18} {:>9} bytes  {}", file.bytes, file.what)?;
+            writeln!(f, "  {name:<27} {:>9} bytes  {}", file.bytes, file.what)?;
         }
         writeln!(f, "quality (alma→bruno):")?;
         writeln!(
@@ -398,14 +498,22 @@ impl fmt::Display for DemoReport {
                 q.clone_seconds
             )?;
         }
-        writeln!(f, "timings:")?;
-        for (name, s) in &self.timings {
-            writeln!(f, "  {name:<42} {s:>7.2} s")?;
+        if let Some(h) = &self.real_head {
+            writeln!(
+                f,
+                "real head (ICT-FaceKit, {} vertices, {} tables from its ARKit shapes): alma's FAT \
+                 cloned in {:.2} s, {} tables, compliance worst/mean {:.4} / {:.4}, {:.1}% from \
+                 the head's own rig FAT",
+                h.vertices,
+                h.rig_tables,
+                h.clone_seconds,
+                h.cloned_tables,
+                h.compliance_worst,
+                h.compliance_mean,
+                h.vs_rig_fat_percent
+            )?;
         }
-        writeln!(f, "  {:<42} {:>7.2} s", "total", self.total_seconds)?;
-        for w in &self.warnings {
-            writeln!(f, "warning: {w}")?;
-        }
+        writeln!(f, "total {:.2} s", self.total_seconds)?;
         Ok(())
     }
 }

@@ -70,6 +70,8 @@ fn demo_writes_every_file() {
         "bruno-cloned.wrl",
         "alma-speech.glb",
         "bruno-speech.glb",
+        "ict-head-speech.glb",
+        "ict-head-cloned-speech.glb",
         "contact-sheet.png",
         "cloning-grid.png",
     ];
@@ -90,11 +92,31 @@ fn demo_writes_every_file() {
         report.cloned_tables
     );
     assert_eq!(bruno.mesh_sizes(), faces().1.mesh_sizes());
+    // The real head: its own FAT from its shapes, and alma's cloned onto it.
+    let head = report
+        .real_head
+        .as_ref()
+        .expect("the demo shows the real head");
+    assert_eq!(head.vertices, 24591);
+    assert!(head.rig_tables >= 50, "{head:?}");
+    assert!(head.cloned_tables >= 80, "{head:?}");
+    for v in [
+        head.compliance_worst,
+        head.compliance_mean,
+        head.vs_rig_fat_percent,
+    ] {
+        assert!(v.is_finite() && v >= 0.0, "{head:?}");
+    }
 }
 
 #[test]
 fn demo_glbs_parse_and_validate() {
-    let files = [demo_file("alma-speech.glb"), demo_file("bruno-speech.glb")];
+    let files = [
+        demo_file("alma-speech.glb"),
+        demo_file("bruno-speech.glb"),
+        demo_file("ict-head-speech.glb"),
+        demo_file("ict-head-cloned-speech.glb"),
+    ];
     for f in &files {
         let bytes = std::fs::read(f).unwrap();
         let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
@@ -152,13 +174,15 @@ fn assert_centred(img: &Image, stats: &ImageStats, coverage: std::ops::Range<f64
 fn demo_pngs_are_sane() {
     let opts = DemoOptions::quick();
     let sheet = read_png(&demo_file("contact-sheet.png"));
-    // Two rows of `sheet_frames` cells plus padding and caption strips.
+    // A row per face (alma, cloned bruno, the real head with its own and with alma's FAT) of
+    // `sheet_frames` cells plus padding and caption strips.
+    let rows = 4;
     let cell = opts.sheet_cell;
     assert!(
         sheet.width >= opts.sheet_frames as u32 * cell
             && sheet.width < opts.sheet_frames as u32 * (cell + 20)
     );
-    assert!(sheet.height >= 2 * cell && sheet.height < 2 * (cell + 40));
+    assert!(sheet.height >= rows * cell && sheet.height < rows * (cell + 40));
     assert_centred(
         &sheet,
         &sheet.stats(SHEET_BACKGROUND),
@@ -168,7 +192,7 @@ fn demo_pngs_are_sane() {
     // Each cell's render background is the renderer's; the face covers a middle part of it.
     let bg = RenderOptions::default().background;
     let mut faces_seen = 0;
-    for row in 0..2u32 {
+    for row in 0..rows {
         for col in 0..opts.sheet_frames as u32 {
             let (x0, y0) = (6 + col * (cell + 6), 6 + row * (cell + 6 + 7 + 6));
             let c = crop(&sheet, x0, y0, cell, cell);
@@ -176,7 +200,7 @@ fn demo_pngs_are_sane() {
             faces_seen += 1;
         }
     }
-    assert_eq!(faces_seen, 2 * opts.sheet_frames);
+    assert_eq!(faces_seen, rows as usize * opts.sheet_frames);
     let grid = read_png(&demo_file("cloning-grid.png"));
     assert!(grid.width > 2 * opts.grid_cell && grid.height > 2 * opts.grid_cell);
     let s = grid.stats(SHEET_BACKGROUND);
@@ -223,7 +247,13 @@ fn demo_figures_are_within_bounds() {
     assert_eq!(r.fps, 25.0);
     assert!(r.timings.iter().all(|(_, s)| s.is_finite() && *s >= 0.0));
     let text = r.to_string();
-    for needle in ["bruno-cloned.wrl", "self-clone alma", "fmc", "total"] {
+    for needle in [
+        "bruno-cloned.wrl",
+        "self-clone alma",
+        "fmc",
+        "real head",
+        "total",
+    ] {
         assert!(text.contains(needle), "{needle} missing from\n{text}");
     }
 }

@@ -19,6 +19,9 @@ pub enum FaceFormat {
     Obj,
     /// The CANDIDE-3 model (`.wfm`); needs its feature-point table.
     Wfm,
+    /// A glTF 2.0 blendshape rig (`.glb`, `.gltf`): meshes and morph targets; with feature
+    /// points its shapes become a FAT ([`crate::face::read`]).
+    Gltf,
 }
 
 impl FaceFormat {
@@ -34,6 +37,8 @@ impl FaceFormat {
             Some(FaceFormat::Obj)
         } else if ends(".wfm") {
             Some(FaceFormat::Wfm)
+        } else if ends(".glb") || ends(".gltf") {
+            Some(FaceFormat::Gltf)
         } else {
             None
         }
@@ -44,23 +49,30 @@ impl FaceFormat {
         FaceFormat::of_extension(path).ok_or_else(|| {
             Error::Unsupported(format!(
                 "{}: unknown face file type (expected .wrl, .vrml, .wrl.gz, .vrml.gz, .wrz, \
-                 .obj or .wfm)",
+                 .obj, .wfm, .glb or .gltf, or a folder of rig shape OBJs)",
                 path.display()
             ))
         })
     }
 
-    /// Recognises a face file by its first bytes: the gzip magic, the VRML header, the
-    /// CANDIDE-3 section headers or OBJ statements. `None` when nothing matches.
+    /// Recognises a face file by its first bytes: the gzip magic, the GLB magic or a glTF
+    /// JSON `asset`, the VRML header, the CANDIDE-3 section headers or OBJ statements.
+    /// `None` when nothing matches.
     pub fn sniff(bytes: &[u8]) -> Option<FaceFormat> {
         if bytes.starts_with(&[0x1f, 0x8b]) {
             return Some(FaceFormat::VrmlGz);
+        }
+        if bytes.starts_with(b"glTF") {
+            return Some(FaceFormat::Gltf);
         }
         let head = &bytes[..bytes.len().min(64 * 1024)];
         let text = String::from_utf8_lossy(head);
         let text = text.trim_start_matches('\u{feff}');
         if text.starts_with("#VRML") {
             return Some(FaceFormat::Vrml);
+        }
+        if text.trim_start().starts_with('{') && text.contains("\"asset\"") {
+            return Some(FaceFormat::Gltf);
         }
         if text.contains("# VERTEX LIST:") && text.contains("# FACE LIST:") {
             return Some(FaceFormat::Wfm);
@@ -92,7 +104,7 @@ pub fn face_name(path: &Path) -> String {
         .unwrap_or_else(|| "face".into());
     let lower = name.to_ascii_lowercase();
     for ext in [
-        ".wrl.gz", ".vrml.gz", ".wrz", ".wrl", ".vrml", ".obj", ".wfm",
+        ".wrl.gz", ".vrml.gz", ".wrz", ".wrl", ".vrml", ".obj", ".wfm", ".glb", ".gltf",
     ] {
         if lower.ends_with(ext) && name.len() > ext.len() {
             return name[..name.len() - ext.len()].to_string();
@@ -116,6 +128,9 @@ mod tests {
         assert_eq!(f("a.obj"), Some(FaceFormat::Obj));
         assert_eq!(f("c.wfm"), Some(FaceFormat::Wfm));
         assert_eq!(f("a.gz"), None);
+        assert_eq!(f("rig.glb"), Some(FaceFormat::Gltf));
+        assert_eq!(f("rig.GLTF"), Some(FaceFormat::Gltf));
+        assert_eq!(face_name(Path::new("x/avatar.glb")), "avatar");
         assert_eq!(face_name(Path::new("x/alma.wrl.gz")), "alma");
         assert_eq!(face_name(Path::new("x/head.obj")), "head");
     }
@@ -129,6 +144,11 @@ mod tests {
         assert_eq!(
             FaceFormat::sniff(&[0x1f, 0x8b, 8, 0]),
             Some(FaceFormat::VrmlGz)
+        );
+        assert_eq!(FaceFormat::sniff(b"glTF\x02\0\0\0"), Some(FaceFormat::Gltf));
+        assert_eq!(
+            FaceFormat::sniff(b"{\n  \"asset\": {\"version\": \"2.0\"}}"),
+            Some(FaceFormat::Gltf)
         );
         assert_eq!(
             FaceFormat::sniff(b"# a mesh\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),

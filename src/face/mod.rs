@@ -15,6 +15,7 @@ pub mod attach;
 pub mod bundled;
 pub mod candide;
 pub mod format;
+mod from_rig;
 pub mod morphs;
 pub mod parts;
 pub mod pose;

@@ -13,6 +13,10 @@
 //! bindings) to become a face with a FAT. Points given by position only are bound to the
 //! nearest vertex and reported in [`FaceReadReport::fp_matches`].
 //!
+//! **Rigs.** A glTF file with morph targets (`.glb`, `.gltf`) or a folder of shape OBJs (the
+//! ICT-FaceKit layout) reads as a face too: with feature points its shapes become a
+//! FAP-compliant FAT through the ARKit-52 map, without them only its neutral meshes.
+//!
 //! ```
 //! let alma = fbakit::face::read("alma")?; // a bundled face, by name
 //! assert!(alma.fat.tables.len() > 60);
@@ -68,12 +72,17 @@ pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, Face
     }
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
-        return Err(Error::Invalid(format!(
-            "{}: is a directory; expected a face file (.wrl, .wrl.gz, .obj, .wfm) or a \
-             bundled face name ({})",
-            path.display(),
-            BundledFace::NAMES.join(", ")
-        )));
+        // A folder is a face only as an OBJ blendshape rig (a neutral plus shape OBJs).
+        let rig = crate::rig::obj_folder::read_obj_rig(path).map_err(|e| {
+            Error::Invalid(format!(
+                "{}: is a directory and not a rig folder ({e}); expected a face file (.wrl, \
+                 .wrl.gz, .obj, .wfm, .glb, .gltf), a folder of rig shape OBJs or a bundled \
+                 face name ({})",
+                path.display(),
+                BundledFace::NAMES.join(", ")
+            ))
+        })?;
+        return super::from_rig::rig_face(path, &rig, opts.feature_points.as_deref());
     }
     let bytes = crate::io::read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
     read_bytes_at(path, &bytes, opts)
@@ -114,6 +123,10 @@ fn read_bytes_at(
         }
         FaceFormat::Obj => obj_face(path, bytes, &name)?,
         FaceFormat::Wfm => return candide(path, bytes, opts),
+        FaceFormat::Gltf => {
+            let rig = crate::rig::gltf_read::read_gltf_bytes(bytes, path)?;
+            return super::from_rig::rig_face(path, &rig, opts.feature_points.as_deref());
+        }
     };
     if let Some(fp) = &opts.feature_points {
         report.fp_matches = attach_file(&mut face, fp, path)?;
