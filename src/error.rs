@@ -199,6 +199,7 @@ impl Error {
             Error::Io { source, .. } => matches!(
                 source.kind(),
                 std::io::ErrorKind::NotFound
+                    | std::io::ErrorKind::IsADirectory
                     | std::io::ErrorKind::PermissionDenied
                     | std::io::ErrorKind::InvalidData
                     | std::io::ErrorKind::FileTooLarge

@@ -41,6 +41,14 @@ pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
 /// Invalid UTF-8 is an error that names the byte offset of the first bad sequence.
 pub fn read_text(path: &Path) -> Result<String> {
     let bytes = read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
+    // A compressed file where text was expected deserves a hint, not a byte value.
+    if bytes.starts_with(&[0x1F, 0x8B]) {
+        return Err(Error::Parse(crate::error::ParseError {
+            location: crate::error::Location::from_offset(path, "", 0),
+            expected: "UTF-8 text".to_string(),
+            found: Some("gzip-compressed data (decompress it first, e.g. `gunzip -k`)".to_string()),
+        }));
+    }
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let valid = std::str::from_utf8(&e.as_bytes()[..at]).unwrap_or_default();

@@ -7,7 +7,9 @@ use fbakit::error::Result;
 use fbakit::face::candide::candide_face_with_notes;
 use fbakit::face::write as write_face;
 
-use super::EXIT_OK;
+use serde::Serialize;
+
+use super::{print_json, EXIT_OK};
 
 /// Arguments of `candide`.
 #[derive(Debug, clap::Args)]
@@ -23,6 +25,9 @@ pub struct CandideArgs {
     /// Output face (.wrl, .wrl.gz, .obj).
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Writes a CANDIDE face.
@@ -35,15 +40,15 @@ pub fn run(a: CandideArgs) -> Result<u8> {
     };
     let c = candide_face_with_notes(&model, &fp, &shape)?;
     write_face(&a.output, &c.face)?;
-    for n in &c.notes {
-        eprintln!("note: {n}");
+    let report = Written::of(&a.output, &c.face, c.notes.clone());
+    if a.json {
+        print_json(&report)?;
+    } else {
+        for n in &c.notes {
+            eprintln!("note: {n}");
+        }
+        eprintln!("{report}");
     }
-    eprintln!(
-        "wrote {} ({} vertices, {} FAT tables)",
-        a.output.display(),
-        c.face.vertex_count(),
-        c.face.fat.tables.len()
-    );
     Ok(EXIT_OK)
 }
 
@@ -56,6 +61,9 @@ pub struct SampleArgs {
     /// Output face (.wrl, .wrl.gz, .obj).
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Writes a bundled procedural face.
@@ -66,11 +74,43 @@ pub fn sample(a: SampleArgs) -> Result<u8> {
     };
     let face = synth.to_face_model();
     write_face(&a.output, &face)?;
-    eprintln!(
-        "wrote {} ({} vertices, {} FAT tables)",
-        a.output.display(),
-        face.vertex_count(),
-        face.fat.tables.len()
-    );
+    let report = Written::of(&a.output, &face, Vec::new());
+    if a.json {
+        print_json(&report)?;
+    } else {
+        eprintln!("{report}");
+    }
     Ok(EXIT_OK)
+}
+
+/// What `candide` and `sample` wrote.
+#[derive(Serialize)]
+struct Written {
+    output: String,
+    meshes: usize,
+    vertices: usize,
+    tables: usize,
+    notes: Vec<String>,
+}
+
+impl Written {
+    fn of(path: &std::path::Path, face: &fbakit::face::FaceModel, notes: Vec<String>) -> Self {
+        Written {
+            output: path.display().to_string(),
+            meshes: face.meshes.len(),
+            vertices: face.vertex_count(),
+            tables: face.fat.tables.len(),
+            notes,
+        }
+    }
+}
+
+impl std::fmt::Display for Written {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "wrote {} ({} vertices, {} FAT tables)",
+            self.output, self.vertices, self.tables
+        )
+    }
 }

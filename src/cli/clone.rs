@@ -12,7 +12,7 @@ use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use super::{print_json, MethodArg, EXIT_OK};
+use super::{print_json, print_warnings, MethodArg, EXIT_OK};
 
 #[derive(Debug, clap::Args)]
 pub struct CloneArgs {
@@ -25,7 +25,7 @@ pub struct CloneArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Surface method.
-    #[arg(long, value_enum, default_value = "fmc")]
+    #[arg(long, value_enum, default_value_t)]
     pub method: MethodArg,
     /// RBF as in the paper: no FAPU rescaling of the cloned motions.
     #[arg(long)]
@@ -46,6 +46,9 @@ pub struct CloneArgs {
     /// Also measure quality: self-clone error of the source, compliance of the output.
     #[arg(long)]
     pub report: bool,
+    /// Print the time of each cloning step (always in --json).
+    #[arg(short, long)]
+    pub verbose: bool,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -76,7 +79,7 @@ pub struct SelfCloneArgs {
     #[command(flatten)]
     pub face: EvalFaceArgs,
     /// Surface method.
-    #[arg(long, value_enum, default_value = "fmc")]
+    #[arg(long, value_enum, default_value_t)]
     pub method: MethodArg,
 }
 
@@ -118,6 +121,8 @@ struct Output<'a> {
     report: &'a CloneReport,
     #[serde(skip_serializing_if = "Option::is_none")]
     quality: Option<Quality>,
+    /// Warnings from writing the output file.
+    write_warnings: Vec<String>,
 }
 
 pub fn run(args: CloneArgs) -> Result<u8> {
@@ -141,9 +146,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     pb.inc(1);
     pb.set_message("writing");
     // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it).
-    for w in write_face(&args.output, &outcome.face)? {
-        eprintln!("warning: {w}");
-    }
+    let write_warnings = write_face(&args.output, &outcome.face)?;
     pb.inc(1);
     let quality = if args.report {
         pb.set_message("measuring quality");
@@ -163,12 +166,12 @@ pub fn run(args: CloneArgs) -> Result<u8> {
             output: args.output.display().to_string(),
             report: r,
             quality,
+            write_warnings,
         })?;
         return Ok(EXIT_OK);
     }
-    for w in &r.warnings {
-        eprintln!("warning: {w}");
-    }
+    print_warnings(&r.warnings);
+    print_warnings(&write_warnings);
     println!(
         "cloned {} morph targets ({} tables) with {} onto {} skin vertices in {:.3} s -> {}",
         r.motions,
@@ -184,8 +187,10 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         r.alignment.angle_degrees(),
         r.alignment_rms
     );
-    for (step, s) in &r.timings.steps {
-        println!("  {step:<20} {:>8.1} ms", s * 1000.0);
+    if args.verbose {
+        for (step, s) in &r.timings.steps {
+            println!("  {step:<20} {:>8.1} ms", s * 1000.0);
+        }
     }
     if let Some(q) = quality {
         println!(

@@ -10,7 +10,7 @@ use fbakit::face::validate::validate_face;
 use fbakit::face::{read_with, FaceReadOptions};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
 
-use super::{print_json, EXIT_FAILURE, EXIT_OK};
+use super::{print_json, print_warnings, EXIT_FAILURE, EXIT_OK};
 
 /// Face subcommands.
 #[derive(Debug, clap::Subcommand)]
@@ -124,6 +124,9 @@ pub struct ConvertArgs {
     /// Feature-point file for the input (needed to give an OBJ face feature points).
     #[arg(long, value_name = "FILE")]
     pub fp: Option<PathBuf>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `face from-morphs`.
@@ -146,6 +149,9 @@ pub struct FromMorphsArgs {
     /// bounding-box diagonal).
     #[arg(long)]
     pub tolerance: Option<f64>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `face to-morphs`.
@@ -158,6 +164,9 @@ pub struct ToMorphsArgs {
     /// Evaluate every table at this value instead of its reference values.
     #[arg(long, value_name = "P", allow_negative_numbers = true)]
     pub value: Option<f64>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Runs a face subcommand.
@@ -228,9 +237,18 @@ fn convert(a: ConvertArgs) -> Result<u8> {
         &a.input,
         &FaceReadOptions::with_feature_points(a.fp.as_deref()),
     )?;
-    for w in write_face(&a.output, &face)? {
-        eprintln!("warning: {w}");
+    let warnings = write_face(&a.output, &face)?;
+    if a.json {
+        print_json(&serde_json::json!({
+            "output": a.output.display().to_string(),
+            "meshes": face.meshes.len(),
+            "vertices": face.vertex_count(),
+            "tables": face.fat.tables.len(),
+            "warnings": warnings,
+        }))?;
+        return Ok(EXIT_OK);
     }
+    print_warnings(&warnings);
     eprintln!(
         "wrote {} ({} meshes, {} vertices, {} FAT tables)",
         a.output.display(),
@@ -248,7 +266,17 @@ fn from_morphs(a: FromMorphsArgs) -> Result<u8> {
         tolerance: a.tolerance,
     };
     let (face, report) = face_from_morph_set(&a.neutral, &a.morph_dir, &options)?;
-    write_face(&a.output, &face)?;
+    let warnings = write_face(&a.output, &face)?;
+    if a.json {
+        print_json(&serde_json::json!({
+            "output": a.output.display().to_string(),
+            "tables": face.fat.tables.len(),
+            "report": report,
+            "warnings": warnings,
+        }))?;
+        return Ok(EXIT_OK);
+    }
+    print_warnings(&warnings);
     for m in &report.morphs {
         eprintln!(
             "{}: {} at {} ({:?}), {} vertices",
@@ -275,6 +303,13 @@ fn from_morphs(a: FromMorphsArgs) -> Result<u8> {
 fn to_morphs(a: ToMorphsArgs) -> Result<u8> {
     let (face, _) = read_with(&a.face, &FaceReadOptions::default())?;
     let written = write_morph_set(&face, &a.dir, a.value)?;
+    if a.json {
+        print_json(&serde_json::json!({
+            "directory": a.dir.display().to_string(),
+            "morphs": written,
+        }))?;
+        return Ok(EXIT_OK);
+    }
     eprintln!(
         "wrote {} morph OBJs, neutral.obj and feature-points.csv to {}",
         written.len(),

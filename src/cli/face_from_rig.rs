@@ -64,12 +64,8 @@ pub fn run(a: FromRigArgs) -> Result<u8> {
         None => None,
     };
     let (face, report) = face_from_rig(&rig, fp, &map)?;
-    for w in fbakit::export::write_face(&a.output, &face)? {
-        eprintln!("warning: {w}");
-    }
-    for w in &rig.warnings {
-        eprintln!("warning: {w}");
-    }
+    super::print_warnings(&fbakit::export::write_face(&a.output, &face)?);
+    super::print_warnings(&rig.warnings);
     if a.json {
         print_json(&Output {
             rig: a.rig.display().to_string(),

@@ -166,9 +166,7 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
         fapu,
         warnings,
     };
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
-    }
+    super::print_warnings(&report.warnings);
     if args.json {
         print_json(&report)?;
     } else {

@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 
 mod candide;
 mod clone;
+mod docs;
 pub mod face;
 pub mod face_export;
 mod face_from_rig;
@@ -23,13 +24,30 @@ mod show;
 mod speak;
 mod view;
 
-/// A cloning method on the command line (`--method fmc|rbf`).
+/// A cloning method on the command line (`--method fmc|rbf`). `clone`, `eval self-clone`,
+/// `grid` and `demo` share one default, [`MethodArg::default`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum MethodArg {
     /// Facial motion cloning (Pandzic 2003).
     Fmc,
     /// RBF cloning (Fratarcangeli & Schaerf 2005).
     Rbf,
+}
+
+impl Default for MethodArg {
+    /// The library's default method ([`fbakit::clone::face::Method::default`]).
+    fn default() -> Self {
+        match fbakit::clone::face::Method::default() {
+            fbakit::clone::face::Method::Fmc => MethodArg::Fmc,
+            fbakit::clone::face::Method::Rbf => MethodArg::Rbf,
+        }
+    }
+}
+
+impl std::fmt::Display for MethodArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(fbakit::clone::face::Method::from(*self).name())
+    }
 }
 
 impl From<MethodArg> for fbakit::clone::face::Method {
@@ -60,11 +78,28 @@ pub const EXIT_BAD_INPUT: u8 = 2;
 #[command(
     name = "fbakit",
     version,
-    about = "MPEG-4 Face and Body Animation toolkit: FAP streams, feature points, FAPUs",
-    long_about = "fbakit reads, checks and writes MPEG-4 facial animation data: ASCII FAP \
-                  streams, facial feature points and their FAP units (FAPU).\n\n\
-                  Exit codes: 0 ok, 1 the operation failed (e.g. validation found problems), \
-                  2 bad usage or unreadable input."
+    about = "MPEG-4 facial animation: FAP streams, feature points, FATs, cloning, playback, \
+             video, speech",
+    long_about = "fbakit reads, checks and writes MPEG-4 Face Animation data (FAP streams, \
+                  feature points and FAP units, faces with Facial Animation Tables in VRML, \
+                  OBJ, CANDIDE-3 and glTF, blendshape rigs), clones a face's FAT onto \
+                  another face, and plays FAP streams as glTF, pictures, video or a one-file \
+                  HTML viewer; `speak` turns typed text into a viseme stream.\n\n\
+                  Every command takes --json (errors are then JSON on stderr too). Warnings \
+                  go to stderr. Exit codes: 0 ok, 1 the operation failed (e.g. validation \
+                  found problems, an output could not be written), 2 bad usage or bad input.",
+    after_help = "Examples:\n  \
+                  fbakit demo                                      the whole pipeline on the bundled faces\n  \
+                  fbakit face info alma                            a face: meshes, feature points, FAPU, FAT\n  \
+                  fbakit fap info samples/speech.fap               a FAP stream\n  \
+                  fbakit clone alma bruno.wrl -o bruno-fat.wrl     clone a FAT onto another face\n  \
+                  fbakit play alma samples/speech.fap -o a.glb     play a stream as animated glTF\n  \
+                  fbakit view alma samples/speech.fap -o a.html    a viewer page that plays on load\n  \
+                  fbakit speak \"Hello world\" -o hi.fap --wav hi.wav  text to visemes with espeak-ng\n  \
+                  fbakit render alma hi.fap --audio hi.wav -o hi.mp4  a talking-head video\n  \
+                  fbakit face from-rig RIG --fp fp.csv -o face.wrl  a FAP-compliant FAT from ARKit shapes\n  \
+                  fbakit completions bash > fbakit.bash            shell completions (man: fbakit man -o DIR)\n\n\
+                  `fbakit COMMAND --help` shows each command's options and examples."
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -245,6 +280,16 @@ pub enum Command {
         after_help = "Example:\n  fbakit rig info ../shared/data/ict-facekit"
     )]
     Rig(rig::RigCommand),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell) on stdout.
+    #[command(
+        after_help = "Examples:\n  fbakit completions bash > ~/.local/share/bash-completion/completions/fbakit\n  \
+                      fbakit completions zsh > ~/.zfunc/_fbakit\n  \
+                      fbakit completions fish > ~/.config/fish/completions/fbakit.fish"
+    )]
+    Completions(docs::CompletionsArgs),
+    /// Write man pages: fbakit.1 and one page per subcommand (fbakit-play.1, ...).
+    #[command(after_help = "Examples:\n  fbakit man -o man/\n  man -l man/fbakit-play.1")]
+    Man(docs::ManArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -257,8 +302,9 @@ pub struct SpecArgs {
     pub json: bool,
 }
 
-/// Runs a parsed command line and maps the outcome to an exit code.
-pub fn run(cli: Cli) -> ExitCode {
+/// Runs a parsed command line and maps the outcome to an exit code; `json` makes an error
+/// a JSON object (see [`print_error`]).
+pub fn run(cli: Cli, json: bool) -> ExitCode {
     let result = match cli.command {
         Command::Spec(args) => spec(args),
         Command::Fapu(args) => fapu::run(args),
@@ -276,21 +322,64 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Render(args) => render::run(args),
         Command::Speak(args) => speak::run(args),
         Command::Rig(cmd) => rig::run(cmd),
+        Command::Completions(args) => docs::completions(args),
+        Command::Man(args) => docs::man(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),
-        Err(e) => report_error(&e),
+        Err(e) => report_error(&e, json),
     }
 }
 
+/// Whether the command line asks for JSON output (`--json` before any `--`), so errors,
+/// including clap's usage errors that come before a command is parsed, are JSON too.
+pub fn wants_json(args: &[std::ffi::OsString]) -> bool {
+    args.iter()
+        .skip(1)
+        .take_while(|a| a.as_os_str() != "--")
+        .any(|a| a.as_os_str() == "--json")
+}
+
+/// Prints an error to stderr (one line of text, or one JSON object under `--json`) and
+/// returns `code`.
+pub fn print_error(message: &str, code: u8, json: bool) -> ExitCode {
+    if json {
+        let kind = if code == EXIT_BAD_INPUT {
+            "bad-input"
+        } else {
+            "failure"
+        };
+        let value = serde_json::json!({
+            "error": { "message": message, "exit_code": code, "kind": kind }
+        });
+        eprintln!("{value}");
+    } else {
+        eprintln!("error: {message}");
+    }
+    ExitCode::from(code)
+}
+
 /// Prints a library error to stderr and picks its exit code.
-pub fn report_error(e: &fbakit::error::Error) -> ExitCode {
-    eprintln!("error: {e}");
-    ExitCode::from(if e.is_input_error() {
+pub fn report_error(e: &fbakit::error::Error, json: bool) -> ExitCode {
+    let code = if e.is_input_error() {
         EXIT_BAD_INPUT
     } else {
         EXIT_FAILURE
-    })
+    };
+    print_error(&e.to_string(), code, json)
+}
+
+/// Prints warnings to stderr, each once and with one `warning:` prefix (library warnings
+/// sometimes carry their own).
+pub fn print_warnings<S: AsRef<str>>(warnings: &[S]) {
+    let mut seen = std::collections::HashSet::new();
+    for w in warnings {
+        let w = w.as_ref().trim();
+        let w = w.strip_prefix("warning:").map_or(w, str::trim_start);
+        if seen.insert(w.to_string()) {
+            eprintln!("warning: {w}");
+        }
+    }
 }
 
 /// Prints any serialisable value as pretty JSON on stdout.

@@ -45,7 +45,7 @@ pub struct PlayArgs {
     pub output: PathBuf,
     /// Output frame rate (the stream is resampled, values interpolated); default: the
     /// stream's.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = super::parse_fps)]
     pub fps: Option<f64>,
     /// Output frames to play, `a..b` (end exclusive; `a..` and `..b` too).
     #[arg(long, value_name = "a..b", value_parser = parse_range)]
@@ -246,6 +246,7 @@ pub fn run(a: PlayArgs) -> Result<u8> {
         print_json(&report)?;
     } else {
         print!("{}", report_text(&report));
+        super::print_warnings(&report.warnings);
     }
     Ok(EXIT_OK)
 }
@@ -315,9 +316,6 @@ fn report_text(r: &PlayReport) -> String {
         for m in &r.missing_tables {
             let _ = writeln!(o, "  {} in {} frames", m.key, m.frames);
         }
-    }
-    for w in &r.warnings {
-        let _ = writeln!(o, "warning: {w}");
     }
     o
 }

@@ -29,7 +29,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Video frame rate (the stream is resampled); default: the stream's.
-    #[arg(long, value_name = "N", value_parser = parse_fps)]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_fps)]
     pub fps: Option<f64>,
     /// Sound file muxed into the mp4 (e.g. the WAV from `fbakit speak`). The video sets the
     /// length: longer audio is cut, shorter audio ends in silence.
@@ -134,9 +134,7 @@ pub fn run(a: RenderArgs) -> Result<u8> {
     if a.json {
         print_json(&out)?;
     } else {
-        for w in &out.warnings {
-            eprintln!("warning: {w}");
-        }
+        super::print_warnings(&out.warnings);
         let what = match format {
             VideoFormat::Mp4 if out.audio.is_some() => "H.264 MP4 with AAC audio",
             VideoFormat::Mp4 => "H.264 MP4",

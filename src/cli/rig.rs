@@ -101,9 +101,7 @@ pub fn run(cmd: RigCommand) -> Result<u8> {
     match cmd {
         RigCommand::Info(a) => {
             let rig = read_rig(&a.rig)?;
-            for w in &rig.warnings {
-                eprintln!("warning: {w}");
-            }
+            super::print_warnings(&rig.warnings);
             let i = info(&rig);
             if a.json {
                 print_json(&i)?;

@@ -27,7 +27,7 @@ pub struct GridArgs {
     #[arg(long, default_value_t = 63.0)]
     pub value: f64,
     /// Cloning method.
-    #[arg(long, value_enum, default_value = "rbf")]
+    #[arg(long, value_enum, default_value_t)]
     pub method: MethodArg,
     /// Cell side in pixels.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=2048))]
@@ -35,6 +35,9 @@ pub struct GridArgs {
     /// Output PNG.
     #[arg(short, long, value_name = "OUT.png")]
     pub output: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 fn parse_key(s: &str) -> std::result::Result<TableKey, String> {
@@ -67,6 +70,18 @@ pub fn grid(a: GridArgs) -> Result<u8> {
     let pairs: Vec<(&str, &FaceModel)> = names.iter().map(String::as_str).zip(&faces).collect();
     let image = cloning_grid(&pairs, a.key, a.value, a.method.into(), a.cell)?;
     image.write_png(&a.output)?;
+    if a.json {
+        print_json(&serde_json::json!({
+            "output": a.output.display().to_string(),
+            "faces": names,
+            "key": a.key.name(),
+            "value": a.value,
+            "method": Method::from(a.method),
+            "width": image.width,
+            "height": image.height,
+        }))?;
+        return Ok(EXIT_OK);
+    }
     println!(
         "wrote {}: {}×{} cloning grid of {} ({} at {}, {})",
         a.output.display(),
@@ -86,9 +101,8 @@ pub struct DemoArgs {
     /// Output directory (created).
     #[arg(long, default_value = "fbakit-demo", value_name = "DIR")]
     pub out: PathBuf,
-    /// Cloning method for the outputs (the other one is measured too unless --single); rbf
-    /// by default because fmc leaves visible seams at the chin and lower lids of bruno.
-    #[arg(long, value_enum, default_value = "rbf")]
+    /// Cloning method for the outputs (the other one is measured too unless --single).
+    #[arg(long, value_enum, default_value_t)]
     pub method: MethodArg,
     /// Only run the chosen method (skip the comparison with the other one).
     #[arg(long)]
@@ -96,6 +110,9 @@ pub struct DemoArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Print the time of each step (always in --json).
+    #[arg(short, long)]
+    pub verbose: bool,
 }
 
 /// Runs `demo`.
@@ -110,6 +127,10 @@ pub fn demo(a: DemoArgs) -> Result<u8> {
         print_json(&report)?;
     } else {
         print!("{report}");
+        if a.verbose {
+            print!("{}", report.timings_text());
+        }
+        super::print_warnings(&report.warnings);
     }
     Ok(EXIT_OK)
 }

@@ -47,7 +47,7 @@ pub struct SpeakArgs {
     #[arg(long, default_value = "en")]
     pub voice: String,
     /// Frames per second of the stream.
-    #[arg(long, value_name = "N", default_value_t = 25.0, value_parser = parse_fps)]
+    #[arg(long, value_name = "N", default_value_t = 25.0, allow_negative_numbers = true, value_parser = parse_fps)]
     pub fps: f64,
     /// What moves the mouth: FAP 1 visemes, low-level jaw and lip FAPs, or both.
     #[arg(long, value_enum, default_value = "visemes")]

@@ -29,7 +29,7 @@ pub struct ViewArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Frame rate of the embedded animation (the stream is resampled); default: the stream's.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = super::parse_fps)]
     pub fps: Option<f64>,
     /// Stream frames to play, `a..b` (end exclusive; `a..` and `..b` too).
     #[arg(long, value_name = "a..b", value_parser = parse_range)]
@@ -150,9 +150,7 @@ pub fn run(a: ViewArgs) -> Result<u8> {
                 println!("  {m}");
             }
         }
-        for w in &report.warnings {
-            eprintln!("warning: {w}");
-        }
+        super::print_warnings(&report.warnings);
     }
     Ok(EXIT_OK)
 }
