@@ -181,12 +181,29 @@ pub enum Error {
     /// input: exit code 1.
     #[error("{0}")]
     MissingTool(String),
+    /// Writing an output failed (the input was fine): exit code 1 whatever the OS said.
+    #[error("cannot write {}: {source}", path.display())]
+    Output {
+        /// The output the user named (never a temporary file).
+        path: PathBuf,
+        /// The OS error.
+        #[source]
+        source: std::io::Error,
+    },
 }
 
 impl Error {
     /// An I/O error on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// A failure writing the output `path`.
+    pub fn output(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Output {
             path: path.into(),
             source,
         }
@@ -205,7 +222,7 @@ impl Error {
                     | std::io::ErrorKind::FileTooLarge
             ),
             Error::Parse(_) | Error::Invalid(_) | Error::Unsupported(_) => true,
-            Error::MissingTool(_) => false,
+            Error::MissingTool(_) | Error::Output { .. } => false,
         }
     }
 }

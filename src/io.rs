@@ -74,10 +74,19 @@ pub fn write_atomic_with(
     let mut out = AtomicFile::create(path, ".tmp")?;
     {
         let mut w = std::io::BufWriter::new(out.file());
-        fill(&mut w).map_err(|e| Error::io(path, e))?;
-        w.flush().map_err(|e| Error::io(path, e))?;
+        fill(&mut w).map_err(|e| Error::output(path, e))?;
+        w.flush().map_err(|e| Error::output(path, e))?;
     }
     out.commit()
+}
+
+/// The OS error alone: `tempfile` appends the temporary file's name, which means nothing to
+/// the user (errors name the output they asked for).
+fn without_temp_path(e: std::io::Error) -> std::io::Error {
+    match e.raw_os_error() {
+        Some(code) => std::io::Error::from_raw_os_error(code),
+        None => std::io::Error::from(e.kind()),
+    }
 }
 
 /// The directory a new output at `path` is created in (`.` for a bare file name).
@@ -107,7 +116,7 @@ impl AtomicFile {
             .prefix(".fbakit-")
             .suffix(suffix)
             .tempfile_in(dir)
-            .map_err(|e| Error::io(dir, e))?;
+            .map_err(|e| Error::output(path, without_temp_path(e)))?;
         Ok(AtomicFile {
             tmp,
             path: path.to_path_buf(),
@@ -133,9 +142,12 @@ impl AtomicFile {
     /// it to the final path.
     pub fn commit(self) -> Result<()> {
         let AtomicFile { tmp, path } = self;
-        tmp.as_file().sync_all().map_err(|e| Error::io(&path, e))?;
-        set_default_permissions(tmp.as_file()).map_err(|e| Error::io(&path, e))?;
-        tmp.persist(&path).map_err(|e| Error::io(&path, e.error))?;
+        tmp.as_file()
+            .sync_all()
+            .map_err(|e| Error::output(&path, e))?;
+        set_default_permissions(tmp.as_file()).map_err(|e| Error::output(&path, e))?;
+        tmp.persist(&path)
+            .map_err(|e| Error::output(&path, without_temp_path(e.error)))?;
         Ok(())
     }
 }
@@ -157,7 +169,7 @@ impl AtomicDir {
             .prefix(".fbakit-")
             .suffix(".tmp")
             .tempdir_in(dir)
-            .map_err(|e| Error::io(dir, e))?;
+            .map_err(|e| Error::output(path, without_temp_path(e)))?;
         Ok(AtomicDir {
             tmp,
             path: path.to_path_buf(),
@@ -189,9 +201,10 @@ impl AtomicDir {
             let aside = tempfile::Builder::new()
                 .prefix(".fbakit-old-")
                 .tempdir_in(parent_dir(&path))
-                .map_err(|e| Error::io(&path, e))?;
+                .map_err(|e| Error::output(&path, without_temp_path(e)))?;
             let aside_path = aside.path().join("old");
-            std::fs::rename(&path, &aside_path).map_err(|e| Error::io(&path, e))?;
+            std::fs::rename(&path, &aside_path)
+                .map_err(|e| Error::output(&path, without_temp_path(e)))?;
             Some((aside, aside_path))
         } else {
             None
@@ -203,7 +216,7 @@ impl AtomicDir {
                 let _ = std::fs::rename(aside_path, &path);
             }
             let _ = std::fs::remove_dir_all(&kept);
-            return Err(Error::io(&path, e));
+            return Err(Error::output(&path, e));
         }
         // `old`'s TempDir removes the previous content when dropped here.
         drop(old);

@@ -90,7 +90,12 @@ fn animation_weights_reproduce_played_positions() {
                 .find(|c| c.target.node == node && c.target.path == "weights")
                 .unwrap();
             let weights = floats(&doc, animation.samplers[ch.sampler as usize].output);
-            assert_eq!(weights.len(), n * anim.len());
+            // A key per frame and a closing key that holds the last frame.
+            assert_eq!(weights.len(), n * (anim.len() + 1));
+            assert_eq!(
+                weights[n * (anim.len() - 1)..n * anim.len()],
+                weights[n * anim.len()..]
+            );
             for &fi in &frames {
                 player.frame_at(fi, &mut frame);
                 let w = &weights[fi * n..(fi + 1) * n];

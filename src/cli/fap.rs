@@ -61,6 +61,9 @@ pub struct ConvertArgs {
     /// Read the input strictly.
     #[arg(long)]
     pub strict: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Runs one FAP subcommand and returns its exit code.
@@ -185,9 +188,17 @@ fn convert(a: ConvertArgs) -> Result<u8> {
     )?;
     fbakit::format::refuse_overwriting_input(&a.output, &[&a.input])?;
     let (stream, warnings) = read_stream_file(&a.input, &options(a.strict))?;
-    for w in &warnings {
-        eprintln!("{w}");
-    }
     write_stream_file(&a.output, &stream)?;
+    let warnings: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    if a.json {
+        print_json(&serde_json::json!({
+            "input": a.input.display().to_string(),
+            "output": a.output.display().to_string(),
+            "frames": stream.frames.len(),
+            "warnings": warnings,
+        }))?;
+    } else {
+        super::print_warnings(&warnings);
+    }
     Ok(EXIT_OK)
 }

@@ -29,7 +29,8 @@
 //!
 //! ## Animation
 //! One animation, `play`, with LINEAR keyframes at every frame (times start at 0 at the first
-//! played frame): per mesh with targets a weights channel (the weight of a target sums over the
+//! played frame) and a closing key one frame after the last that holds it, so the clip lasts
+//! exactly frames / fps: per mesh with targets a weights channel (the weight of a target sums over the
 //! frame's activations of its key — a viseme pair selecting the same viseme twice adds up), and
 //! per transform driven by the FAT a rotation / translation / scale channel on its node **A**
 //! with the animated field values (rotation `ΔR · r`, translation `t + Δt + c`, scale `s + Δs`).
@@ -355,7 +356,20 @@ fn animation_channels(
     k: f32,
 ) -> Result<Vec<ChannelData>> {
     let t0 = frames[0].time;
-    let times: Vec<f32> = frames.iter().map(|f| (f.time - t0) as f32).collect();
+    let mut times: Vec<f32> = frames.iter().map(|f| (f.time - t0) as f32).collect();
+    // A closing key one frame after the last, holding it: frame i is shown from i/fps to
+    // (i+1)/fps, so the clip lasts frames/fps (what `play` reports) and a looping viewer
+    // shows the last frame as long as the others.
+    let closing = frames.len() >= 2;
+    if closing {
+        let step = (frames[frames.len() - 1].time - t0) / (frames.len() - 1) as f64;
+        times.push((frames[frames.len() - 1].time - t0 + step) as f32);
+    }
+    let frames_with_close: Vec<&AnimationFrame> = frames
+        .iter()
+        .chain(closing.then(|| &frames[frames.len() - 1]))
+        .collect();
+    let frames = &frames_with_close[..];
     let mut channels = Vec::new();
     let mut w = Vec::new();
     for (mi, node) in mesh_nodes.iter().enumerate() {
@@ -389,7 +403,7 @@ fn animation_channels(
         }
     }
     for (i, t) in face.transforms.iter().enumerate() {
-        let delta = |f: &AnimationFrame| {
+        let delta = |f: &&AnimationFrame| {
             f.transform_deltas
                 .get(i)
                 .copied()
