@@ -308,7 +308,10 @@ pub fn export_face_with_units(
             mesh_nodes.push(None);
             continue;
         }
-        let [r, g, b] = m.color.unwrap_or([0.8, 0.8, 0.8]);
+        // Without a model colour, the part's usual one (a rig's head is skin, not grey).
+        let [r, g, b] = m.color.unwrap_or_else(|| {
+            crate::face::parts::FacePart::of_mesh_name(&m.name).default_colour()
+        });
         let (positions, offsets) = &scaled[mi];
         let mut data =
             MeshData::new(m.name.clone(), &positions[..], triangles).with_material(MaterialData {
