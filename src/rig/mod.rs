@@ -15,6 +15,7 @@
 //! Shapes with the same name on several meshes (a head and its teeth both moving under
 //! `jawOpen`) are one shape.
 
+pub mod bounded_ls;
 pub mod fap_map;
 pub mod fat_build;
 pub mod gltf_read;
