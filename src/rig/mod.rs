@@ -15,12 +15,14 @@
 //! Shapes with the same name on several meshes (a head and its teeth both moving under
 //! `jawOpen`) are one shape.
 
+pub mod arkit_names;
 pub mod bounded_ls;
 pub mod fap_map;
 pub mod fat_build;
 pub mod gltf_read;
 pub mod gltf_write;
 pub mod obj_folder;
+pub mod weights_csv;
 
 use std::collections::HashMap;
 use std::path::Path;
