@@ -16,6 +16,7 @@
 //! `jawOpen`) are one shape.
 
 pub mod arkit_names;
+pub mod arkit_weights;
 pub mod bounded_ls;
 pub mod fap_map;
 pub mod fat_build;
