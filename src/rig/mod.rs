@@ -15,6 +15,7 @@
 //! Shapes with the same name on several meshes (a head and its teeth both moving under
 //! `jawOpen`) are one shape.
 
+pub mod arkit_amplitudes;
 pub mod arkit_names;
 pub mod arkit_weights;
 pub mod bounded_ls;
