@@ -26,9 +26,23 @@ pub struct FaceExportArgs {
     /// is scaled from it to metres.
     #[arg(long, value_name = "mm|cm|m")]
     pub units: Option<fbakit::face::units::LengthUnit>,
+    /// Morph target names: `fat` (one target per FAT table interval, named after its key) or
+    /// `arkit` (the 52 ARKit shapes, each the face posed with its FAP recipe from
+    /// specs/arkit-fap-amplitudes.csv; shapes without a recipe get no target).
+    #[arg(long, value_name = "fat|arkit", default_value = "fat")]
+    pub names: NamesArg,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Morph target naming of `face export`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum NamesArg {
+    /// The FAT's keys (`open_jaw`, `viseme_7`, ...).
+    Fat,
+    /// ARKit's 52 blend shapes (`jawOpen`, `eyeBlinkLeft`, ...).
+    Arkit,
 }
 
 #[derive(Serialize)]
@@ -38,6 +52,8 @@ struct Report {
     meshes: usize,
     morph_targets: usize,
     warnings: Vec<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arkit: Option<fbakit::rig::arkit_export::ArkitExportReport>,
 }
 
 /// Runs `face export`.
@@ -47,7 +63,11 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         &[OutputFormat::Glb, OutputFormat::Gltf],
         "`face export` output",
     )?;
+    fbakit::format::refuse_overwriting_input(&a.output, &[&a.face])?;
     let face = fbakit::face::read(&a.face)?;
+    if a.names == NamesArg::Arkit {
+        return export_arkit(&a, &face);
+    }
     let export = export_face_with_units(&face, None, a.units)?;
     if format == OutputFormat::Glb {
         export.document.write_glb(&a.output)?;
@@ -66,6 +86,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
             .map(|p| p.targets.len())
             .sum(),
         warnings: export.warnings,
+        arkit: None,
     };
     if a.json {
         print_json(&report)?;
@@ -77,6 +98,68 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         for w in &report.warnings {
             println!("warning: {w}");
         }
+    }
+    Ok(EXIT_OK)
+}
+
+/// `face export --names arkit`: the face as ARKit-named blend shapes, in metres.
+fn export_arkit(a: &FaceExportArgs, face: &fbakit::face::FaceModel) -> Result<u8> {
+    use fbakit::rig::arkit_export::{face_to_arkit_rig, scale_rig};
+    if face.fat.tables.is_empty() {
+        return Err(fbakit::error::Error::Invalid(format!(
+            "{}: the face has no FAT, so no ARKit shapes can be made from it",
+            a.face.display()
+        )));
+    }
+    let amplitudes = fbakit::rig::arkit_amplitudes::arkit_amplitudes();
+    let (mut rig, arkit) = face_to_arkit_rig(face, &amplitudes)?;
+    let mut warnings = Vec::new();
+    let k = match fbakit::face::units::unit_of(face, a.units) {
+        Some(g) => g.unit.metres(),
+        None => {
+            warnings.push(
+                "the face's length unit cannot be guessed (no size); written as metres".into(),
+            );
+            1.0
+        }
+    };
+    scale_rig(&mut rig, k);
+    fbakit::rig::gltf_write::write_rig_gltf(&rig, &a.output)?;
+    let report = Report {
+        face: face.name.clone(),
+        output: a.output.display().to_string(),
+        meshes: rig.meshes.len(),
+        morph_targets: rig.shapes.len(),
+        warnings,
+        arkit: Some(arkit),
+    };
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    if a.json {
+        print_json(&report)?;
+        return Ok(EXIT_OK);
+    }
+    let arkit = report.arkit.as_ref().expect("set above");
+    println!(
+        "wrote {}: {} meshes, {} ARKit morph targets",
+        report.output, report.meshes, report.morph_targets
+    );
+    println!(
+        "no target ({}): {}",
+        arkit.unmapped.len(),
+        arkit
+            .unmapped
+            .iter()
+            .map(|u| format!("{} ({})", u.shape, u.reason))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if !arkit.missing_tables.is_empty() {
+        println!(
+            "recipe parts without a table on this face: {}",
+            arkit.missing_tables.join(", ")
+        );
     }
     Ok(EXIT_OK)
 }

@@ -393,7 +393,10 @@ impl<'a> ArkitBridge<'a> {
         for n in 0..=last {
             frame_activations(timeline.at_frame(n), &mut acts);
             for a in &acts {
-                if a.value != 0.0 && face.fat.table(a.key).is_none() && !unplayable.contains(&a.key)
+                if a.value != 0.0
+                    && a.key.slot().is_some()
+                    && face.fat.table(a.key).is_none()
+                    && !unplayable.contains(&a.key)
                 {
                     unplayable.push(a.key);
                 }

@@ -16,6 +16,7 @@
 //! `jawOpen`) are one shape.
 
 pub mod arkit_amplitudes;
+pub mod arkit_export;
 pub mod arkit_names;
 pub mod arkit_weights;
 pub mod bounded_ls;
