@@ -34,14 +34,18 @@ pub fn load_ict(dir: &Path) -> Result<(Rig, FaceModel, RigFatReport)> {
 
 /// The table's text for a loaded rig.
 pub fn table_text(rig: &Rig, face: &FaceModel, report: &RigFatReport) -> Result<String> {
-    Ok(amplitudes_csv(&measure_amplitudes(rig, face, report, SOURCE)?))
+    Ok(amplitudes_csv(&measure_amplitudes(
+        rig, face, report, SOURCE,
+    )?))
 }
 
 fn main() {
     let dir = std::env::args()
         .nth(1)
         .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/ict-facekit"));
+        .unwrap_or_else(|| {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/ict-facekit")
+        });
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/arkit-fap-amplitudes.csv");
     let result = load_ict(&dir)
         .and_then(|(rig, face, report)| table_text(&rig, &face, &report))

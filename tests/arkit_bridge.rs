@@ -106,10 +106,22 @@ fn weights_round_trip_through_a_fap_stream() {
     );
     assert_eq!(stream.frame_rate, 60.0);
     assert_eq!(stream.frames.len(), 20);
-    assert!(report.relative_residual < 0.01, "{}", report.relative_residual);
-    let yaw = report.columns.iter().find(|c| c.column == "HeadYaw").unwrap();
+    assert!(
+        report.relative_residual < 0.01,
+        "{}",
+        report.relative_residual
+    );
+    let yaw = report
+        .columns
+        .iter()
+        .find(|c| c.column == "HeadYaw")
+        .unwrap();
     assert!(yaw.shapes.is_empty() && !yaw.ignored.is_empty());
-    let brow = report.columns.iter().find(|c| c.column == "BrowInnerUp").unwrap();
+    let brow = report
+        .columns
+        .iter()
+        .find(|c| c.column == "BrowInnerUp")
+        .unwrap();
     assert_eq!(brow.shapes, ["browInnerUp_L", "browInnerUp_R"]);
     // jawOpen drives open_jaw up to about its calibrated value.
     let jaw = fbakit::spec::FapId::from_name("open_jaw").unwrap();
@@ -209,7 +221,11 @@ fn validate(files: &[PathBuf]) -> Option<Vec<serde_json::Value>> {
         );
         return None;
     }
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     Some(
         String::from_utf8(out.stdout)
             .unwrap()
@@ -298,31 +314,54 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
         std::fs::write(&p, text).unwrap();
         p.to_str().unwrap().to_string()
     };
-    let ragged = put("ragged.csv", "Timecode,JawOpen
+    let ragged = put(
+        "ragged.csv",
+        "Timecode,JawOpen
 00:00:00:01,0.5
 00:00:00:02
-");
-    let nan = put("nan.csv", "time,JawOpen
+",
+    );
+    let nan = put(
+        "nan.csv",
+        "time,JawOpen
 0,0.5
 0.1,NaN
-");
-    let no_time = put("notime.csv", "JawOpen,EyeBlinkLeft
+",
+    );
+    let no_time = put(
+        "notime.csv",
+        "JawOpen,EyeBlinkLeft
 0.1,0.2
-");
-    let fp = put("fp.csv", "not,a,feature,point,file
-");
+",
+    );
+    let fp = put(
+        "fp.csv",
+        "not,a,feature,point,file
+",
+    );
     let out = d.join("out.fap");
     let out_s = out.to_str().unwrap();
     // The CSV is read before the rig, so these fail fast even with a rig path that does not
     // exist.
     let rig = d.join("no-rig").to_str().unwrap().to_string();
     for (csv, expect) in [
-        (&ragged, "ragged.csv:3:12: expected 2 fields like the header"),
+        (
+            &ragged,
+            "ragged.csv:3:12: expected 2 fields like the header",
+        ),
         (&nan, "nan.csv:3:5: expected a finite weight"),
         (&no_time, "notime.csv:1:1: expected a `Timecode` column"),
     ] {
         let o = fbakit(&[
-            "fap", "from-arkit", csv, "--face", &rig, "--fp", &fp, "-o", out_s,
+            "fap",
+            "from-arkit",
+            csv,
+            "--face",
+            &rig,
+            "--fp",
+            &fp,
+            "-o",
+            out_s,
         ]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{err}");
@@ -331,19 +370,34 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
         assert!(!out.exists());
     }
     // Unknown output extension, and writing over the input.
-    let good = put("good.csv", "time,JawOpen
+    let good = put(
+        "good.csv",
+        "time,JawOpen
 0,0.5
 0.1,0.6
-");
+",
+    );
     let o = fbakit(&[
-        "fap", "from-arkit", &good, "--face", &rig, "--fp", &fp, "-o",
+        "fap",
+        "from-arkit",
+        &good,
+        "--face",
+        &rig,
+        "--fp",
+        &fp,
+        "-o",
         d.join("out.xyz").to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
     let o = fbakit(&[
         "fap", "to-arkit", &good, "--face", &rig, "--fp", &fp, "-o", &good,
     ]);
-    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert_eq!(
         std::fs::read_to_string(&good).unwrap(),
         "time,JawOpen
@@ -352,18 +406,33 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
 "
     );
     // to-arkit with a stream that does not parse.
-    let bad_fap = put("bad.fap", "2.1 x 25
-");
+    let bad_fap = put(
+        "bad.fap",
+        "2.1 x 25
+",
+    );
     let o = fbakit(&[
-        "fap", "to-arkit", &bad_fap, "--face", &rig, "--fp", &fp, "-o",
+        "fap",
+        "to-arkit",
+        &bad_fap,
+        "--face",
+        &rig,
+        "--fp",
+        &fp,
+        "-o",
         d.join("w.csv").to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(!d.join("w.csv").exists());
     // face export --names arkit of a face file that does not exist.
     let o = fbakit(&[
-        "face", "export", "nope.wrl", "-o",
-        d.join("x.glb").to_str().unwrap(), "--names", "arkit",
+        "face",
+        "export",
+        "nope.wrl",
+        "-o",
+        d.join("x.glb").to_str().unwrap(),
+        "--names",
+        "arkit",
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(!d.join("x.glb").exists());
@@ -409,7 +478,12 @@ fn cli_round_trip_on_ict() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert_eq!(err.matches("clamped").count(), 1, "{err}");
-    assert!(err.contains("capture.csv: 1 weight outside 0..1 clamped (first at line 4, column 3 `JawOpen`)"), "{err}");
+    assert!(
+        err.contains(
+            "capture.csv: 1 weight outside 0..1 clamped (first at line 4, column 3 `JawOpen`)"
+        ),
+        "{err}"
+    );
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(report["frames"], 20);
     assert_eq!(report["fps"], 60.0);
@@ -436,5 +510,8 @@ fn cli_round_trip_on_ict() {
     assert_eq!(w.rows.len(), 20);
     let jaw = w.columns.iter().position(|c| c.name == "JawOpen").unwrap();
     let got = w.rows[2].weights[jaw];
-    assert!((got - 1.0).abs() < ROUND_TRIP_TOLERANCE, "JawOpen at the clamped row: {got}");
+    assert!(
+        (got - 1.0).abs() < ROUND_TRIP_TOLERANCE,
+        "JawOpen at the clamped row: {got}"
+    );
 }

@@ -120,13 +120,21 @@ pub fn from_arkit(a: FromArkitArgs) -> Result<u8> {
         })?;
         return Ok(EXIT_OK);
     }
-    let used = report.columns.iter().filter(|c| c.ignored.is_empty()).count();
+    let used = report
+        .columns
+        .iter()
+        .filter(|c| c.ignored.is_empty())
+        .count();
     println!(
         "wrote {}: {} frames at {} fps ({}), {} FAPs from {used} weight columns",
         a.output.display(),
         report.frames,
         report.fps,
-        if report.fps_detected { "detected" } else { "--fps" },
+        if report.fps_detected {
+            "detected"
+        } else {
+            "--fps"
+        },
         report.faps.len()
     );
     let ignored: Vec<String> = report
@@ -136,7 +144,11 @@ pub fn from_arkit(a: FromArkitArgs) -> Result<u8> {
         .map(|c| format!("{} ({})", c.column, c.ignored))
         .collect();
     if !ignored.is_empty() {
-        println!("ignored columns ({}): {}", ignored.len(), ignored.join(", "));
+        println!(
+            "ignored columns ({}): {}",
+            ignored.len(),
+            ignored.join(", ")
+        );
     }
     println!(
         "fit residual: {:.2} % of the rig's motion at {} feature points",

@@ -104,10 +104,7 @@ pub fn measure_amplitudes(
                 )
             };
             let value = c.value * share;
-            match rows
-                .iter_mut()
-                .find(|(i, r)| *i == a && r.fap == fap)
-            {
+            match rows.iter_mut().find(|(i, r)| *i == a && r.fap == fap) {
                 Some((_, r)) => {
                     r.value += value;
                     r.source = format!("{}; {how}", r.source);
@@ -223,7 +220,10 @@ pub fn parse_amplitudes(file: &Path, text: &str) -> Result<Vec<Amplitude>> {
             return Err(err_at(offset, format!("at most {MAX_ROWS} rows")));
         }
         if record.len() != 5 {
-            return Err(err_at(offset, "5 fields: shape,fap,value,unit,source".into()));
+            return Err(err_at(
+                offset,
+                "5 fields: shape,fap,value,unit,source".into(),
+            ));
         }
         let shape = record[0].trim();
         let Some(a) = ARKIT_SHAPES.iter().find(|a| **a == shape) else {
@@ -272,20 +272,29 @@ mod tests {
     #[test]
     fn bundled_table_parses_and_round_trips() {
         let rows = arkit_amplitudes();
-        assert!(rows.iter().any(|r| r.shape == "jawOpen" && r.fap.name() == "open_jaw"));
+        assert!(rows
+            .iter()
+            .any(|r| r.shape == "jawOpen" && r.fap.name() == "open_jaw"));
         let again = parse_amplitudes(Path::new("x.csv"), &amplitudes_csv(&rows)).unwrap();
         assert_eq!(again.len(), rows.len());
     }
 
     #[test]
     fn bad_tables_are_located() {
-        let e = |t: &str| parse_amplitudes(Path::new("a.csv"), t).unwrap_err().to_string();
+        let e = |t: &str| {
+            parse_amplitudes(Path::new("a.csv"), t)
+                .unwrap_err()
+                .to_string()
+        };
         assert!(e("").contains("a.csv:1:1"));
         assert!(e("shape,fap\n").contains("expected the header"));
         let h = "shape,fap,value,unit,source\n";
-        assert!(e(&format!("{h}JawOpen,open_jaw,1,MNS,x\n")).contains("a.csv:2:1: expected an ARKit shape"));
-        assert!(e(&format!("{h}jawOpen,nope,1,MNS,x\n")).contains("a.csv:2:9: expected a low-level FAP"));
-        assert!(e(&format!("{h}jawOpen,open_jaw,NaN,MNS,x\n")).contains("a.csv:2:18: expected a finite"));
+        assert!(e(&format!("{h}JawOpen,open_jaw,1,MNS,x\n"))
+            .contains("a.csv:2:1: expected an ARKit shape"));
+        assert!(e(&format!("{h}jawOpen,nope,1,MNS,x\n"))
+            .contains("a.csv:2:9: expected a low-level FAP"));
+        assert!(e(&format!("{h}jawOpen,open_jaw,NaN,MNS,x\n"))
+            .contains("a.csv:2:18: expected a finite"));
         assert!(e(&format!("{h}jawOpen,open_jaw\n")).contains("expected 5 fields"));
     }
 }

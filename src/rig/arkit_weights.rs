@@ -182,7 +182,8 @@ impl<'a> ArkitBridge<'a> {
                 key: TableKey::LowLevel(fap),
                 value: c.value,
             }];
-            let moved = probe_positions(face, &probes, &mut evaluator, &mut output, &mut pose, &act);
+            let moved =
+                probe_positions(face, &probes, &mut evaluator, &mut output, &mut pose, &act);
             side_columns.push(diff(&moved, &neutral));
             sides.push(SideUnknown {
                 fap,
@@ -357,7 +358,10 @@ impl<'a> ArkitBridge<'a> {
 
     /// Plays `stream` on the face (hold rule, frames `0 ..=` its last frame number) and fits
     /// the ARKit weights of every frame (module docs).
-    pub fn faps_to_weights(&mut self, stream: &FapStream) -> Result<(Vec<Vec<f32>>, ToArkitReport)> {
+    pub fn faps_to_weights(
+        &mut self,
+        stream: &FapStream,
+    ) -> Result<(Vec<Vec<f32>>, ToArkitReport)> {
         if !(stream.frame_rate.is_finite() && stream.frame_rate > 0.0) {
             return Err(Error::Invalid(format!(
                 "stream `{}`: frame rate {} is not a finite positive number",
@@ -465,7 +469,11 @@ fn probe_positions(
 }
 
 /// The summed offsets of `shapes` at the probes (flattened).
-fn shape_probe_delta(rig: &Rig, probes: &[(FeaturePointId, usize, u32)], shapes: &[usize]) -> Vec<f64> {
+fn shape_probe_delta(
+    rig: &Rig,
+    probes: &[(FeaturePointId, usize, u32)],
+    shapes: &[usize],
+) -> Vec<f64> {
     let mut out = vec![0.0; probes.len() * 3];
     for &s in shapes {
         for (k, &(_, m, v)) in probes.iter().enumerate() {
@@ -490,10 +498,7 @@ fn residual(columns: &[Vec<f64>], x: &[f64], b: &[f64]) -> (f64, f64) {
             *ri += xi * ci;
         }
     }
-    (
-        r.iter().map(|v| v * v).sum(),
-        b.iter().map(|v| v * v).sum(),
-    )
+    (r.iter().map(|v| v * v).sum(), b.iter().map(|v| v * v).sum())
 }
 
 fn relative(res: f64, norm: f64) -> f64 {

@@ -130,7 +130,13 @@ pub fn solve_box_qp(q: &[f64], c: &[f64], lower: &[f64], upper: &[f64]) -> Vec<f
     let n = c.len();
     debug_assert_eq!(q.len(), n * n);
     let lo: Vec<f64> = (0..n)
-        .map(|i| lower.get(i).copied().filter(|v| v.is_finite()).unwrap_or(0.0))
+        .map(|i| {
+            lower
+                .get(i)
+                .copied()
+                .filter(|v| v.is_finite())
+                .unwrap_or(0.0)
+        })
         .collect();
     let hi: Vec<f64> = (0..n)
         .map(|i| {
@@ -352,7 +358,9 @@ mod tests {
         // optimality conditions.
         let mut seed = 12345u64;
         let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         };
         for _ in 0..50 {

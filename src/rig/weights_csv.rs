@@ -413,9 +413,7 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
 /// Byte offset of field `col` of the line starting at `start`.
 fn field_offset(text: &str, start: usize, col: usize) -> usize {
     let line = text[start..].split('\n').next().unwrap_or("");
-    split_line(line, start)
-        .get(col)
-        .map_or(start, |f| f.offset)
+    split_line(line, start).get(col).map_or(start, |f| f.offset)
 }
 
 /// `1 / median(Δt)` over the positive steps, snapped to a whole rate within 0.5 %.
@@ -523,7 +521,9 @@ mod tests {
         assert_eq!(w.rows[3].weights[0], 1.0);
         assert_eq!(w.warnings.len(), 1, "{:?}", w.warnings);
         assert!(
-            w.warnings[0].contains("w.csv: 1 weight outside 0..1 clamped (first at line 5, column 3 `EyeBlinkLeft`)"),
+            w.warnings[0].contains(
+                "w.csv: 1 weight outside 0..1 clamped (first at line 5, column 3 `EyeBlinkLeft`)"
+            ),
             "{}",
             w.warnings[0]
         );
@@ -550,12 +550,13 @@ mod tests {
     #[test]
     fn hostile_inputs_are_located_errors() {
         assert!(message("").contains("w.csv:1:1: expected a header row"));
-        assert!(
-            message("EyeBlinkLeft,JawOpen\n0.1,0.2\n")
-                .contains("w.csv:1:1: expected a `Timecode` column"),
-        );
+        assert!(message("EyeBlinkLeft,JawOpen\n0.1,0.2\n")
+            .contains("w.csv:1:1: expected a `Timecode` column"),);
         let ragged = message("time,JawOpen\n0,0.1\n0.1\n");
-        assert!(ragged.contains("w.csv:3:4: expected 2 fields like the header (this row has 1)"), "{ragged}");
+        assert!(
+            ragged.contains("w.csv:3:4: expected 2 fields like the header (this row has 1)"),
+            "{ragged}"
+        );
         let long = message("time,JawOpen\n0,0.1,7\n");
         assert!(long.contains("w.csv:2:7: expected 2 fields"), "{long}");
         let nan = message("time,JawOpen\n0,NaN\n");
@@ -565,14 +566,23 @@ mod tests {
         let tc = message("Timecode,JawOpen\n12:00:61:00,0\n");
         assert!(tc.contains("w.csv:2:1: expected a timecode"), "{tc}");
         let back = message("time,JawOpen\n1,0\n0.5,0\n");
-        assert!(back.contains("w.csv:3:1: expected a time no earlier"), "{back}");
+        assert!(
+            back.contains("w.csv:3:1: expected a time no earlier"),
+            "{back}"
+        );
         let dup = message("time,JawOpen,jaw_open\n0,0,0\n");
-        assert!(dup.contains("w.csv:1:14: expected one column per shape"), "{dup}");
+        assert!(
+            dup.contains("w.csv:1:14: expected one column per shape"),
+            "{dup}"
+        );
         assert!(message("time,JawOpen\n").contains("at least one row"));
         let far = message("time,JawOpen\n0,0\n0.01,0\n0.02,0\n1e6,0\n");
         assert!(far.contains("within 10000000 frames"), "{far}");
         let empty_name = message("time,,JawOpen\n0,0,0\n");
-        assert!(empty_name.contains("w.csv:1:6: expected a column name"), "{empty_name}");
+        assert!(
+            empty_name.contains("w.csv:1:6: expected a column name"),
+            "{empty_name}"
+        );
         // A huge BlendShapeCount is just a number: nothing is sized from it.
         let w = parse(
             "Timecode,BlendShapeCount,JawOpen\n00:00:00:59,99999999999999999999,0.5\n00:00:01:00,1e300,0.5\n",
@@ -584,7 +594,13 @@ mod tests {
         let wide = format!("time{}\n", ",x".repeat(MAX_COLUMNS + 5));
         assert!(parse(&wide, None).is_err());
         // Arbitrary bytes never panic.
-        for junk in ["\u{feff}", "\u{feff}Timecode\n", ",,,\n,,,", "time\n\n\n0\n", "Timecode,a\n::::,1"] {
+        for junk in [
+            "\u{feff}",
+            "\u{feff}Timecode\n",
+            ",,,\n,,,",
+            "time\n\n\n0\n",
+            "Timecode,a\n::::,1",
+        ] {
             let _ = parse(junk, None);
         }
     }
