@@ -8,11 +8,18 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 use fbakit::face::FaceModel;
+use fbakit::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
+use fbakit::mesh::{Mesh, Polygons};
 use fbakit::rig::arkit_names::ARKIT_SHAPES;
 use fbakit::rig::arkit_weights::ArkitBridge;
+use fbakit::rig::fap_map::FapMap;
+use fbakit::rig::fat_build::face_from_rig;
 use fbakit::rig::fat_build::RigFatReport;
 use fbakit::rig::weights_csv::parse_weights_csv;
 use fbakit::rig::Rig;
+use fbakit::rig::{BlendShape, RigMesh, ShapeDelta};
+use fbakit::spec::FapId;
+use glam::Vec3;
 
 #[path = "../examples/make_arkit_amplitudes.rs"]
 mod make_arkit_amplitudes;
@@ -81,6 +88,106 @@ fn weight_csv() -> String {
         s.push_str(",0.05\n");
     }
     s
+}
+
+/// A tiny rig whose vertices are feature points (mm; ES0 60, IRISD0 10, MNS0 20, MW0 50), so
+/// every number below follows by hand: MNS = 20/1024, IRISD = 10/1024.
+fn synthetic_rig() -> (Rig, FeaturePointSet) {
+    let points: [(&str, [f32; 3]); 10] = [
+        ("3.5", [30.0, 40.0, 0.0]),
+        ("3.6", [-30.0, 40.0, 0.0]),
+        ("3.1", [30.0, 45.0, 0.0]),
+        ("3.3", [30.0, 35.0, 0.0]),
+        ("9.15", [0.0, 0.0, 0.0]),
+        ("2.2", [0.0, -20.0, 0.0]),
+        ("8.3", [25.0, -25.0, 0.0]),
+        ("8.4", [-25.0, -25.0, 0.0]),
+        ("2.1", [0.0, -60.0, 0.0]),
+        ("2.4", [20.0, -25.0, 0.0]),
+    ];
+    let positions: Vec<Vec3> = points.iter().map(|p| Vec3::from(p.1)).collect();
+    let tris: Vec<[u32; 3]> = (1..positions.len() as u32 - 1)
+        .map(|i| [0, i, i + 1])
+        .collect();
+    let mesh = Mesh {
+        name: "face".into(),
+        positions,
+        polygons: Polygons::from_triangles(&tris),
+        ..Mesh::default()
+    };
+    let shape = |name: &str, moves: &[(u32, [f32; 3])]| BlendShape {
+        name: name.into(),
+        default_weight: 0.0,
+        deltas: vec![ShapeDelta {
+            mesh: 0,
+            vertices: moves.iter().map(|m| m.0).collect(),
+            offsets: moves.iter().map(|m| Vec3::from(m.1)).collect(),
+        }],
+    };
+    let rig = Rig {
+        name: "synthetic".into(),
+        meshes: vec![RigMesh {
+            name: "face".into(),
+            mesh,
+        }],
+        shapes: vec![
+            // 2.1 drops 10 mm: open_jaw 512 MNS.
+            shape("jawOpen", &[(8, [0.0, -10.0, 0.0])]),
+            // 2.4 and 8.3 rise 4 and 5 mm: raise_l_cornerlip 204.8, raise_l_cornerlip_o 256.
+            shape(
+                "mouthSmile_L",
+                &[(6, [0.0, 5.0, 0.0]), (9, [0.0, 4.0, 0.0])],
+            ),
+            // 3.1 drops 5 mm: close_t_l_eyelid 512 IRISD.
+            shape("eyeBlink_L", &[(2, [0.0, -5.0, 0.0])]),
+        ],
+        warnings: vec![],
+    };
+    let mut set = FeaturePointSet::new();
+    for (i, (label, p)) in points.iter().enumerate() {
+        let mut point = FeaturePoint::at(label.parse().unwrap(), Vec3::from(*p));
+        point.binding = Some(VertexBinding::vertex(i as u32));
+        set.insert(point);
+    }
+    (rig, set)
+}
+
+#[test]
+fn synthetic_rig_round_trips_exactly() {
+    let (rig, points) = synthetic_rig();
+    let (face, calibration) = face_from_rig(&rig, Some(points), &FapMap::arkit()).unwrap();
+    let text = "time,JawOpen,MouthSmileLeft,eyeBlink_L,HeadYaw\n\
+                0,0,0,0,0.1\n0.04,0.5,0.25,1,0.1\n0.08,1,1,0.5,0.1\n";
+    let csv = parse_weights_csv(Path::new("w.csv"), text, None).unwrap();
+    assert_eq!(csv.fps, 25.0);
+    let mut bridge = ArkitBridge::new(&rig, &face, &calibration).unwrap();
+    let (stream, report) = bridge.weights_to_faps(&csv, "w").unwrap();
+    // Only the Tikhonov term keeps the fit from being exact.
+    assert!(
+        report.relative_residual < 1e-3,
+        "{}",
+        report.relative_residual
+    );
+    let v = |n: usize, fap: &str| stream.frames[n].value(FapId::from_name(fap).unwrap());
+    // Whole FAPU of weight × calibrated value (Tikhonov shifts them by far less than 0.5).
+    assert_eq!(v(1, "open_jaw"), Some(256.0));
+    assert_eq!(v(2, "open_jaw"), Some(512.0));
+    assert_eq!(v(1, "raise_l_cornerlip"), Some(51.0));
+    assert_eq!(v(1, "raise_l_cornerlip_o"), Some(64.0));
+    assert_eq!(v(1, "close_t_l_eyelid"), Some(512.0));
+    assert_eq!(v(0, "open_jaw"), Some(0.0));
+    let (weights, _) = bridge.faps_to_weights(&stream).unwrap();
+    let idx = |n: &str| ARKIT_SHAPES.iter().position(|a| *a == n).unwrap();
+    for (row, w) in csv.rows.iter().zip(&weights) {
+        for (c, name) in [(0, "jawOpen"), (1, "mouthSmileLeft"), (2, "eyeBlinkLeft")] {
+            assert!(
+                (row.weights[c] - w[idx(name)]).abs() < 0.005,
+                "{name}: {} vs {}",
+                row.weights[c],
+                w[idx(name)]
+            );
+        }
+    }
 }
 
 /// Round-trip tolerance on the weights of the captured shapes (measured worst: 0.013).
