@@ -622,3 +622,41 @@ fn cli_round_trip_on_ict() {
         "JawOpen at the clamped row: {got}"
     );
 }
+
+#[test]
+fn clone_writes_arkit_named_targets() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bruno-arkit.glb");
+    let o = fbakit(&[
+        "clone",
+        "alma",
+        "bruno",
+        "-o",
+        out.to_str().unwrap(),
+        "--method",
+        "rbf",
+        "--names",
+        "arkit",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rig = fbakit::rig::read_rig(&out).unwrap();
+    assert!(rig.shape("jawOpen").is_some());
+    assert!(rig.shapes.len() <= 52);
+    assert!(rig
+        .shapes
+        .iter()
+        .all(|s| ARKIT_SHAPES.contains(&s.name.as_str())));
+    // ARKit names need a glTF output: refused before cloning, nothing written.
+    let wrl = dir.path().join("bruno.wrl");
+    let o = fbakit(&[
+        "clone",
+        "alma",
+        "bruno",
+        "-o",
+        wrl.to_str().unwrap(),
+        "--names",
+        "arkit",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!wrl.exists());
+}

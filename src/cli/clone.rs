@@ -46,6 +46,10 @@ pub struct CloneArgs {
     /// Also measure quality: self-clone error of the source, compliance of the output.
     #[arg(long)]
     pub report: bool,
+    /// Morph target names of a .glb/.gltf output: `fat` (the cloned FAT's keys) or `arkit`
+    /// (the 52 ARKit blend shapes from their FAP recipes, as `face export --names arkit`).
+    #[arg(long, value_name = "fat|arkit", default_value = "fat")]
+    pub names: super::face_export::NamesArg,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -118,10 +122,19 @@ struct Output<'a> {
     report: &'a CloneReport,
     #[serde(skip_serializing_if = "Option::is_none")]
     quality: Option<Quality>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arkit: Option<fbakit::rig::arkit_export::ArkitExportReport>,
 }
 
 pub fn run(args: CloneArgs) -> Result<u8> {
-    OutputFormat::resolve(&args.output, OutputFormat::FACES, "the cloned face")?;
+    let format = OutputFormat::resolve(&args.output, OutputFormat::FACES, "the cloned face")?;
+    let arkit_names = args.names == super::face_export::NamesArg::Arkit;
+    if arkit_names && !matches!(format, OutputFormat::Glb | OutputFormat::Gltf) {
+        return Err(fbakit::error::Error::Invalid(format!(
+            "{}: --names arkit needs a .glb or .gltf output",
+            args.output.display()
+        )));
+    }
     refuse_overwriting_input(&args.output, &[&args.source, &args.target])?;
     let pb = bar(if args.report { 5 } else { 4 });
     pb.set_message("reading source");
@@ -140,8 +153,18 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     let outcome = clone_face(&source, &target, &opts)?;
     pb.inc(1);
     pb.set_message("writing");
-    // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it).
-    for w in write_face(&args.output, &outcome.face)? {
+    // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it), or
+    // ARKit-named shapes made from it.
+    let mut arkit = None;
+    let warnings = if arkit_names {
+        let (report, warnings) =
+            fbakit::rig::arkit_export::write_arkit_gltf(&outcome.face, &args.output, None)?;
+        arkit = Some(report);
+        warnings
+    } else {
+        write_face(&args.output, &outcome.face)?
+    };
+    for w in warnings {
         eprintln!("warning: {w}");
     }
     pb.inc(1);
@@ -163,6 +186,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
             output: args.output.display().to_string(),
             report: r,
             quality,
+            arkit,
         })?;
         return Ok(EXIT_OK);
     }
@@ -186,6 +210,13 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     );
     for (step, s) in &r.timings.steps {
         println!("  {step:<20} {:>8.1} ms", s * 1000.0);
+    }
+    if arkit.is_some() {
+        super::face_export::print_arkit_report(
+            &args.output.display().to_string(),
+            outcome.face.meshes.len(),
+            arkit.as_ref(),
+        );
     }
     if let Some(q) = quality {
         println!(

@@ -104,46 +104,36 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
 
 /// `face export --names arkit`: the face as ARKit-named blend shapes, in metres.
 fn export_arkit(a: &FaceExportArgs, face: &fbakit::face::FaceModel) -> Result<u8> {
-    use fbakit::rig::arkit_export::{face_to_arkit_rig, scale_rig};
-    if face.fat.tables.is_empty() {
-        return Err(fbakit::error::Error::Invalid(format!(
-            "{}: the face has no FAT, so no ARKit shapes can be made from it",
-            a.face.display()
-        )));
+    let (arkit, warnings) = fbakit::rig::arkit_export::write_arkit_gltf(face, &a.output, a.units)?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
     }
-    let amplitudes = fbakit::rig::arkit_amplitudes::arkit_amplitudes();
-    let (mut rig, arkit) = face_to_arkit_rig(face, &amplitudes)?;
-    let mut warnings = Vec::new();
-    let k = match fbakit::face::units::unit_of(face, a.units) {
-        Some(g) => g.unit.metres(),
-        None => {
-            warnings.push(
-                "the face's length unit cannot be guessed (no size); written as metres".into(),
-            );
-            1.0
-        }
-    };
-    scale_rig(&mut rig, k);
-    fbakit::rig::gltf_write::write_rig_gltf(&rig, &a.output)?;
     let report = Report {
         face: face.name.clone(),
         output: a.output.display().to_string(),
-        meshes: rig.meshes.len(),
-        morph_targets: rig.shapes.len(),
+        meshes: face.meshes.len(),
+        morph_targets: arkit.targets.len(),
         warnings,
         arkit: Some(arkit),
     };
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
-    }
     if a.json {
         print_json(&report)?;
         return Ok(EXIT_OK);
     }
-    let arkit = report.arkit.as_ref().expect("set above");
+    print_arkit_report(&report.output, report.meshes, report.arkit.as_ref());
+    Ok(EXIT_OK)
+}
+
+/// The text report of an ARKit-named export (shared with `clone --names arkit`).
+pub fn print_arkit_report(
+    output: &str,
+    meshes: usize,
+    arkit: Option<&fbakit::rig::arkit_export::ArkitExportReport>,
+) {
+    let Some(arkit) = arkit else { return };
     println!(
-        "wrote {}: {} meshes, {} ARKit morph targets",
-        report.output, report.meshes, report.morph_targets
+        "wrote {output}: {meshes} meshes, {} ARKit morph targets",
+        arkit.targets.len()
     );
     println!(
         "no target ({}): {}",
@@ -161,5 +151,4 @@ fn export_arkit(a: &FaceExportArgs, face: &fbakit::face::FaceModel) -> Result<u8
             arkit.missing_tables.join(", ")
         );
     }
-    Ok(EXIT_OK)
 }

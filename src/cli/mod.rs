@@ -154,7 +154,8 @@ pub enum Command {
                       missing feature points), 1 other failures.",
         after_help = "Examples:\n  fbakit clone alma.wrl bruno.wrl -o bruno-animated.wrl\n  \
                       fbakit clone alma.wrl head.obj --fp-target head.fdp -o head.wrl --method rbf --report\n  \
-                      fbakit clone alma.wrl bruno.wrl -o out.wrl --json > report.json"
+                      fbakit clone alma.wrl bruno.wrl -o out.wrl --json > report.json\n  \
+                      fbakit clone alma bruno -o bruno-arkit.glb --method rbf --names arkit"
     )]
     Clone(clone::CloneArgs),
     /// Quality figures of a face's FAT (compliance, self-cloning error).

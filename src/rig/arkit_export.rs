@@ -155,3 +155,34 @@ pub fn scale_rig(rig: &mut Rig, k: f32) {
         }
     }
 }
+
+/// Writes `face` as ARKit-named blend shapes to `path` (`.glb` or `.gltf` by extension) with
+/// the bundled amplitudes, in metres (`units` is the face's length unit, `None`: guessed),
+/// atomically. Returns the report and the warnings (an unguessable unit).
+pub fn write_arkit_gltf(
+    face: &FaceModel,
+    path: &std::path::Path,
+    units: Option<crate::face::units::LengthUnit>,
+) -> Result<(ArkitExportReport, Vec<String>)> {
+    if face.fat.tables.is_empty() {
+        return Err(crate::error::Error::Invalid(format!(
+            "face `{}` has no FAT, so no ARKit shapes can be made from it",
+            face.name
+        )));
+    }
+    let amplitudes = super::arkit_amplitudes::arkit_amplitudes();
+    let (mut rig, report) = face_to_arkit_rig(face, &amplitudes)?;
+    let mut warnings = Vec::new();
+    let k = match crate::face::units::unit_of(face, units) {
+        Some(g) => g.unit.metres(),
+        None => {
+            warnings.push(
+                "the face's length unit cannot be guessed (no size); written as metres".into(),
+            );
+            1.0
+        }
+    };
+    scale_rig(&mut rig, k);
+    super::gltf_write::write_rig_gltf(&rig, path)?;
+    Ok((report, warnings))
+}
