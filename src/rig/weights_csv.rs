@@ -606,6 +606,30 @@ mod tests {
     }
 
     #[test]
+    fn random_text_never_panics() {
+        // Deterministic pseudo-random texts over the characters that matter to the grammar.
+        let alphabet: Vec<char> = "Timecode,time:;.0123456789-e+NaInf\"\r\n \u{feff}é"
+            .chars()
+            .collect();
+        let mut seed = 7u64;
+        for len in 0..3000usize {
+            let mut t = String::from(if len % 2 == 0 {
+                "Timecode,A,B\n"
+            } else {
+                "time,A\n"
+            });
+            for _ in 0..(len % 97) {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                t.push(alphabet[(seed >> 33) as usize % alphabet.len()]);
+            }
+            let _ = parse(&t, None);
+            let _ = parse(&t, Some(30.0));
+        }
+    }
+
+    #[test]
     fn written_csv_reads_back() {
         let names = vec!["EyeBlinkLeft".to_string(), "JawOpen".to_string()];
         let frames: Vec<Vec<f32>> = (0..70).map(|i| vec![i as f32 / 70.0, 0.25]).collect();
