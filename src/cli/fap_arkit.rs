@@ -60,7 +60,9 @@ pub struct ToArkitArgs {
     pub stream: PathBuf,
     #[command(flatten)]
     pub rig: RigArgs,
-    /// Output weight CSV: `Timecode`, then the 52 ARKit shapes (EyeBlinkLeft, ...).
+    /// Output weight CSV: `Timecode`, then the 52 ARKit shapes (EyeBlinkLeft, ...). Its
+    /// timecodes start at 00:00:00:00; reading one shorter than a second back with
+    /// `from-arkit` needs `--fps` (the timecode rate shows only once the seconds roll over).
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Print the report as JSON.
