@@ -286,7 +286,16 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| err(f.offset, "a finite weight (a number, 0..1)".into()))?;
+                .ok_or_else(|| {
+                    err(
+                        f.offset,
+                        format!(
+                            "a finite weight (a number, 0..1) in field {} `{}`",
+                            i + 1,
+                            header[i].text
+                        ),
+                    )
+                })?;
             if !(0.0..=1.0).contains(&v) {
                 clamped += 1;
                 if first_clamp.is_none() {
