@@ -660,3 +660,46 @@ fn clone_writes_arkit_named_targets() {
     assert_eq!(o.status.code(), Some(2));
     assert!(!wrl.exists());
 }
+
+#[test]
+fn full_live_link_face_header_resolves_on_ict() {
+    let Some(ict) = ict() else { return };
+    let rotations = [
+        "HeadYaw",
+        "HeadPitch",
+        "HeadRoll",
+        "LeftEyeYaw",
+        "LeftEyePitch",
+        "LeftEyeRoll",
+        "RightEyeYaw",
+        "RightEyePitch",
+        "RightEyeRoll",
+    ];
+    let mut header = String::from("Timecode,BlendShapeCount");
+    for n in ARKIT_SHAPES {
+        header.push(',');
+        header.push_str(&fbakit::rig::arkit_names::capture_name(n));
+    }
+    for r in rotations {
+        header.push(',');
+        header.push_str(r);
+    }
+    let zeros = ",0".repeat(52 + 9);
+    let text = format!("{header}\n00:00:00:00.000,61{zeros}\n00:00:00:01.000,61{zeros}\n");
+    let csv = parse_weights_csv(Path::new("llf.csv"), &text, Some(60.0)).unwrap();
+    let bridge = ArkitBridge::new(&ict.rig, &ict.face, &ict.report).unwrap();
+    let (stream, report) = bridge.weights_to_faps(&csv, "llf").unwrap();
+    assert_eq!(stream.frames.len(), 2);
+    let ignored: Vec<(&str, &str)> = report
+        .columns
+        .iter()
+        .filter(|c| !c.ignored.is_empty())
+        .map(|c| (c.column.as_str(), c.ignored.as_str()))
+        .collect();
+    // ICT has every ARKit shape but tongueOut; the nine rotations are not blend shapes.
+    assert_eq!(ignored.len(), 10, "{ignored:?}");
+    assert!(ignored.contains(&("TongueOut", "ARKit shape the rig does not have")));
+    assert!(ignored.contains(&("HeadYaw", "not a blend shape of the rig")));
+    // All-zero weights give the neutral: every FAP 0.
+    assert!(stream.frames[0].values().iter().all(|v| *v == 0.0));
+}
