@@ -153,6 +153,16 @@ fn completions_and_man_pages_are_generated() {
 }
 
 #[test]
+fn no_flag_that_does_nothing() {
+    // `face export` writes glTF whatever it is told; a `--gltf` switch would only mislead.
+    let help = text(&fbakit(&["face", "export", "--help"]).stdout);
+    assert!(!help.contains("--gltf"), "{help}");
+    let out = fbakit(&["face", "export", "alma", "-o", "x.glb", "--gltf"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!Path::new("x.glb").exists());
+}
+
+#[test]
 fn one_default_cloning_method() {
     for args in [
         &["clone", "--help"][..],

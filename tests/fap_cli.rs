@@ -160,7 +160,7 @@ fn convert_refuses_unknown_outputs_and_its_own_input() {
 
 #[test]
 fn help_has_examples() {
-    for cmd in ["info", "validate", "convert"] {
+    for cmd in ["info", "validate", "convert", "from-arkit", "to-arkit"] {
         let o = fbakit(&["fap", cmd, "--help"]);
         assert_eq!(o.status.code(), Some(0));
         assert!(stdout(&o).contains("fbakit fap"), "{cmd}");

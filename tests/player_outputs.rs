@@ -213,7 +213,6 @@ fn bundled_gzipped_faces_export_and_play() {
         "samples/faces/alma.wrl.gz",
         "-o",
         glb.to_str().unwrap(),
-        "--gltf",
     ]);
     assert_eq!(
         o.status.code(),

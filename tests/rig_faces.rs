@@ -69,7 +69,13 @@ fn a_rig_without_feature_points_reads_as_meshes_with_a_note() {
 fn the_real_head_plays_speech_and_an_xface_stream_head_sized_in_metres() {
     let dir = tempfile::tempdir().unwrap();
     let glb = dir.path().join("ict.glb");
-    let out = ok(&["play", "ict", "samples/speech.fap", "-o", glb.to_str().unwrap()]);
+    let out = ok(&[
+        "play",
+        "ict",
+        "samples/speech.fap",
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
     assert!(text(&out.stdout).contains("75 frames"));
     let bytes = std::fs::read(&glb).unwrap();
     let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
@@ -111,7 +117,13 @@ fn the_real_head_plays_speech_and_an_xface_stream_head_sized_in_metres() {
 fn the_real_head_is_viewed_and_cloned_onto() {
     let dir = tempfile::tempdir().unwrap();
     let page = dir.path().join("ict.html");
-    ok(&["view", "ict", "samples/speech.fap", "-o", page.to_str().unwrap()]);
+    ok(&[
+        "view",
+        "ict",
+        "samples/speech.fap",
+        "-o",
+        page.to_str().unwrap(),
+    ]);
     assert!(std::fs::metadata(&page).unwrap().len() > 100_000);
     // alma's FAT onto the head given as a rig file plus its feature points.
     let out_face = dir.path().join("ict-cloned.wrl.gz");

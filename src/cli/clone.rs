@@ -49,6 +49,10 @@ pub struct CloneArgs {
     /// Print the time of each cloning step (always in --json).
     #[arg(short, long)]
     pub verbose: bool,
+    /// Morph target names of a .glb/.gltf output: `fat` (the cloned FAT's keys) or `arkit`
+    /// (the 52 ARKit blend shapes from their FAP recipes, as `face export --names arkit`).
+    #[arg(long, value_name = "fat|arkit", default_value = "fat")]
+    pub names: super::face_export::NamesArg,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -123,10 +127,19 @@ struct Output<'a> {
     quality: Option<Quality>,
     /// Warnings from writing the output file.
     write_warnings: Vec<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arkit: Option<fbakit::rig::arkit_export::ArkitExportReport>,
 }
 
 pub fn run(args: CloneArgs) -> Result<u8> {
-    OutputFormat::resolve(&args.output, OutputFormat::FACES, "the cloned face")?;
+    let format = OutputFormat::resolve(&args.output, OutputFormat::FACES, "the cloned face")?;
+    let arkit_names = args.names == super::face_export::NamesArg::Arkit;
+    if arkit_names && !matches!(format, OutputFormat::Glb | OutputFormat::Gltf) {
+        return Err(fbakit::error::Error::Invalid(format!(
+            "{}: --names arkit needs a .glb or .gltf output",
+            args.output.display()
+        )));
+    }
     refuse_overwriting_input(&args.output, &[&args.source, &args.target])?;
     let pb = bar(if args.report { 5 } else { 4 });
     pb.set_message("reading source");
@@ -145,8 +158,17 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     let outcome = clone_face(&source, &target, &opts)?;
     pb.inc(1);
     pb.set_message("writing");
-    // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it).
-    let write_warnings = write_face(&args.output, &outcome.face)?;
+    // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it), or
+    // ARKit-named shapes made from it.
+    let mut arkit = None;
+    let write_warnings = if arkit_names {
+        let (report, warnings) =
+            fbakit::rig::arkit_export::write_arkit_gltf(&outcome.face, &args.output, None)?;
+        arkit = Some(report);
+        warnings
+    } else {
+        write_face(&args.output, &outcome.face)?
+    };
     pb.inc(1);
     let quality = if args.report {
         pb.set_message("measuring quality");
@@ -167,6 +189,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
             report: r,
             quality,
             write_warnings,
+            arkit,
         })?;
         return Ok(EXIT_OK);
     }
@@ -191,6 +214,13 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         for (step, s) in &r.timings.steps {
             println!("  {step:<20} {:>8.1} ms", s * 1000.0);
         }
+    }
+    if arkit.is_some() {
+        super::face_export::print_arkit_report(
+            &args.output.display().to_string(),
+            outcome.face.meshes.len(),
+            arkit.as_ref(),
+        );
     }
     if let Some(q) = quality {
         println!(

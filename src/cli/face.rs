@@ -63,9 +63,15 @@ pub enum FaceCommand {
         long_about = "Export a face as glTF 2.0: its transforms as nodes, each mesh with its \
                       colour, and the FAT as morph targets (one per table, or one per interval \
                       of a multi-interval table) named in extras.targetNames. OUT's extension \
-                      picks binary .glb or text .gltf (buffer embedded).",
-        after_help = "Examples:\n  fbakit face export alma -o alma.glb --gltf\n  \
-                      fbakit face export samples/faces/bruno.wrl.gz -o bruno.gltf"
+                      picks binary .glb or text .gltf (buffer embedded). With --names arkit \
+                      the morph targets are instead Apple ARKit's 52 blend shapes (jawOpen, \
+                      eyeBlinkLeft, ...), each the face posed with its FAP recipe \
+                      (specs/arkit-fap-amplitudes.csv, measured on ICT-FaceKit) minus the \
+                      neutral, on flat meshes in face-frame coordinates; shapes without a \
+                      recipe get no target and are listed.",
+        after_help = "Examples:\n  fbakit face export alma -o alma.glb\n  \
+                      fbakit face export samples/faces/bruno.wrl.gz -o bruno.gltf\n  \
+                      fbakit face export alma -o alma-arkit.glb --names arkit"
     )]
     Export(super::face_export::FaceExportArgs),
     /// Build a face with a FAP-compliant FAT from a blendshape rig (ARKit names by default).

@@ -1,4 +1,4 @@
-//! `fbakit face export FACE -o OUT.glb|.gltf [--gltf]`: a face with its FAT as morph targets
+//! `fbakit face export FACE -o OUT.glb|.gltf`: a face with its FAT as morph targets
 //! (no animation).
 
 use std::path::PathBuf;
@@ -14,21 +14,32 @@ use super::{print_json, EXIT_OK};
 /// Arguments of `face export`.
 #[derive(Debug, Args)]
 pub struct FaceExportArgs {
-    /// Face: a VRML face file, or `alma` / `bruno` for the built-in faces.
+    /// Face: any face file or rig, or a bundled face (`alma`, `bruno`, `ict`).
     pub face: PathBuf,
     /// Output `.glb` or `.gltf` file.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
-    /// Export as glTF 2.0 (the export format; binary or text by OUT's extension).
-    #[arg(long)]
-    pub gltf: bool,
     /// Length unit of the face's coordinates (default: guessed from its size); glTF output
     /// is scaled from it to metres.
     #[arg(long, value_name = "mm|cm|m")]
     pub units: Option<fbakit::face::units::LengthUnit>,
+    /// Morph target names: `fat` (one target per FAT table interval, named after its key) or
+    /// `arkit` (the 52 ARKit shapes, each the face posed with its FAP recipe from
+    /// specs/arkit-fap-amplitudes.csv; shapes without a recipe get no target).
+    #[arg(long, value_name = "fat|arkit", default_value = "fat")]
+    pub names: NamesArg,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Morph target naming of `face export`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum NamesArg {
+    /// The FAT's keys (`open_jaw`, `viseme_7`, ...).
+    Fat,
+    /// ARKit's 52 blend shapes (`jawOpen`, `eyeBlinkLeft`, ...).
+    Arkit,
 }
 
 #[derive(Serialize)]
@@ -38,6 +49,8 @@ struct Report {
     meshes: usize,
     morph_targets: usize,
     warnings: Vec<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arkit: Option<fbakit::rig::arkit_export::ArkitExportReport>,
 }
 
 /// Runs `face export`.
@@ -47,7 +60,11 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         &[OutputFormat::Glb, OutputFormat::Gltf],
         "`face export` output",
     )?;
+    fbakit::format::refuse_overwriting_input(&a.output, &[&a.face])?;
     let face = fbakit::face::read(&a.face)?;
+    if a.names == NamesArg::Arkit {
+        return export_arkit(&a, &face);
+    }
     let export = export_face_with_units(&face, None, a.units)?;
     if format == OutputFormat::Glb {
         export.document.write_glb(&a.output)?;
@@ -66,6 +83,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
             .map(|p| p.targets.len())
             .sum(),
         warnings: export.warnings,
+        arkit: None,
     };
     if a.json {
         print_json(&report)?;
@@ -74,9 +92,58 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
             "wrote {}: {} meshes, {} morph targets",
             report.output, report.meshes, report.morph_targets
         );
-        for w in &report.warnings {
-            println!("warning: {w}");
-        }
+        super::print_warnings(&report.warnings);
     }
     Ok(EXIT_OK)
+}
+
+/// `face export --names arkit`: the face as ARKit-named blend shapes, in metres.
+fn export_arkit(a: &FaceExportArgs, face: &fbakit::face::FaceModel) -> Result<u8> {
+    let (arkit, warnings) = fbakit::rig::arkit_export::write_arkit_gltf(face, &a.output, a.units)?;
+    if !a.json {
+        super::print_warnings(&warnings);
+    }
+    let report = Report {
+        face: face.name.clone(),
+        output: a.output.display().to_string(),
+        meshes: face.meshes.len(),
+        morph_targets: arkit.targets.len(),
+        warnings,
+        arkit: Some(arkit),
+    };
+    if a.json {
+        print_json(&report)?;
+        return Ok(EXIT_OK);
+    }
+    print_arkit_report(&report.output, report.meshes, report.arkit.as_ref());
+    Ok(EXIT_OK)
+}
+
+/// The text report of an ARKit-named export (shared with `clone --names arkit`).
+pub fn print_arkit_report(
+    output: &str,
+    meshes: usize,
+    arkit: Option<&fbakit::rig::arkit_export::ArkitExportReport>,
+) {
+    let Some(arkit) = arkit else { return };
+    println!(
+        "wrote {output}: {meshes} meshes, {} ARKit morph targets",
+        arkit.targets.len()
+    );
+    println!(
+        "no target ({}): {}",
+        arkit.unmapped.len(),
+        arkit
+            .unmapped
+            .iter()
+            .map(|u| format!("{} ({})", u.shape, u.reason))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if !arkit.missing_tables.is_empty() {
+        println!(
+            "recipe parts without a table on this face: {}",
+            arkit.missing_tables.join(", ")
+        );
+    }
 }

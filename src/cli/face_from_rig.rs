@@ -42,6 +42,17 @@ struct Output<'a> {
     warnings: &'a [String],
 }
 
+/// The mapping table `--map` names: `arkit` (built in) or a CSV file checked against `rig`.
+pub fn load_map(map: &str, rig: &fbakit::rig::Rig) -> Result<FapMap> {
+    if map.eq_ignore_ascii_case("arkit") {
+        return Ok(FapMap::arkit());
+    }
+    let path = PathBuf::from(map);
+    let m = read_fap_map(&path)?;
+    m.check_against(rig, &path)?;
+    Ok(m)
+}
+
 /// Runs `face from-rig`.
 pub fn run(a: FromRigArgs) -> Result<u8> {
     fbakit::format::OutputFormat::resolve(
@@ -51,14 +62,7 @@ pub fn run(a: FromRigArgs) -> Result<u8> {
     )?;
     fbakit::format::refuse_overwriting_input(&a.output, &[&a.rig])?;
     let rig = read_rig(&a.rig)?;
-    let map = if a.map.eq_ignore_ascii_case("arkit") {
-        FapMap::arkit()
-    } else {
-        let path = PathBuf::from(&a.map);
-        let map = read_fap_map(&path)?;
-        map.check_against(&rig, &path)?;
-        map
-    };
+    let map = load_map(&a.map, &rig)?;
     let fp = match &a.fp {
         Some(p) => Some(fbakit::fdp::read_feature_points(p)?.points),
         None => None,

@@ -1,4 +1,4 @@
-//! `fbakit fap info|validate|convert`: FAP stream commands.
+//! `fbakit fap info|validate|convert|from-arkit|to-arkit`: FAP stream commands.
 
 use std::path::PathBuf;
 
@@ -26,6 +26,26 @@ pub enum FapCommand {
     #[command(after_help = "Examples:\n  fbakit fap convert joy.fap joy.json\n  \
                             fbakit fap convert joy.json joy-canonical.fap --strict")]
     Convert(ConvertArgs),
+    /// ARKit blend-shape weights (a Live Link Face CSV) → a FAP stream, through a rig and the
+    /// FAT built from it: each frame poses the rig's feature points with the weights and
+    /// solves a bounded least-squares fit for the FAP values (positive and negative parts
+    /// each 0..2× the calibrated range, small Tikhonov term). Head and eye rotation columns
+    /// are reported as ignored; weights outside 0..1 are clamped with one warning.
+    #[command(
+        name = "from-arkit",
+        after_help = "Example:\n  fbakit fp from-landmarks ict/generic_neutral_mesh.obj --ibug68 ict/vertex_indices.json -o ict-fp.csv\n  \
+                      fbakit fap from-arkit capture.csv --face ict/ --fp ict-fp.csv -o capture.fap"
+    )]
+    FromArkit(super::fap_arkit::FromArkitArgs),
+    /// A FAP stream → ARKit blend-shape weights (CSV: Timecode, then the 52 ARKit shapes at
+    /// the stream's frame rate): the stream is played on the FAT built from the rig and each
+    /// frame's feature-point motion is fitted by the rig's shapes, 0 ≤ w ≤ 1 (bounded least
+    /// squares, small Tikhonov term). Shapes the rig lacks are written as 0.
+    #[command(
+        name = "to-arkit",
+        after_help = "Example:\n  fbakit fap to-arkit samples/speech.fap --face ict/ --fp ict-fp.csv -o speech-arkit.csv"
+    )]
+    ToArkit(super::fap_arkit::ToArkitArgs),
 }
 
 /// Arguments of `fap info`.
@@ -72,6 +92,8 @@ pub fn run(cmd: FapCommand) -> Result<u8> {
         FapCommand::Info(a) => info(a),
         FapCommand::Validate(a) => validate(a),
         FapCommand::Convert(a) => convert(a),
+        FapCommand::FromArkit(a) => super::fap_arkit::from_arkit(a),
+        FapCommand::ToArkit(a) => super::fap_arkit::to_arkit(a),
     }
 }
 

@@ -13,8 +13,9 @@ mod clone;
 mod docs;
 pub mod face;
 pub mod face_export;
-mod face_from_rig;
+pub(crate) mod face_from_rig;
 pub mod fap;
+mod fap_arkit;
 mod fapu;
 mod fp;
 pub mod play;
@@ -188,7 +189,8 @@ pub enum Command {
                       missing feature points), 1 other failures.",
         after_help = "Examples:\n  fbakit clone alma.wrl bruno.wrl -o bruno-animated.wrl\n  \
                       fbakit clone alma.wrl head.obj --fp-target head.fdp -o head.wrl --method rbf --report\n  \
-                      fbakit clone alma.wrl bruno.wrl -o out.wrl --json > report.json"
+                      fbakit clone alma.wrl bruno.wrl -o out.wrl --json > report.json\n  \
+                      fbakit clone alma bruno -o bruno-arkit.glb --method rbf --names arkit"
     )]
     Clone(clone::CloneArgs),
     /// Quality figures of a face's FAT (compliance, self-cloning error).

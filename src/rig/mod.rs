@@ -14,13 +14,25 @@
 //! [`FaceModel`] (meshes, no FAT), and [`gltf_write`] writes a rig back as glTF morph targets.
 //! Shapes with the same name on several meshes (a head and its teeth both moving under
 //! `jawOpen`) are one shape.
+//!
+//! The ARKit bridge: [`arkit_names`] (the 52 shapes and which rig shapes play them),
+//! [`weights_csv`] (capture-app weight curves), [`bounded_ls`] (the box-constrained least
+//! squares both directions solve), [`arkit_weights`] (weights ⇄ FAP values on a rig and its
+//! FAT), [`arkit_amplitudes`] (FAP values per ARKit shape, measured) and [`arkit_export`]
+//! (any FAT face as ARKit-named shapes).
 
+pub mod arkit_amplitudes;
+pub mod arkit_export;
+pub mod arkit_names;
+pub mod arkit_weights;
+pub mod bounded_ls;
 pub mod fap_map;
 pub mod fat_build;
 pub mod gltf_read;
 pub mod gltf_write;
 pub mod obj_folder;
 pub mod trim;
+pub mod weights_csv;
 
 use std::collections::HashMap;
 use std::path::Path;
