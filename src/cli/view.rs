@@ -121,10 +121,7 @@ pub fn run(a: ViewArgs) -> Result<u8> {
         glb_bytes: page.glb_bytes,
         frames: anim.as_ref().map_or(0, |a| a.frames.len()),
         fps: anim.as_ref().map(|a| a.fps),
-        duration_seconds: anim
-            .as_ref()
-            .and_then(|a| Some(a.frames.last()?.time - a.frames.first()?.time))
-            .unwrap_or(0.0),
+        duration_seconds: anim.as_ref().map_or(0.0, |a| a.duration()),
         missing_tables: missing,
         warnings,
     };

@@ -68,6 +68,17 @@ pub struct ViewerAnimation<'a> {
     pub name: &'a str,
 }
 
+impl ViewerAnimation<'_> {
+    /// Length in seconds: frames / fps, as the player reports it and the clip lasts.
+    pub fn duration(&self) -> f64 {
+        if self.fps > 0.0 {
+            self.frames.len() as f64 / self.fps
+        } else {
+            0.0
+        }
+    }
+}
+
 /// What the page's script needs besides the glb; embedded as JSON.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ViewerModel {
@@ -103,7 +114,8 @@ pub struct StreamSummary {
     pub fps: f64,
     /// Number of frames.
     pub frames: usize,
-    /// Time of the last frame, in seconds (the animation's length).
+    /// The animation's length in seconds: frames / fps (the clip holds the last frame for
+    /// one frame, like every glTF clip fbakit writes).
     pub duration: f64,
 }
 
@@ -417,10 +429,7 @@ impl ViewerModel {
             name: a.name.to_string(),
             fps: a.fps,
             frames: a.frames.len(),
-            duration: match (a.frames.first(), a.frames.last()) {
-                (Some(f), Some(l)) => l.time - f.time,
-                _ => 0.0,
-            },
+            duration: a.duration(),
         });
         Ok(ViewerModel {
             face: face.name.clone(),
