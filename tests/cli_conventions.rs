@@ -4,19 +4,9 @@
 //! file or the option.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn fbakit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run fbakit")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+mod support;
+use support::cli::{fbakit, text};
 
 /// The subcommand names listed under `Commands:` in a help text (without `help`).
 fn subcommands(help: &str) -> Vec<String> {

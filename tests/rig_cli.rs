@@ -2,19 +2,9 @@
 //! messages on good and bad rigs.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn fbakit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run fbakit")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
+mod support;
+use support::cli::{fbakit, text};
 
 const QUAD: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
 

@@ -3,19 +3,10 @@
 //! exported head-sized in metres.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn fbakit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run fbakit")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
+mod support;
+use support::cli::{fbakit, text};
 
 fn ok(args: &[&str]) -> Output {
     let out = fbakit(args);

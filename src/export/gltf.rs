@@ -241,15 +241,8 @@ pub fn export_face_with_units(
     face.check_structure()?;
     let morphs = FaceMorphs::new(face)?;
     let mut warnings = Vec::new();
-    let k = match crate::face::units::unit_of(face, units) {
-        Some(g) => g.unit.metres(),
-        None => {
-            warnings.push(
-                "the face's length unit cannot be guessed (no size); written as metres".into(),
-            );
-            1.0
-        }
-    };
+    let (k, unit_warning) = crate::face::units::metres_factor(face, units);
+    warnings.extend(unit_warning);
     let mut scene = SceneBuilder::new(face.name.clone());
 
     // Transform nodes: A (t + c, r, s) and, when c ≠ 0, pivot B (−c) holding the children.

@@ -186,6 +186,18 @@ pub fn unit_of(face: &FaceModel, unit: Option<LengthUnit>) -> Option<UnitGuess> 
     }
 }
 
+/// The factor from the face's units to metres ([`unit_of`]), and a warning when no unit can be
+/// guessed (the coordinates are then taken as metres, factor 1).
+pub fn metres_factor(face: &FaceModel, unit: Option<LengthUnit>) -> (f32, Option<String>) {
+    match unit_of(face, unit) {
+        Some(g) => (g.unit.metres(), None),
+        None => (
+            1.0,
+            Some("the face's length unit cannot be guessed (no size); written as metres".into()),
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -173,15 +173,8 @@ pub fn write_arkit_gltf(
     let amplitudes = super::arkit_amplitudes::arkit_amplitudes();
     let (mut rig, report) = face_to_arkit_rig(face, &amplitudes)?;
     let mut warnings = Vec::new();
-    let k = match crate::face::units::unit_of(face, units) {
-        Some(g) => g.unit.metres(),
-        None => {
-            warnings.push(
-                "the face's length unit cannot be guessed (no size); written as metres".into(),
-            );
-            1.0
-        }
-    };
+    let (k, unit_warning) = crate::face::units::metres_factor(face, units);
+    warnings.extend(unit_warning);
     scale_rig(&mut rig, k);
     super::gltf_write::write_rig_gltf(&rig, path)?;
     Ok((report, warnings))

@@ -1,2 +1,4 @@
-//! Helpers shared by integration tests.
+//! Helpers shared by integration tests (each test binary uses some of them).
+#![allow(dead_code)]
+pub mod cli;
 pub mod gltf_scenes;
