@@ -26,7 +26,7 @@
 //! - [`speech`]: text to a FAP stream: phoneme timing from espeak-ng, visemes, blending.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads (plain and gzip) and atomic writes.
-//! - [`format`]: output formats resolved once from a path; refusing to overwrite inputs.
+//! - [`mod@format`]: output formats resolved once from a path; refusing to overwrite inputs.
 //! - [`vrml`]: VRML97 text syntax: parser, scene graph with DEF/USE, canonical writer.
 //! - [`prelude`]: the names most programs need, in one `use fbakit::prelude::*`.
 //!

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 
-/// The face file formats [`crate::face::read`] understands.
+/// The face file formats [`crate::face::read()`] understands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FaceFormat {
@@ -20,7 +20,7 @@ pub enum FaceFormat {
     /// The CANDIDE-3 model (`.wfm`); needs its feature-point table.
     Wfm,
     /// A glTF 2.0 blendshape rig (`.glb`, `.gltf`): meshes and morph targets; with feature
-    /// points its shapes become a FAT ([`crate::face::read`]).
+    /// points its shapes become a FAT ([`crate::face::read()`]).
     Gltf,
 }
 

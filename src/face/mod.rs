@@ -2,8 +2,8 @@
 //! and Facial Animation Tables (FAT).
 //!
 //! [`FaceModel`] is what cloning and playing work on. Every face enters through one front
-//! door, [`read`] (any format, by extension or content, or a bundled face by name), and
-//! leaves through [`write`] (VRML, gzip VRML, OBJ; glTF is [`crate::export::gltf`]). Faces
+//! door, [`read()`] (any format, by extension or content, or a bundled face by name), and
+//! leaves through [`write()`] (VRML, gzip VRML, OBJ; glTF is [`crate::export::gltf`]). Faces
 //! are also built from OBJ morph sets ([`morphs`]) and from CANDIDE-3 ([`candide`]);
 //! [`summary`] describes one and [`validate`] checks one.
 //!

@@ -18,7 +18,7 @@
 //! [`fat_from_morph_targets`].
 //!
 //! **Writing.** [`write_morph_set`] writes `neutral.obj` (all meshes merged in face
-//! coordinates, as [`super::write`] writes OBJ), `feature-points.csv` (the feature points
+//! coordinates, as [`super::write()`] writes OBJ), `feature-points.csv` (the feature points
 //! bound to the merged mesh's vertices) and one OBJ per table and value: the table's vertex
 //! motion plus the effect of the transforms it drives on the meshes under them. Files other
 //! than `*.obj` and the file `neutral.obj` are ignored when a set is read, so a written set

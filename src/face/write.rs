@@ -15,7 +15,7 @@ use crate::io::gzip;
 use crate::mesh::obj::ObjScene;
 use crate::mesh::{FaceGroup, Mesh, Polygons};
 
-/// The formats [`write`] writes.
+/// The formats [`write()`] writes.
 pub const WRITABLE: &[OutputFormat] =
     &[OutputFormat::Vrml, OutputFormat::VrmlGz, OutputFormat::Obj];
 

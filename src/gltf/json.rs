@@ -3,7 +3,7 @@
 //! Plain serde structs mirroring the schema's property names. Optional properties are omitted
 //! when unset and arrays when empty, because glTF forbids empty arrays and the validator reports
 //! properties set to their defaults. This model knows nothing about meshes or faces: the
-//! [builder](super::builder) fills it, the [container](super::container) serialises it.
+//! the builder fills it, the container serialises it ([`super::GltfDocument`]).
 
 use serde::{Deserialize, Serialize};
 use serde_json::Value;

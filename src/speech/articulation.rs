@@ -10,7 +10,7 @@
 
 use crate::spec::{FapId, Viseme};
 
-/// The FAPs written, in this order in [`ARTICULATION`] rows.
+/// The FAPs written, in this order in the articulation table's rows.
 pub const ARTICULATION_FAPS: [u8; 7] = [3, 4, 5, 6, 7, 16, 17];
 
 /// Per viseme 0..=14: open_jaw, lower_t_midlip, raise_b_midlip, stretch_l_cornerlip,
