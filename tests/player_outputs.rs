@@ -155,7 +155,11 @@ fn play_reports_missing_tables() {
 fn play_usage_errors_exit_2() {
     let o = fbakit(&["play", "alma", "samples/speech.fap", "-o", "x.txt"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown output extension"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("x.txt") && err.contains("unknown extension `.txt`") && err.contains(".glb"),
+        "{err}"
+    );
     let o = fbakit(&["play", "nobody", "samples/speech.fap", "-o", "x.glb"]);
     assert_eq!(o.status.code(), Some(2));
     let o = fbakit(&[

@@ -82,21 +82,20 @@ enum OutFormat {
 }
 
 fn out_format(path: &Path) -> Result<OutFormat> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("csv") => Ok(OutFormat::Csv),
-        Some("xml") => Ok(OutFormat::Xml),
-        Some("fdp") => Err(Error::Unsupported(format!(
+    use fbakit::format::OutputFormat;
+    if OutputFormat::of_path(path) == Some(OutputFormat::Fdp) {
+        return Err(Error::Unsupported(format!(
             "{}: fbakit reads Xface .fdp files but does not write them; write .xml or .csv",
             path.display()
-        ))),
-        _ => Err(Error::Unsupported(format!(
-            "{}: unknown output extension (expected .csv or .xml)",
-            path.display()
-        ))),
+        )));
+    }
+    match OutputFormat::resolve(
+        path,
+        &[OutputFormat::Csv, OutputFormat::Xml],
+        "`fp from-landmarks` output",
+    )? {
+        OutputFormat::Xml => Ok(OutFormat::Xml),
+        _ => Ok(OutFormat::Csv),
     }
 }
 

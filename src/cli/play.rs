@@ -11,6 +11,7 @@ use fbakit::export::gltf::export_face_with_units;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
 use fbakit::fap::{read_stream_file, ReadOptions};
+use fbakit::format::OutputFormat;
 use fbakit::player::{PlayOptions, Player};
 use fbakit::render::RenderOptions;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -135,25 +136,29 @@ struct PlayReport {
     warnings: Vec<String>,
 }
 
-/// Picks the output format from `--format` or OUT.
+/// Picks the output format from `--format` or OUT (through the one output rule,
+/// [`OutputFormat::resolve`]; a path without extension is a new folder of OBJ frames).
 pub fn output_format(out: &Path, format: Option<PlayFormat>) -> Result<PlayFormat> {
     if let Some(f) = format {
         return Ok(f);
     }
-    let ext = out
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("glb") => Ok(PlayFormat::Glb),
-        Some("gltf") => Ok(PlayFormat::Gltf),
-        Some("png") => Ok(PlayFormat::Png),
-        _ if out.is_dir() => Ok(PlayFormat::Obj),
-        None => Ok(PlayFormat::Obj),
-        Some(e) => Err(Error::Unsupported(format!(
-            "unknown output extension `.{e}` (use .glb, .gltf, .png, a directory or --format)"
-        ))),
+    if out.extension().is_none() {
+        return Ok(PlayFormat::Obj);
     }
+    let accepted = [
+        OutputFormat::Glb,
+        OutputFormat::Gltf,
+        OutputFormat::Png,
+        OutputFormat::Directory,
+    ];
+    Ok(
+        match OutputFormat::resolve(out, &accepted, "`play` output (or give --format)")? {
+            OutputFormat::Glb => PlayFormat::Glb,
+            OutputFormat::Gltf => PlayFormat::Gltf,
+            OutputFormat::Png => PlayFormat::Png,
+            _ => PlayFormat::Obj,
+        },
+    )
 }
 
 /// A progress bar on stderr, hidden when stderr is not a terminal.
