@@ -135,6 +135,52 @@ fn the_real_head_is_viewed_and_cloned_onto() {
 }
 
 #[test]
+fn play_and_render_take_a_rig_with_its_feature_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("rig-speech.glb");
+    ok(&[
+        "play",
+        GLB,
+        "samples/speech.fap",
+        "--fp",
+        FP,
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    let bytes = std::fs::read(&glb).unwrap();
+    let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(chunks.json).unwrap();
+    let targets = json["meshes"][0]["primitives"][0]["targets"]
+        .as_array()
+        .map_or(0, Vec::len);
+    assert!(targets >= 50, "{targets} morph targets from the rig's FAT");
+    let gif = dir.path().join("rig.gif");
+    ok(&[
+        "render",
+        GLB,
+        "samples/speech.fap",
+        "--fp",
+        FP,
+        "--size",
+        "64x64",
+        "-o",
+        gif.to_str().unwrap(),
+    ]);
+    // No command writes over its input.
+    let copy = dir.path().join("copy.glb");
+    std::fs::copy(GLB, &copy).unwrap();
+    let c = copy.to_str().unwrap();
+    for args in [
+        &["play", c, "samples/speech.fap", "-o", c][..],
+        &["render", c, "samples/speech.fap", "-o", c],
+    ] {
+        let out = fbakit(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+    }
+    assert_eq!(std::fs::read(&copy).unwrap(), std::fs::read(GLB).unwrap());
+}
+
+#[test]
 fn a_folder_of_shape_objs_is_a_face_too() {
     let dir = tempfile::tempdir().unwrap();
     let quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";

@@ -18,6 +18,7 @@ pub mod fap;
 mod fap_arkit;
 mod fapu;
 mod fp;
+mod inputs;
 pub mod play;
 mod render;
 mod rig;

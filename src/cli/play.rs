@@ -10,7 +10,6 @@ use fbakit::error::{Error, Result};
 use fbakit::export::gltf::export_face_with_units;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
-use fbakit::fap::{read_stream_file, ReadOptions};
 use fbakit::format::OutputFormat;
 use fbakit::player::{PlayOptions, Player};
 use fbakit::render::RenderOptions;
@@ -36,8 +35,12 @@ pub enum PlayFormat {
 /// Arguments of `play`.
 #[derive(Debug, Args)]
 pub struct PlayArgs {
-    /// Face: a VRML face file, or `alma` / `bruno` for the built-in faces.
+    /// Face: a face file or rig, or a bundled face (`alma`, `bruno`, `ict`).
     pub face: PathBuf,
+    /// Feature points of the face (an OBJ needs them; with them a rig's shapes become its
+    /// FAT).
+    #[arg(long, value_name = "FILE")]
+    pub fp: Option<PathBuf>,
     /// FAP stream (`.fap` or `.json`).
     pub stream: PathBuf,
     /// Output: `.glb` / `.gltf` file, `.png` contact sheet, or a directory for an OBJ or PNG
@@ -179,14 +182,11 @@ pub fn progress(len: u64, what: &str) -> ProgressBar {
 /// Runs `play`.
 pub fn run(a: PlayArgs) -> Result<u8> {
     let format = output_format(&a.output, a.format)?;
-    let face = fbakit::face::read(&a.face)?;
-    let opts = if a.strict {
-        ReadOptions::strict()
-    } else {
-        ReadOptions::lenient()
-    };
-    let (stream, stream_warnings) = read_stream_file(&a.stream, &opts)?;
-    let mut warnings: Vec<String> = stream_warnings.iter().map(|d| d.to_string()).collect();
+    let mut inputs: Vec<&Path> = vec![&a.face, &a.stream];
+    inputs.extend(a.fp.as_deref());
+    fbakit::format::refuse_overwriting_input(&a.output, &inputs)?;
+    let face = super::inputs::read_face(&a.face, a.fp.as_deref())?;
+    let (stream, mut warnings) = super::inputs::read_stream(&a.stream, a.strict)?;
     let mut player = Player::new(
         &face,
         &stream,

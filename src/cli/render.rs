@@ -7,7 +7,6 @@ use clap::Args;
 use fbakit::error::{Error, Result};
 use fbakit::export::movie::{movie_fps, render_movie, MovieOptions};
 use fbakit::export::video::{open_sink, VideoFormat, VideoSettings};
-use fbakit::fap::{read_stream_file, ReadOptions};
 
 use serde::Serialize;
 
@@ -17,8 +16,12 @@ use super::{parse_fps, print_json, EXIT_OK};
 /// Arguments of `render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Face: a VRML face file, or `alma` / `bruno` for the built-in faces.
+    /// Face: a face file or rig, or a bundled face (`alma`, `bruno`, `ict`).
     pub face: PathBuf,
+    /// Feature points of the face (an OBJ needs them; with them a rig's shapes become its
+    /// FAT).
+    #[arg(long, value_name = "FILE")]
+    pub fp: Option<PathBuf>,
     /// FAP stream (`.fap` or `.json`).
     pub stream: PathBuf,
     /// Output: `.mp4` (needs the ffmpeg program), `.gif`, or a directory for one PNG per
@@ -81,14 +84,12 @@ pub fn run(a: RenderArgs) -> Result<u8> {
             "--audio needs an .mp4 output (GIF and PNG frames have no sound)".into(),
         ));
     }
-    let face = fbakit::face::read(&a.face)?;
-    let opts = if a.strict {
-        ReadOptions::strict()
-    } else {
-        ReadOptions::lenient()
-    };
-    let (stream, stream_warnings) = read_stream_file(&a.stream, &opts)?;
-    let warnings: Vec<String> = stream_warnings.iter().map(|d| d.to_string()).collect();
+    let mut inputs: Vec<&std::path::Path> = vec![&a.face, &a.stream];
+    inputs.extend(a.fp.as_deref());
+    inputs.extend(a.audio.as_deref());
+    fbakit::format::refuse_overwriting_input(&a.output, &inputs)?;
+    let face = super::inputs::read_face(&a.face, a.fp.as_deref())?;
+    let (stream, warnings) = super::inputs::read_stream(&a.stream, a.strict)?;
     let settings = VideoSettings {
         width: a.size.0,
         height: a.size.1,

@@ -6,8 +6,6 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use fbakit::error::{Error, Result};
 use fbakit::export::viewer::{ViewerAnimation, ViewerPage};
-use fbakit::face::{read_with, FaceReadOptions};
-use fbakit::fap::{read_stream_file, ReadOptions};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use fbakit::player::{PlayOptions, Player};
 use serde::Serialize;
@@ -62,28 +60,20 @@ pub fn run(a: ViewArgs) -> Result<u8> {
     OutputFormat::resolve(&a.output, &[OutputFormat::Html], "the viewer page")?;
     let mut inputs: Vec<&Path> = vec![&a.face];
     inputs.extend(a.stream.as_deref());
+    inputs.extend(a.fp.as_deref());
     refuse_overwriting_input(&a.output, &inputs)?;
     if a.stream.is_none() && (a.fps.is_some() || a.frames.is_some()) {
         return Err(Error::Invalid(
             "--fps and --frames need a STREAM to play".into(),
         ));
     }
-    let face = read_with(
-        &a.face,
-        &FaceReadOptions::with_feature_points(a.fp.as_deref()),
-    )?
-    .0;
+    let face = super::inputs::read_face(&a.face, a.fp.as_deref())?;
     let mut warnings = Vec::new();
     let mut missing = Vec::new();
     let played = match &a.stream {
         Some(path) => {
-            let opts = if a.strict {
-                ReadOptions::strict()
-            } else {
-                ReadOptions::lenient()
-            };
-            let (stream, diags) = read_stream_file(path, &opts)?;
-            warnings.extend(diags.iter().map(|d| d.to_string()));
+            let (stream, diags) = super::inputs::read_stream(path, a.strict)?;
+            warnings.extend(diags);
             let player = Player::new(
                 &face,
                 &stream,

@@ -1,0 +1,29 @@
+//! Reading the inputs commands share: a face (through the one front door, with an optional
+//! feature-point file) and a FAP stream (strict or lenient), so every command reads them the
+//! same way.
+
+use std::path::Path;
+
+use fbakit::error::Result;
+use fbakit::face::{FaceModel, FaceReadOptions};
+use fbakit::fap::{read_stream_file, FapStream, ReadOptions};
+
+/// Reads a face file, rig or bundled face; `fp` replaces its feature points (an OBJ needs
+/// them; a rig's shapes become a FAT with them).
+pub fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
+    Ok(fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp))?.0)
+}
+
+/// Reads a FAP stream, strictly or leniently, with its reader warnings as text.
+pub fn read_stream(path: &Path, strict: bool) -> Result<(FapStream, Vec<String>)> {
+    let opts = if strict {
+        ReadOptions::strict()
+    } else {
+        ReadOptions::lenient()
+    };
+    let (stream, diagnostics) = read_stream_file(path, &opts)?;
+    Ok((
+        stream,
+        diagnostics.iter().map(ToString::to_string).collect(),
+    ))
+}
