@@ -270,3 +270,84 @@ fn talking_head_mp4_from_typed_text() {
         "mp4 {duration} s, wav {audio} s"
     );
 }
+
+#[test]
+fn one_command_from_typed_text_to_a_talking_head() {
+    if skip("one_command_from_typed_text_to_a_talking_head") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A page: the bundled real head (the default face) says it; the page plays on load.
+    let o = fbakit(
+        dir.path(),
+        &["speak", "Good morning", "-o", "hi.html", "--json"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["talking_head"]["face"], "ict");
+    let frames = r["frames"].as_u64().unwrap();
+    assert_eq!(r["talking_head"]["frames"].as_u64().unwrap(), frames);
+    let html = std::fs::read_to_string(dir.path().join("hi.html")).unwrap();
+    assert!(html.contains("<html") && html.len() > 100_000);
+    // A GIF on another face (no ffmpeg needed); refusing to overwrite that face's file.
+    let o = fbakit(
+        dir.path(),
+        &[
+            "speak", "Hi", "-o", "hi.gif", "--face", "alma", "--size", "64x64",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::metadata(dir.path().join("hi.gif")).unwrap().len() > 1000);
+    let o = fbakit(
+        dir.path(),
+        &["speak", "Hi", "-o", "hi.gif", "--face", "hi.gif"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("hi.gif"), "{}", stderr(&o));
+    if !fbakit::export::video::ffmpeg_available() {
+        eprintln!("skip the mp4 part: ffmpeg is not installed");
+        return;
+    }
+    // An mp4 whose soundtrack is the speech: as long as the stream.
+    let o = fbakit(
+        dir.path(),
+        &[
+            "speak",
+            "Hello world",
+            "-o",
+            "hi.mp4",
+            "--size",
+            "96x96",
+            "--json",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(r["talking_head"]["audio"].is_string(), "{r:#}");
+    let audio = r["audio_seconds"].as_f64().unwrap();
+    let p = Command::new("ffprobe")
+        .args([
+            "-v",
+            "error",
+            "-show_entries",
+            "stream=codec_type:format=duration",
+            "-of",
+            "default=nw=1",
+            "hi.mp4",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&p.stdout);
+    assert!(text.contains("codec_type=audio"), "{text}");
+    let duration: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("duration="))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        (duration - audio).abs() < 0.1,
+        "mp4 {duration} s, speech {audio} s"
+    );
+}

@@ -91,16 +91,16 @@ pub const EXIT_BAD_INPUT: u8 = 2;
                   go to stderr. Exit codes: 0 ok, 1 the operation failed (e.g. validation \
                   found problems, an output could not be written), 2 bad usage or bad input.",
     after_help = "Examples:\n  \
-                  fbakit demo                                      the whole pipeline on the bundled faces\n  \
-                  fbakit face info alma                            a face: meshes, feature points, FAPU, FAT\n  \
-                  fbakit fap info samples/speech.fap               a FAP stream\n  \
-                  fbakit clone alma bruno.wrl -o bruno-fat.wrl     clone a FAT onto another face\n  \
-                  fbakit play alma samples/speech.fap -o a.glb     play a stream as animated glTF\n  \
-                  fbakit view alma samples/speech.fap -o a.html    a viewer page that plays on load\n  \
-                  fbakit speak \"Hello world\" -o hi.fap --wav hi.wav  text to visemes with espeak-ng\n  \
-                  fbakit render alma hi.fap --audio hi.wav -o hi.mp4  a talking-head video\n  \
+                  fbakit demo                                       the whole pipeline on the bundled faces\n  \
+                  fbakit face info alma                             a face: meshes, feature points, FAPU, FAT\n  \
+                  fbakit fap info samples/speech.fap                a FAP stream\n  \
+                  fbakit clone alma bruno.wrl -o bruno-fat.wrl      clone a FAT onto another face\n  \
+                  fbakit play alma samples/speech.fap -o a.glb      play a stream as animated glTF\n  \
+                  fbakit view alma samples/speech.fap -o a.html     a viewer page that plays on load\n  \
+                  fbakit speak \"Hello world\" -o hi.mp4              a real head says what you type, with sound\n  \
+                  fbakit render alma s.fap --audio s.wav -o s.mp4   a stream (and its sound) as video\n  \
                   fbakit face from-rig RIG --fp fp.csv -o face.wrl  a FAP-compliant FAT from ARKit shapes\n  \
-                  fbakit completions bash > fbakit.bash            shell completions (man: fbakit man -o DIR)\n\n\
+                  fbakit completions bash > fbakit.bash             shell completions (man: fbakit man -o DIR)\n\n\
                   `fbakit COMMAND --help` shows each command's options and examples."
 )]
 pub struct Cli {
@@ -271,7 +271,9 @@ pub enum Command {
                       writes jaw and lip FAPs instead, for faces without viseme tables. Exit \
                       codes: 0 ok, 2 bad input (empty text, unknown voice), 1 other failures \
                       (including espeak-ng not installed).",
-        after_help = "Examples:\n  fbakit speak \"Hello world\" -o hello.fap --wav hello.wav\n  \
+        after_help = "Examples:\n  fbakit speak \"Hello world\" -o hello.mp4            the real head says it, with sound\n  \
+                      fbakit speak \"Hello world\" -o hello.html --face alma\n  \
+                      fbakit speak \"Hello world\" -o hello.fap --wav hello.wav\n  \
                       fbakit render alma hello.fap --audio hello.wav -o hello.mp4\n  \
                       fbakit speak \"Guten Tag\" --voice de -o tag.fap --wav tag.wav\n  \
                       fbakit speak \"Hello\" --mouth faps -o hello-candide.fap --json"

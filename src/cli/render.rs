@@ -8,6 +8,8 @@ use fbakit::error::{Error, Result};
 use fbakit::export::movie::{movie_fps, render_movie, MovieOptions};
 use fbakit::export::video::{open_sink, VideoFormat, VideoSettings};
 
+use fbakit::face::FaceModel;
+use fbakit::fap::FapStream;
 use serde::Serialize;
 
 use super::play::{parse_size, progress};
@@ -46,8 +48,9 @@ pub struct RenderArgs {
     pub json: bool,
 }
 
+/// What a rendered video holds.
 #[derive(Debug, Serialize)]
-struct RenderReport {
+pub struct RenderReport {
     face: String,
     stream: String,
     output: String,
@@ -77,7 +80,6 @@ fn ignore_sigpipe() {
 
 /// Runs `render`.
 pub fn run(a: RenderArgs) -> Result<u8> {
-    ignore_sigpipe();
     let format = VideoFormat::from_path(&a.output)?;
     if a.audio.is_some() && format != VideoFormat::Mp4 {
         return Err(Error::Unsupported(
@@ -90,20 +92,66 @@ pub fn run(a: RenderArgs) -> Result<u8> {
     fbakit::format::refuse_overwriting_input(&a.output, &inputs)?;
     let face = super::inputs::read_face(&a.face, a.fp.as_deref())?;
     let (stream, warnings) = super::inputs::read_stream(&a.stream, a.strict)?;
-    let settings = VideoSettings {
-        width: a.size.0,
-        height: a.size.1,
-        fps: movie_fps(&stream, a.fps),
-        audio: a.audio.clone(),
-    };
-    let mut sink = open_sink(&a.output, format, &settings)?;
-    let movie = MovieOptions {
-        width: a.size.0,
-        height: a.size.1,
+    let job = VideoJob {
+        output: &a.output,
+        format,
+        size: a.size,
         fps: a.fps,
+        audio: a.audio.as_deref(),
+    };
+    let out = write_video(
+        &face,
+        &stream,
+        &a.stream.display().to_string(),
+        &job,
+        warnings,
+    )?;
+    if a.json {
+        print_json(&out)?;
+    } else {
+        print_report(&out);
+    }
+    Ok(EXIT_OK)
+}
+
+/// What to render and where (shared by `render` and `speak`).
+pub struct VideoJob<'a> {
+    /// The output path.
+    pub output: &'a std::path::Path,
+    /// Its format.
+    pub format: VideoFormat,
+    /// Frame size.
+    pub size: (u32, u32),
+    /// Frame rate; default the stream's.
+    pub fps: Option<f64>,
+    /// Sound muxed into an mp4.
+    pub audio: Option<&'a std::path::Path>,
+}
+
+/// Plays `stream` on `face` into the video `job` describes, with a progress bar on a
+/// terminal.
+pub fn write_video(
+    face: &FaceModel,
+    stream: &FapStream,
+    stream_name: &str,
+    job: &VideoJob<'_>,
+    warnings: Vec<String>,
+) -> Result<RenderReport> {
+    ignore_sigpipe();
+    let settings = VideoSettings {
+        width: job.size.0,
+        height: job.size.1,
+        fps: movie_fps(stream, job.fps),
+        audio: job.audio.map(std::path::Path::to_path_buf),
+    };
+    let mut sink = open_sink(job.output, job.format, &settings)?;
+    let movie = MovieOptions {
+        width: job.size.0,
+        height: job.size.1,
+        fps: job.fps,
     };
     let bar = progress(0, "rendering");
-    let report = render_movie(&face, &stream, &movie, sink.as_mut(), &mut |n, total| {
+    let report = render_movie(face, stream, &movie, sink.as_mut(), &mut |n, total| {
         bar.set_length(total as u64);
         bar.set_position(n as u64);
     });
@@ -116,49 +164,48 @@ pub fn run(a: RenderArgs) -> Result<u8> {
     };
     let written = sink.finish()?;
     bar.finish_and_clear();
-    let out = RenderReport {
+    Ok(RenderReport {
         face: face.name.clone(),
-        stream: a.stream.display().to_string(),
+        stream: stream_name.to_string(),
         output: written.path.display().to_string(),
-        format,
+        format: job.format,
         frames: report.frames,
         fps: report.fps,
         duration_seconds: report.duration_seconds,
-        width: a.size.0,
-        height: a.size.1,
-        audio: a.audio.as_ref().map(|p| p.display().to_string()),
+        width: job.size.0,
+        height: job.size.1,
+        audio: job.audio.map(|p| p.display().to_string()),
         bytes: written.bytes,
         framed_on_feature_points: report.framed_on_feature_points,
         missing_tables: report.missing_tables,
         warnings,
+    })
+}
+
+/// The text report of a written video, warnings on stderr.
+pub fn print_report(out: &RenderReport) {
+    super::print_warnings(&out.warnings);
+    let what = match out.format {
+        VideoFormat::Mp4 if out.audio.is_some() => "H.264 MP4 with AAC audio",
+        VideoFormat::Mp4 => "H.264 MP4",
+        VideoFormat::Gif => "animated GIF",
+        VideoFormat::PngFolder => "PNG frames",
     };
-    if a.json {
-        print_json(&out)?;
-    } else {
-        super::print_warnings(&out.warnings);
-        let what = match format {
-            VideoFormat::Mp4 if out.audio.is_some() => "H.264 MP4 with AAC audio",
-            VideoFormat::Mp4 => "H.264 MP4",
-            VideoFormat::Gif => "animated GIF",
-            VideoFormat::PngFolder => "PNG frames",
-        };
-        println!(
-            "wrote {}: {what}, {} frames {}x{} at {} fps ({:.3} s, {} bytes)",
-            out.output, out.frames, out.width, out.height, out.fps, out.duration_seconds, out.bytes
-        );
-        if !out.missing_tables.is_empty() {
-            let keys: Vec<String> = out
-                .missing_tables
-                .iter()
-                .map(|(k, n)| format!("{k} ({n} frames)"))
-                .collect();
-            eprintln!(
-                "warning: the face has no table for {} (those did not move it)",
-                keys.join(", ")
-            );
-        }
+    println!(
+        "wrote {}: {what}, {} frames {}x{} at {} fps ({:.3} s, {} bytes)",
+        out.output, out.frames, out.width, out.height, out.fps, out.duration_seconds, out.bytes
+    );
+    if !out.missing_tables.is_empty() {
+        let keys: Vec<String> = out
+            .missing_tables
+            .iter()
+            .map(|(k, n)| format!("{k} ({n} frames)"))
+            .collect();
+        super::print_warnings(&[format!(
+            "the face has no table for {} (those did not move it)",
+            keys.join(", ")
+        )]);
     }
-    Ok(EXIT_OK)
 }
 
 #[cfg(test)]
