@@ -96,4 +96,8 @@ pub struct SurfaceCloneResult {
     pub warnings: Vec<String>,
 }
 
+/// CANDIDE-3 test faces with exact motions (tests and the `bench-fixtures` benchmarks only:
+/// they read `../shared` beside the checkout).
+#[cfg(any(test, feature = "bench-fixtures"))]
+#[doc(hidden)]
 pub mod fixtures;

@@ -17,10 +17,6 @@ use super::{
 use crate::mesh::Mesh;
 use crate::spec::{FeaturePointId, Side};
 
-fn fp(label: &str) -> FeaturePointId {
-    label.parse().expect("standard label")
-}
-
 /// The order rules run in: later rules use the points of earlier ones.
 const ORDER: [Rule; 12] = [
     Rule::Landmark,
@@ -50,19 +46,19 @@ struct Eye {
 fn eye(side: Side) -> Eye {
     match side {
         Side::Left => Eye {
-            inner: fp("3.11"),
-            outer: fp("3.7"),
-            upper: fp("3.1"),
-            lower: fp("3.3"),
-            pupil: fp("3.5"),
+            inner: FeaturePointId::FP_3_11,
+            outer: FeaturePointId::FP_3_7,
+            upper: FeaturePointId::FP_3_1,
+            lower: FeaturePointId::FP_3_3,
+            pupil: FeaturePointId::FP_3_5,
             name: "left",
         },
         _ => Eye {
-            inner: fp("3.8"),
-            outer: fp("3.12"),
-            upper: fp("3.2"),
-            lower: fp("3.4"),
-            pupil: fp("3.6"),
+            inner: FeaturePointId::FP_3_8,
+            outer: FeaturePointId::FP_3_12,
+            upper: FeaturePointId::FP_3_2,
+            lower: FeaturePointId::FP_3_4,
+            pupil: FeaturePointId::FP_3_6,
             name: "right",
         },
     }
@@ -98,18 +94,24 @@ pub(super) fn place(
     landmarks: &[u32],
 ) -> Result<LandmarkFeaturePoints, String> {
     let rows = scheme.preset();
-    let landmark_of = |id: &str| -> Result<Vec3, String> {
-        let id = fp(id);
+    let landmark_of = |id: FeaturePointId| -> Result<Vec3, String> {
         rows.iter()
             .find(|r| r.fp == id && r.rule == Rule::Landmark)
             .map(|r| mesh.positions[landmarks[r.landmarks[0]] as usize])
             .ok_or_else(|| format!("the {scheme} preset has no landmark for {id}"))
     };
-    let left_eye = (landmark_of("3.7")? + landmark_of("3.11")?) * 0.5;
-    let right_eye = (landmark_of("3.8")? + landmark_of("3.12")?) * 0.5;
-    let mouth = (landmark_of("8.3")? + landmark_of("8.4")?) * 0.5;
-    let frame = FaceFrame::from_points(left_eye, right_eye, mouth, landmark_of("9.3")?)
-        .map_err(|e| format!("{scheme} landmarks: {e}"))?;
+    let left_eye =
+        (landmark_of(FeaturePointId::FP_3_7)? + landmark_of(FeaturePointId::FP_3_11)?) * 0.5;
+    let right_eye =
+        (landmark_of(FeaturePointId::FP_3_8)? + landmark_of(FeaturePointId::FP_3_12)?) * 0.5;
+    let mouth = (landmark_of(FeaturePointId::FP_8_3)? + landmark_of(FeaturePointId::FP_8_4)?) * 0.5;
+    let frame = FaceFrame::from_points(
+        left_eye,
+        right_eye,
+        mouth,
+        landmark_of(FeaturePointId::FP_9_3)?,
+    )
+    .map_err(|e| format!("{scheme} landmarks: {e}"))?;
     let skin = Skin::new(mesh, &frame, landmarks);
     let mut members = vec![Vec::new(); skin.component_count];
     for (v, &c) in skin.component.iter().enumerate() {
@@ -256,7 +258,7 @@ impl Ctx<'_> {
     fn scale(&self) -> Result<(f32, f32), String> {
         let (l, r) = (self.eye_centre(Side::Left)?, self.eye_centre(Side::Right)?);
         let es = l.x - r.x;
-        let ens = (l.y + r.y) * 0.5 - self.local(fp("9.15"))?.y;
+        let ens = (l.y + r.y) * 0.5 - self.local(FeaturePointId::FP_9_15)?.y;
         if es <= 0.0 || ens <= 0.0 {
             return Err(format!(
                 "the eyes and nose bottom give no face proportions (eye separation {es}, eyes to nose {ens})"
@@ -458,7 +460,10 @@ impl Ctx<'_> {
     }
 
     fn chin_boss(&self) -> RuleResult {
-        let (lip, chin) = (self.local(fp("8.2"))?, self.local(fp("2.1"))?);
+        let (lip, chin) = (
+            self.local(FeaturePointId::FP_8_2)?,
+            self.local(FeaturePointId::FP_2_1)?,
+        );
         let x = (lip.x + chin.x) * 0.5;
         let mut best: Option<(f32, f32)> = None;
         for i in 0..=100 {
@@ -482,11 +487,11 @@ impl Ctx<'_> {
     fn cheek(&self, side: Side) -> RuleResult {
         let (es, _) = self.scale()?;
         let corner = self.local(if side == Side::Left {
-            fp("8.3")
+            FeaturePointId::FP_8_3
         } else {
-            fp("8.4")
+            FeaturePointId::FP_8_4
         })?;
-        let y = (self.local(fp("9.15"))?.y + corner.y) * 0.5;
+        let y = (self.local(FeaturePointId::FP_9_15)?.y + corner.y) * 0.5;
         self.front_vertex(
             sign(side) * 0.55 * es,
             y,
@@ -506,7 +511,7 @@ impl Ctx<'_> {
 
     fn nostril_border(&self, side: Side) -> RuleResult {
         let (es, ens) = self.scale()?;
-        let y = self.local(fp("9.15"))?.y + 0.07 * ens;
+        let y = self.local(FeaturePointId::FP_9_15)?.y + 0.07 * ens;
         let s = sign(side);
         let n = 200usize;
         let (from, to) = (0.05 * es, 0.45 * es);
@@ -543,7 +548,7 @@ impl Ctx<'_> {
     fn nose_bump(&self) -> RuleResult {
         let (_, ens) = self.scale()?;
         let eyes = (self.eye_centre(Side::Left)? + self.eye_centre(Side::Right)?) * 0.5;
-        let tip = self.local(fp("9.3"))?;
+        let tip = self.local(FeaturePointId::FP_9_3)?;
         self.front_vertex(
             tip.x,
             eyes.y - 0.45 * ens,
@@ -555,7 +560,7 @@ impl Ctx<'_> {
     /// least 1.5 eye separations behind the eyes.
     fn skull(&self) -> Result<f32, String> {
         let (es, _) = self.scale()?;
-        let x = self.local(fp("9.3"))?.x;
+        let x = self.local(FeaturePointId::FP_9_3)?.x;
         let deepest = self
             .skin
             .skin_vertices()
@@ -575,7 +580,7 @@ impl Ctx<'_> {
 
     fn top_of_skull(&self) -> RuleResult {
         let es = self.skull()?;
-        let x = self.local(fp("9.3"))?.x;
+        let x = self.local(FeaturePointId::FP_9_3)?.x;
         let v = self
             .skin
             .skin_vertices()
@@ -593,7 +598,7 @@ impl Ctx<'_> {
 
     fn back_of_skull(&self) -> RuleResult {
         let es = self.skull()?;
-        let x = self.local(fp("9.3"))?.x;
+        let x = self.local(FeaturePointId::FP_9_3)?.x;
         let eyes = (self.eye_centre(Side::Left)? + self.eye_centre(Side::Right)?) * 0.5;
         let (lo, hi) = self
             .skin
