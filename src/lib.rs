@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # fbakit — MPEG-4 Face and Body Animation toolkit
 //!
 //! Modules follow the data, from the standard's tables to the files built on them:
