@@ -193,6 +193,15 @@ fn a_folder_of_shape_objs_is_a_face_too() {
     let out = ok(&["face", "info", dir.path().to_str().unwrap(), "--json"]);
     let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(info["vertices"], 4);
+    // A rig folder with a broken shape names that shape.
+    std::fs::write(dir.path().join("jawOpen.obj"), "v 0 -1 0\nf 1 1 1\n").unwrap();
+    let out = fbakit(&["face", "info", dir.path().to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("jawOpen.obj"),
+        "{}",
+        text(&out.stderr)
+    );
     // A folder that is no rig is bad input naming the folder.
     let empty = tempfile::tempdir().unwrap();
     let out = fbakit(&["face", "info", empty.path().to_str().unwrap()]);

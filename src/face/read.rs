@@ -72,16 +72,18 @@ pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, Face
     }
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
-        // A folder is a face only as an OBJ blendshape rig (a neutral plus shape OBJs).
-        let rig = crate::rig::obj_folder::read_obj_rig(path).map_err(|e| {
-            Error::Invalid(format!(
+        // A folder is a face only as an OBJ blendshape rig (a neutral plus shape OBJs); a
+        // folder with a neutral is a rig, and its own errors (a shape of the wrong size) stand.
+        if let Err(e) = crate::rig::obj_folder::find_neutral(path) {
+            return Err(Error::Invalid(format!(
                 "{}: is a directory and not a rig folder ({e}); expected a face file (.wrl, \
                  .wrl.gz, .obj, .wfm, .glb, .gltf), a folder of rig shape OBJs or a bundled \
                  face name ({})",
                 path.display(),
                 BundledFace::NAMES.join(", ")
-            ))
-        })?;
+            )));
+        }
+        let rig = crate::rig::obj_folder::read_obj_rig(path)?;
         return super::from_rig::rig_face(path, &rig, opts.feature_points.as_deref());
     }
     let bytes = crate::io::read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
