@@ -365,14 +365,13 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         let path = out_dir.join(format!("{name}-speech.glb"));
         export.document.write_glb(&path)?;
         let what = match name {
-            "ict-head" => "speech.fap on the ICT head with its own FAT (from its ARKit shapes)",
-            "ict-head-cloned" => "speech.fap on the ICT head with alma's FAT cloned onto it",
-            _ => "",
-        };
-        let what = if what.is_empty() {
-            format!("speech.fap played on {name} (animated glTF)")
-        } else {
-            what.to_string()
+            "ict-head" => {
+                "speech.fap on the ICT head with its own FAT (from its ARKit shapes)".to_string()
+            }
+            "ict-head-cloned" => {
+                "speech.fap on the ICT head with alma's FAT cloned onto it".to_string()
+            }
+            _ => format!("speech.fap played on {name} (animated glTF)"),
         };
         record(&mut files, path, &what)?;
     }
