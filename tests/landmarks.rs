@@ -314,6 +314,41 @@ fn cli_writes_points_that_fapu_and_both_cloners_accept() {
     );
     let back = fbakit::fdp::read_feature_points(&xml).unwrap();
     assert_eq!(back.points.len(), points.len());
+    // Xface .fdp too: the points, bound on the mesh file's name, and the FAPU in its head.
+    let fdp = tmp.path().join("ict-fp.fdp");
+    let out = fbakit(&[
+        "fp",
+        "from-landmarks",
+        neutral.to_str().unwrap(),
+        "--ibug68",
+        ids.to_str().unwrap(),
+        "-o",
+        fdp.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let xface = fbakit::fdp::read_feature_points(&fdp).unwrap();
+    assert_eq!(xface.points.len(), points.len());
+    let info = fbakit(&[
+        "face",
+        "info",
+        neutral.to_str().unwrap(),
+        "--fp",
+        fdp.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    // ICT is in cm: its eyes are 6.475 cm apart.
+    let es0 = v["fapu"]["units"]["ES"].as_f64().unwrap() * 1024.0;
+    assert!((es0 - 6.475).abs() < 0.01, "ES0 {es0}: {v:#}");
 
     // Both cloning methods accept the ICT neutral with these points (fmc used to refuse it
     // for lack of 2.10-2.14, 5.1-5.4, 9.1, 9.2, 9.12).
@@ -392,8 +427,8 @@ fn cli_refuses_bad_input_and_writes_nothing() {
         assert!(err.contains("ids.json"), "{err}");
         assert!(!out_csv.exists());
     }
-    // Unknown or unwritable extensions are refused before anything is read.
-    for name in ["fp.txt", "fp.fdp"] {
+    // Unknown extensions are refused before anything is read.
+    for name in ["fp.txt", "fp.fdp.txt"] {
         let out = run("[1]", &tmp.path().join(name));
         assert_eq!(out.status.code(), Some(2));
         assert!(!tmp.path().join(name).exists());

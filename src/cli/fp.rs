@@ -25,11 +25,13 @@ pub enum FpCommand {
                       cheeks, cheek bones, nose wings, nose bump, top and back of the skull \
                       when the mesh has one. Every point is bound to a mesh vertex and printed \
                       with its provenance. OUT is .csv (fp,vertices,combine,description with \
-                      the provenance) or fbakit .xml. Exit codes: 0 ok, 2 bad input (ids out \
+                      the provenance), fbakit .xml or Xface .fdp (points on the mesh file's \
+                      name, FAPU in its head). Exit codes: 0 ok, 2 bad input (ids out \
                       of range or repeated, wrong count, unreadable mesh, unknown output \
                       extension).",
         after_help = "Examples:\n  fbakit fp from-landmarks generic_neutral_mesh.obj --ibug68 vertex_indices.json -o ict-fp.csv\n  \
                       fbakit fp from-landmarks head.obj --ibug68 landmarks.csv -o head.xml --json\n  \
+                      fbakit fp from-landmarks head.obj --ibug68 landmarks.json -o head.fdp\n  \
                       fbakit fp from-landmarks canonical_face_model.obj --mediapipe468 -o mp-fp.csv"
     )]
     FromLandmarks(FromLandmarksArgs),
@@ -79,22 +81,18 @@ pub fn run(cmd: FpCommand) -> Result<u8> {
 enum OutFormat {
     Csv,
     Xml,
+    Fdp,
 }
 
 fn out_format(path: &Path) -> Result<OutFormat> {
     use fbakit::format::OutputFormat;
-    if OutputFormat::of_path(path) == Some(OutputFormat::Fdp) {
-        return Err(Error::Unsupported(format!(
-            "{}: fbakit reads Xface .fdp files but does not write them; write .xml or .csv",
-            path.display()
-        )));
-    }
     match OutputFormat::resolve(
         path,
-        &[OutputFormat::Csv, OutputFormat::Xml],
+        &[OutputFormat::Csv, OutputFormat::Xml, OutputFormat::Fdp],
         "`fp from-landmarks` output",
     )? {
         OutputFormat::Xml => Ok(OutFormat::Xml),
+        OutputFormat::Fdp => Ok(OutFormat::Fdp),
         _ => Ok(OutFormat::Csv),
     }
 }
@@ -145,6 +143,18 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
     };
     match format {
         OutFormat::Csv => fbakit::fdp::csv::write_csv_file(&args.output, &found.table())?,
+        // Xface names the mesh a point is on; the mesh file's name is what `--fp` matches.
+        OutFormat::Fdp => fbakit::fdp::xface::write_xface_file(
+            &args.output,
+            &fbakit::fdp::xface::XfaceFdp::from_points(
+                &set,
+                &args
+                    .mesh
+                    .file_name()
+                    .map_or_else(|| "mesh".into(), |n| n.to_string_lossy()),
+                fapu,
+            ),
+        )?,
         OutFormat::Xml => fbakit::fdp::xml::write_xml_file(
             &args.output,
             &fbakit::fdp::xml::FeaturePointDocument {
