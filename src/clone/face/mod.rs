@@ -34,6 +34,13 @@
 //!    option on (default), each motion of a low-level translation FAP is multiplied by one
 //!    factor so its feature point's displacement has the length of the source's displacement
 //!    × (target FAPU / source FAPU) of that FAP's unit. Off reproduces the paper.
+//!    **`guard`** (every method): a low-level translation FAP whose cloned feature point
+//!    moves less than 5 % of the FAPU-scaled source motion (or more than 4×), or whose
+//!    rescale factor lies outside [min(1, r)/4, 4·max(1, r)] (r = target/source FAPU of its
+//!    unit), has *failed* — a rescale dividing by almost nothing once gave factors of 4.5·10⁵.
+//!    It is repaired by a direct transfer (nearest source vertex in the aligned frame, times
+//!    r) and re-checked; if that fails too the FAP's table is dropped. Either way it is
+//!    listed in [`CloneReport::failed_faps`] and warned about.
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
@@ -106,6 +113,7 @@ pub use align::Similarity;
 pub use options::{face_fmc_options, CloneOptions, Method};
 pub use parts::{identify_parts, FaceParts, Part};
 pub use report::{CloneOutcome, CloneReport, RigidReport};
+pub use rescale::FapFailure;
 pub use rigid::install_center;
 pub use skin_surface::{build_skin_surface, SkinSurface};
 
@@ -119,7 +127,7 @@ use crate::fat::{Fat, TableKey};
 use align::{alignment_rms, face_alignment};
 use assemble::{assemble_fat, SourceMotions};
 use motions::surface_motions;
-use rescale::rescale_to_fapu;
+use rescale::{guard_motions, rescale_to_fapu};
 use rigid::RigidPlan;
 
 /// Motions of the surface method on already built surfaces.
@@ -215,6 +223,17 @@ pub fn clone_face(
         &rigid,
         &mut report,
     )?;
+    let mut fat = fat;
+    // Dropped FAPs lose their whole table (transform entries included): half a FAP is worse
+    // than none.
+    let dropped: Vec<&str> = report
+        .failed_faps
+        .iter()
+        .filter(|f| !f.repaired)
+        .map(|f| f.fap.as_str())
+        .collect();
+    fat.tables
+        .retain(|t| !dropped.contains(&t.key.name().as_str()));
     report.tables = fat.tables.len();
     face.fat = fat;
     report.timings.push("fat", clock.elapsed().as_secs_f64());
@@ -255,6 +274,32 @@ fn clone_skin_motions(
             .timings
             .push("rescale", clock.elapsed().as_secs_f64());
     }
+    // The guard, for every method: no FAP leaves with a feature point that does not move or
+    // a runaway factor.
+    let clock = Instant::now();
+    let rescaled = opts.method == Method::Rbf && opts.rbf_fapu_rescale;
+    report.failed_faps = guard_motions(
+        &ssurf.surface,
+        &moving,
+        &tsurf.surface,
+        &mut result.motions,
+        rescaled,
+    );
+    for f in &report.failed_faps {
+        report.warnings.push(format!(
+            "FAP {} at {}: {} (factor {:.4}); {}",
+            f.fap,
+            f.value,
+            f.reason,
+            f.factor,
+            if f.repaired {
+                "repaired by a direct nearest-vertex transfer"
+            } else {
+                "its table is dropped"
+            }
+        ));
+    }
+    report.timings.push("guard", clock.elapsed().as_secs_f64());
     Ok(result.motions)
 }
 
