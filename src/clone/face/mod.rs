@@ -9,7 +9,13 @@
 //!    position, quantised at 1e-5 of the face's size) join it unless they hold skin feature
 //!    points or belong to another part (Pandžić's "connected meshes"). Meshes holding any other
 //!    feature point, and meshes connected to those, are the deformable skin. Whatever is left
-//!    (hair, hats) is listed and stays rigid with the head.
+//!    (hair, hats) is listed and stays rigid with the head. Before that, a target whose skin
+//!    mesh also holds its eyes, teeth and gums as separate connected pieces (a one-mesh head
+//!    like the bundled `ict`) has them cut into part meshes ([`split_embedded_parts`]):
+//!    roughly spherical pieces around the pupils are eyeballs; pieces behind the lips within
+//!    1.5 MNS0 of the lip line are upper or lower teeth by their side of the lip line, and a
+//!    piece reaching well into both jaws (ICT's gums and tongue) is cut along it. The tongue
+//!    is not told apart from the lower gums: it follows the jaw.
 //! 2. **`align`** — a similarity (scale, rotation, translation; Umeyama's SVD solution) that
 //!    puts the target's feature points onto the source's, least squares over every point both
 //!    faces have. The target is cloned in that aligned frame (so a target modelled at another
@@ -105,6 +111,7 @@ mod report;
 mod rescale;
 mod rigid;
 mod skin_surface;
+mod split;
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -116,6 +123,7 @@ pub use report::{CloneOutcome, CloneReport, RigidReport};
 pub use rescale::FapFailure;
 pub use rigid::install_center;
 pub use skin_surface::{build_skin_surface, SkinSurface};
+pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
@@ -166,10 +174,27 @@ pub fn clone_face(
             source.name
         )));
     }
-    // 1. Parts.
+    // 1. Parts (a one-mesh target first has its eyes, teeth and gums cut into part meshes).
     let clock = Instant::now();
+    // The target's own FAT is replaced anyway; without it its skin mesh can be cut.
+    let mut bare = target.clone();
+    bare.fat = Fat::default();
+    let (split_target, split) = split_embedded_parts(&bare);
+    let target = &split_target;
     let sparts = identify_parts(source);
-    let tparts = identify_parts(target);
+    let mut tparts = identify_parts(target);
+    for s in &split {
+        if let Some(mi) = target.mesh_index(&s.mesh) {
+            tparts.skin.retain(|&m| m != mi);
+            tparts.other.retain(|&m| m != mi);
+            for list in tparts.parts.values_mut() {
+                list.retain(|&m| m != mi);
+            }
+            tparts.parts.entry(s.part).or_default().push(mi);
+        }
+    }
+    tparts.parts.retain(|_, l| !l.is_empty());
+    report.split_parts = split;
     report.timings.push("parts", clock.elapsed().as_secs_f64());
     check_parts(source, &sparts, "source", &mut report.warnings)?;
     check_parts(target, &tparts, "target", &mut report.warnings)?;
