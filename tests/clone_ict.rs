@@ -66,7 +66,11 @@ fn median(mut v: Vec<f64>) -> f64 {
 #[test]
 fn head_a_has_the_chosen_faps() {
     let Some(c) = cases() else { return };
-    assert!(c[0].truth.fat.tables.len() >= 10, "{}", c[0].truth.fat.tables.len());
+    assert!(
+        c[0].truth.fat.tables.len() >= 10,
+        "{}",
+        c[0].truth.fat.tables.len()
+    );
 }
 
 #[test]
@@ -77,7 +81,11 @@ fn both_cloners_against_the_real_head_truth() {
             let r = ground_truth_error(&out.face, &case.truth).unwrap();
             let all: Vec<f64> = r.keys.iter().map(|k| k.all).collect();
             let med = median(all.clone());
-            let worst = r.keys.iter().max_by(|a, b| a.all.total_cmp(&b.all)).unwrap();
+            let worst = r
+                .keys
+                .iter()
+                .max_by(|a, b| a.all.total_cmp(&b.all))
+                .unwrap();
             eprintln!(
                 "case {ci} {m:?}: {secs:.2} s, median {med:.1} %, mean {:.1} %, worst {} {:.1} %, failed {:?}",
                 r.mean_all,
@@ -92,16 +100,19 @@ fn both_cloners_against_the_real_head_truth() {
             for k in &r.keys {
                 eprintln!("    {:<22} {:6.1} %", k.key, k.all);
             }
-            // Measured (debug build, see the report): the targets are median ≤ 10 % and no
-            // FAP above 100 %; the asserts hold what is measured, with margin.
-            assert!(med < MEDIAN_LIMIT, "{m:?} case {ci}: median {med}");
-            assert!(worst.all < WORST_LIMIT, "{m:?} case {ci}: {worst:?}");
+            // The targets are median ≤ 10 % and no FAP above 100 %. fmc meets them
+            // (measured median 7.7 %, worst thrust_jaw 16 %); rbf does not (median 77.5 %,
+            // worst stretch_r_cornerlip 139 %: its volume morph on this mesh), so its limits
+            // hold the measured figures with margin, to catch regressions, not to bless them.
+            let (med_max, worst_max) = match m {
+                Method::Fmc => (10.0, 25.0),
+                Method::Rbf => (90.0, 160.0),
+            };
+            assert!(med <= med_max, "{m:?} case {ci}: median {med}");
+            assert!(worst.all < worst_max, "{m:?} case {ci}: {worst:?}");
         }
     }
 }
-
-const MEDIAN_LIMIT: f64 = 1000.0;
-const WORST_LIMIT: f64 = 1000.0;
 
 #[test]
 fn eyeballs_stay_still() {

@@ -58,11 +58,11 @@ pub fn head_a(dir: &Path) -> FaceModel {
     let found =
         feature_points_from_landmarks(&rig.meshes[0].mesh, LandmarkScheme::Ibug68, &ids.ids)
             .unwrap();
-    let (mut face, _) = face_from_rig(&rig, Some(found.feature_point_set()), &FapMap::arkit())
-        .unwrap();
-    face.fat.tables.retain(|t| {
-        matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if FAPS.contains(&f.number()))
-    });
+    let (mut face, _) =
+        face_from_rig(&rig, Some(found.feature_point_set()), &FapMap::arkit()).unwrap();
+    face.fat.tables.retain(
+        |t| matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if FAPS.contains(&f.number())),
+    );
     face.name = "ict_a".into();
     face
 }

@@ -9,7 +9,7 @@ use super::{CloneReport, FaceParts, Similarity, SkinSurface};
 use crate::clone::SurfaceMotion;
 use crate::error::{Error, Result};
 use crate::face::FaceModel;
-use crate::fat::morph::{fat_from_morph_targets, MorphTarget};
+use crate::fat::morph::{fat_from_morph_targets, MorphMesh, MorphTarget};
 use crate::fat::{Fat, TableKey};
 
 /// The source side of a clone: the face, its parts and its FAT as morph targets.
@@ -23,10 +23,11 @@ pub(super) struct SourceMotions<'a> {
 }
 
 /// The target FAT: one table per source morph target from the `cloned` skin motions (by key
-/// and value), plus the rigid plan's transform entries. Fails on any non-finite number.
+/// and value) and the split parts' rigid motions, plus the rigid plan's transform entries. Fails on any non-finite number.
 pub(super) fn assemble_fat(
     source: &SourceMotions,
     cloned: &HashMap<(TableKey, u64), &SurfaceMotion>,
+    part_meshes: &HashMap<(TableKey, u64), Vec<MorphMesh>>,
     face: &FaceModel,
     tsurf: &SkinSurface,
     alignment: &Similarity,
@@ -39,6 +40,9 @@ pub(super) fn assemble_fat(
         let mut meshes = Vec::new();
         if let Some(m) = cloned.get(&(t.key, t.value.to_bits())) {
             meshes = back_to_meshes(face, &frames, tsurf, alignment, m);
+        }
+        if let Some(extra) = part_meshes.get(&(t.key, t.value.to_bits())) {
+            meshes.extend(extra.iter().cloned());
         }
         out_targets.push(MorphTarget {
             key: t.key,

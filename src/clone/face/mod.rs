@@ -63,7 +63,11 @@
 //!    transform by the FAPU-scaled displacement of the FAP's tongue feature point (the mean
 //!    tongue displacement for high-level tables), as Pandžić does; tables whose tongue
 //!    motion has no rigid equivalent (tongue roll) and deformations of other non-skin meshes
-//!    (pupil dilation) are dropped with a warning.
+//!    (pupil dilation) are dropped with a warning. Parts cut out of a one-mesh target that
+//!    the source has no part mesh for (a one-mesh source moves its teeth through the skin
+//!    FAT) take the source displacements at their nearest source skin vertices (when the
+//!    source has geometry there: median gap under 0.5 % of its size), times the FAPU ratio,
+//!    reduced to their best rigid motion.
 //! 8. **`fat`** — per target skin mesh the face-frame displacements go back to the mesh frame
 //!    (inverse world 3×3) and [`fat_from_morph_targets`] rebuilds the tables (multi-interval
 //!    tables keep their borders); transform entries are appended. Every output number must be
@@ -106,6 +110,7 @@ mod align;
 mod assemble;
 mod motions;
 mod options;
+mod part_motion;
 mod parts;
 mod report;
 mod rescale;
@@ -239,9 +244,20 @@ pub fn clone_face(
         parts: &sparts,
         targets: &targets,
     };
+    // Split target parts the source moves only by deformation get that motion, rigidly.
+    let part_meshes = part_motion::part_motions(
+        &sparts,
+        &report.split_parts,
+        &face,
+        &ssurf,
+        &tsurf,
+        &alignment,
+        &motions,
+    );
     let fat = assemble_fat(
         &source_motions,
         &cloned,
+        &part_meshes,
         &face,
         &tsurf,
         &alignment,
