@@ -22,12 +22,20 @@ pub(super) struct SourceMotions<'a> {
     pub targets: &'a [MorphTarget],
 }
 
+/// What cloning produced on the target, by source motion (key, value bits): skin motions and
+/// the split parts' rigid displacements.
+pub(super) struct ClonedMotions<'a> {
+    /// Skin motions.
+    pub skin: HashMap<(TableKey, u64), &'a SurfaceMotion>,
+    /// Part meshes' displacements.
+    pub parts: HashMap<(TableKey, u64), Vec<MorphMesh>>,
+}
+
 /// The target FAT: one table per source morph target from the `cloned` skin motions (by key
 /// and value) and the split parts' rigid motions, plus the rigid plan's transform entries. Fails on any non-finite number.
 pub(super) fn assemble_fat(
     source: &SourceMotions,
-    cloned: &HashMap<(TableKey, u64), &SurfaceMotion>,
-    part_meshes: &HashMap<(TableKey, u64), Vec<MorphMesh>>,
+    cloned: &ClonedMotions,
     face: &FaceModel,
     tsurf: &SkinSurface,
     alignment: &Similarity,
@@ -38,10 +46,10 @@ pub(super) fn assemble_fat(
     let mut out_targets = Vec::with_capacity(source.targets.len());
     for t in source.targets {
         let mut meshes = Vec::new();
-        if let Some(m) = cloned.get(&(t.key, t.value.to_bits())) {
+        if let Some(m) = cloned.skin.get(&(t.key, t.value.to_bits())) {
             meshes = back_to_meshes(face, &frames, tsurf, alignment, m);
         }
-        if let Some(extra) = part_meshes.get(&(t.key, t.value.to_bits())) {
+        if let Some(extra) = cloned.parts.get(&(t.key, t.value.to_bits())) {
             meshes.extend(extra.iter().cloned());
         }
         out_targets.push(MorphTarget {

@@ -138,7 +138,7 @@ use crate::face::FaceModel;
 use crate::fat::morph::fat_to_morph_targets;
 use crate::fat::{Fat, TableKey};
 use align::{alignment_rms, face_alignment};
-use assemble::{assemble_fat, SourceMotions};
+use assemble::{assemble_fat, ClonedMotions, SourceMotions};
 use motions::surface_motions;
 use rescale::{guard_motions, rescale_to_fapu};
 use rigid::RigidPlan;
@@ -254,10 +254,13 @@ pub fn clone_face(
         &alignment,
         &motions,
     );
+    let cloned = ClonedMotions {
+        skin: cloned,
+        parts: part_meshes,
+    };
     let fat = assemble_fat(
         &source_motions,
         &cloned,
-        &part_meshes,
         &face,
         &tsurf,
         &alignment,

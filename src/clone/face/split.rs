@@ -378,7 +378,7 @@ fn sub_mesh(mesh: &Mesh, polys: &[usize], keep: Option<&[u32]>) -> (Mesh, BTreeM
         },
         normal_polygons: mesh.normal_polygons.as_ref().map(|p| pick(p, false)),
         groups: Vec::new(),
-        flags: mesh.flags.clone(),
+        flags: mesh.flags,
     };
     (m, map)
 }
