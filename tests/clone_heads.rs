@@ -208,3 +208,45 @@ fn lower_teeth_follow_the_jaw_upper_teeth_stay() {
         assert!(up < 0.05 * c, "upper teeth {up} vs chin {c}");
     }
 }
+
+/// rbf loses the inner lower lip of `ict` (its contours are not found on that mesh): those
+/// FAPs fail the guard. Without --strict the clone is written and the failures reported;
+/// with it, exit 1 and nothing written.
+#[test]
+fn strict_refuses_failed_faps() {
+    let dir = std::env::temp_dir().join(format!("fbakit-strict-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |out: &std::path::Path, strict: bool| {
+        let mut args = vec!["clone", "alma", "ict", "--method", "rbf", "--json", "-o"];
+        args.push(out.to_str().unwrap());
+        if strict {
+            args.push("--strict");
+        }
+        std::process::Command::new(env!("CARGO_BIN_EXE_fbakit"))
+            .args(&args)
+            .output()
+            .unwrap()
+    };
+    let loose = dir.join("loose.glb");
+    let o = run(&loose, false);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let failed = v["report"]["failed_faps"].as_array().unwrap();
+    assert!(!failed.is_empty());
+    assert!(failed
+        .iter()
+        .all(|f| f["fap"].as_str().unwrap().contains("_b_")));
+    assert!(loose.exists());
+    let strict = dir.join("strict.glb");
+    let o = run(&strict, true);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(!strict.exists());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--strict"));
+    // Every factor written is within the guard's bounds.
+    let factors = v["report"]["fapu_rescale"].as_object().unwrap();
+    assert!(factors.values().all(|k| {
+        let k = k.as_f64().unwrap();
+        (0.05..20.0).contains(&k)
+    }));
+    std::fs::remove_dir_all(&dir).ok();
+}
