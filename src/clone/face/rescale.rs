@@ -28,7 +28,8 @@ pub struct FapFailure {
     pub value: f64,
     /// Why it failed.
     pub reason: String,
-    /// The rescale factor it would have needed (expected / cloned feature-point motion).
+    /// The rescale factor it would have needed (expected / cloned feature-point motion;
+    /// infinite, `null` in JSON, when the feature point did not move at all).
     pub factor: f64,
     /// `true`: replaced by a direct nearest-vertex transfer that passed the check; `false`:
     /// the FAP's table was dropped.
