@@ -141,8 +141,10 @@ impl Landmarks {
 }
 
 /// Splits eyeballs, teeth and gums out of the skin meshes of a face that has no such part
-/// meshes (a one-mesh head), recognised by shape and place ([`Landmarks::fate`]). Only meshes
-/// no FAT table deforms are cut (a FAT would need remapping). Returns the face (unchanged
+/// meshes (a one-mesh head), recognised by shape and place: roughly spherical pieces near
+/// the pupils are eyeballs, pieces behind the lips near the lip line are teeth or gums of
+/// the jaw on their side (cut along the lip line when they reach well into both). Only
+/// meshes no FAT table deforms are cut (a FAT would need remapping). Returns the face (unchanged
 /// when nothing was split) and the new part meshes.
 pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
     let Some(lm) = Landmarks::of(face) else {
