@@ -12,7 +12,7 @@ use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use super::{print_json, print_warnings, MethodArg, EXIT_OK};
+use super::{print_json, print_warnings, MethodArg, EXIT_FAILURE, EXIT_OK};
 
 #[derive(Debug, clap::Args)]
 pub struct CloneArgs {
@@ -43,6 +43,10 @@ pub struct CloneArgs {
     /// Print the cloning report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Exit 1 without writing anything when any FAP failed the guard (a feature point that
+    /// does not move, a runaway FAPU rescale), even if it was repaired.
+    #[arg(long)]
+    pub strict: bool,
     /// Also measure quality: self-clone error of the source, compliance of the output.
     #[arg(long)]
     pub report: bool,
@@ -157,6 +161,27 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     };
     let outcome = clone_face(&source, &target, &opts)?;
     pb.inc(1);
+    if args.strict && !outcome.report.failed_faps.is_empty() {
+        pb.finish_and_clear();
+        let r = &outcome.report;
+        if args.json {
+            print_json(&Output {
+                output: String::new(),
+                report: r,
+                quality: None,
+                write_warnings: Vec::new(),
+                arkit: None,
+            })?;
+        } else {
+            print_warnings(&r.warnings);
+        }
+        eprintln!(
+            "error: --strict: {} FAP motion(s) failed the guard; nothing written to {}",
+            r.failed_faps.len(),
+            args.output.display()
+        );
+        return Ok(EXIT_FAILURE);
+    }
     pb.set_message("writing");
     // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it), or
     // ARKit-named shapes made from it.

@@ -204,20 +204,49 @@ impl GroundTruthReport {
     }
 }
 
-/// Displacement error of `cloned` against `truth`: the same meshes (names and vertex counts)
-/// with a different FAT (module docs).
+/// Displacement error of `cloned` against `truth`: the same neutral geometry with a
+/// different FAT (module docs). The meshes may be cut differently (a one-mesh target has its
+/// parts split out by cloning): truth vertices are then matched to cloned vertices by neutral
+/// world position.
 pub fn ground_truth_error(cloned: &FaceModel, truth: &FaceModel) -> Result<GroundTruthReport> {
-    if cloned.mesh_sizes() != truth.mesh_sizes() {
-        return Err(Error::Invalid(
-            "ground truth comparison needs the same meshes on both faces".into(),
-        ));
-    }
     let skin = identify_parts(truth).skin;
     let mut ec = cloned.evaluator()?;
     let mut et = truth.evaluator()?;
     let (mut oc, mut ot) = (ec.output(), et.output());
     let nc = cloned.pose_with(&mut ec, &mut oc, &[]);
     let nt = truth.pose_with(&mut et, &mut ot, &[]);
+    let same = cloned.mesh_sizes() == truth.mesh_sizes();
+    // Truth (mesh, vertex) → cloned (mesh, vertex).
+    let flat: Vec<(usize, usize)> = nc
+        .iter()
+        .enumerate()
+        .flat_map(|(m, l)| (0..l.len()).map(move |v| (m, v)))
+        .collect();
+    let index = (!same).then(|| {
+        crate::mesh::VertexIndex::new(&nc.iter().flatten().copied().collect::<Vec<Vec3>>())
+    });
+    let mut matched: Vec<Vec<(usize, usize)>> = Vec::with_capacity(nt.len());
+    for (mi, l) in nt.iter().enumerate() {
+        let mut row = Vec::with_capacity(l.len());
+        for (v, &p) in l.iter().enumerate() {
+            match &index {
+                None => row.push((mi, v)),
+                Some(ix) => {
+                    let Some((k, d)) = ix.nearest_vertex(p) else {
+                        return Err(Error::Invalid("cloned face has no vertices".into()));
+                    };
+                    if d > 1e-4 * (1.0 + p.length()) {
+                        return Err(Error::Invalid(
+                            "ground truth comparison needs the same neutral geometry on both faces"
+                                .into(),
+                        ));
+                    }
+                    row.push(flat[k as usize]);
+                }
+            }
+        }
+        matched.push(row);
+    }
     let mut per_key: BTreeMap<TableKey, (f64, f64, usize)> = BTreeMap::new();
     for t in fat_to_morph_targets(&truth.fat) {
         let a = [Activation {
@@ -230,8 +259,9 @@ pub fn ground_truth_error(cloned: &FaceModel, truth: &FaceModel) -> Result<Groun
         for mi in 0..pt.len() {
             let is_skin = skin.contains(&mi);
             for v in 0..pt[mi].len() {
+                let (cm, cv) = matched[mi][v];
                 let dt = pt[mi][v] - nt[mi][v];
-                let dc = pc[mi][v] - nc[mi][v];
+                let dc = pc[cm][cv] - nc[cm][cv];
                 let e = (dt - dc).length() as f64;
                 let l = dt.length() as f64;
                 num += e;

@@ -9,7 +9,7 @@ use super::{CloneReport, FaceParts, Similarity, SkinSurface};
 use crate::clone::SurfaceMotion;
 use crate::error::{Error, Result};
 use crate::face::FaceModel;
-use crate::fat::morph::{fat_from_morph_targets, MorphTarget};
+use crate::fat::morph::{fat_from_morph_targets, MorphMesh, MorphTarget};
 use crate::fat::{Fat, TableKey};
 
 /// The source side of a clone: the face, its parts and its FAT as morph targets.
@@ -22,11 +22,20 @@ pub(super) struct SourceMotions<'a> {
     pub targets: &'a [MorphTarget],
 }
 
+/// What cloning produced on the target, by source motion (key, value bits): skin motions and
+/// the split parts' rigid displacements.
+pub(super) struct ClonedMotions<'a> {
+    /// Skin motions.
+    pub skin: HashMap<(TableKey, u64), &'a SurfaceMotion>,
+    /// Part meshes' displacements.
+    pub parts: HashMap<(TableKey, u64), Vec<MorphMesh>>,
+}
+
 /// The target FAT: one table per source morph target from the `cloned` skin motions (by key
-/// and value), plus the rigid plan's transform entries. Fails on any non-finite number.
+/// and value) and the split parts' rigid motions, plus the rigid plan's transform entries. Fails on any non-finite number.
 pub(super) fn assemble_fat(
     source: &SourceMotions,
-    cloned: &HashMap<(TableKey, u64), &SurfaceMotion>,
+    cloned: &ClonedMotions,
     face: &FaceModel,
     tsurf: &SkinSurface,
     alignment: &Similarity,
@@ -37,8 +46,11 @@ pub(super) fn assemble_fat(
     let mut out_targets = Vec::with_capacity(source.targets.len());
     for t in source.targets {
         let mut meshes = Vec::new();
-        if let Some(m) = cloned.get(&(t.key, t.value.to_bits())) {
+        if let Some(m) = cloned.skin.get(&(t.key, t.value.to_bits())) {
             meshes = back_to_meshes(face, &frames, tsurf, alignment, m);
+        }
+        if let Some(extra) = cloned.parts.get(&(t.key, t.value.to_bits())) {
+            meshes.extend(extra.iter().cloned());
         }
         out_targets.push(MorphTarget {
             key: t.key,

@@ -9,7 +9,13 @@
 //!    position, quantised at 1e-5 of the face's size) join it unless they hold skin feature
 //!    points or belong to another part (Pandžić's "connected meshes"). Meshes holding any other
 //!    feature point, and meshes connected to those, are the deformable skin. Whatever is left
-//!    (hair, hats) is listed and stays rigid with the head.
+//!    (hair, hats) is listed and stays rigid with the head. Before that, a target whose skin
+//!    mesh also holds its eyes, teeth and gums as separate connected pieces (a one-mesh head
+//!    like the bundled `ict`) has them cut into part meshes ([`split_embedded_parts`]):
+//!    roughly spherical pieces around the pupils are eyeballs; pieces behind the lips within
+//!    1.5 MNS0 of the lip line are upper or lower teeth by their side of the lip line, and a
+//!    piece reaching well into both jaws (ICT's gums and tongue) is cut along it. The tongue
+//!    is not told apart from the lower gums: it follows the jaw.
 //! 2. **`align`** — a similarity (scale, rotation, translation; Umeyama's SVD solution) that
 //!    puts the target's feature points onto the source's, least squares over every point both
 //!    faces have. The target is cloned in that aligned frame (so a target modelled at another
@@ -34,6 +40,13 @@
 //!    option on (default), each motion of a low-level translation FAP is multiplied by one
 //!    factor so its feature point's displacement has the length of the source's displacement
 //!    × (target FAPU / source FAPU) of that FAP's unit. Off reproduces the paper.
+//!    **`guard`** (every method): a low-level translation FAP whose cloned feature point
+//!    moves less than 5 % of the FAPU-scaled source motion (or more than 4×), or whose
+//!    rescale factor lies outside [min(1, r)/4, 4·max(1, r)] (r = target/source FAPU of its
+//!    unit), has *failed* — a rescale dividing by almost nothing once gave factors of 4.5·10⁵.
+//!    It is repaired by a direct transfer (nearest source vertex in the aligned frame, times
+//!    r) and re-checked; if that fails too the FAP's table is dropped. Either way it is
+//!    listed in [`CloneReport::failed_faps`] and warned about.
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
@@ -50,7 +63,11 @@
 //!    transform by the FAPU-scaled displacement of the FAP's tongue feature point (the mean
 //!    tongue displacement for high-level tables), as Pandžić does; tables whose tongue
 //!    motion has no rigid equivalent (tongue roll) and deformations of other non-skin meshes
-//!    (pupil dilation) are dropped with a warning.
+//!    (pupil dilation) are dropped with a warning. Parts cut out of a one-mesh target that
+//!    the source has no part mesh for (a one-mesh source moves its teeth through the skin
+//!    FAT) take the source displacements at their nearest source skin vertices (when the
+//!    source has geometry there: median gap under 0.5 % of its size), times the FAPU ratio,
+//!    reduced to their best rigid motion.
 //! 8. **`fat`** — per target skin mesh the face-frame displacements go back to the mesh frame
 //!    (inverse world 3×3) and [`fat_from_morph_targets`] rebuilds the tables (multi-interval
 //!    tables keep their borders); transform entries are appended. Every output number must be
@@ -83,9 +100,10 @@
 //! # Where each step lives
 //!
 //! [`options`](CloneOptions) and [`report`](CloneReport) hold the settings and the report;
-//! `parts` step 1, `align` step 2, `skin_surface` step 3 (welding), `motions` the moves
-//! between meshes and the surface (steps 4 and 8), `rescale` step 6, `rigid` step 7 and
-//! `assemble` step 8. This file runs them in order.
+//! `parts` step 1 (`split` cuts one-mesh heads), `align` step 2, `skin_surface` step 3
+//! (welding), `motions` the moves between meshes and the surface (steps 4 and 8), `rescale`
+//! step 6 and the guard, `rigid` and `part_motion` step 7 and `assemble` step 8. This file
+//! runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
 
@@ -93,11 +111,13 @@ mod align;
 mod assemble;
 mod motions;
 mod options;
+mod part_motion;
 mod parts;
 mod report;
 mod rescale;
 mod rigid;
 mod skin_surface;
+mod split;
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -106,8 +126,10 @@ pub use align::Similarity;
 pub use options::{face_fmc_options, CloneOptions, Method};
 pub use parts::{identify_parts, FaceParts, Part};
 pub use report::{CloneOutcome, CloneReport, RigidReport};
+pub use rescale::FapFailure;
 pub use rigid::install_center;
 pub use skin_surface::{build_skin_surface, SkinSurface};
+pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
@@ -117,9 +139,9 @@ use crate::face::FaceModel;
 use crate::fat::morph::fat_to_morph_targets;
 use crate::fat::{Fat, TableKey};
 use align::{alignment_rms, face_alignment};
-use assemble::{assemble_fat, SourceMotions};
+use assemble::{assemble_fat, ClonedMotions, SourceMotions};
 use motions::surface_motions;
-use rescale::rescale_to_fapu;
+use rescale::{guard_motions, rescale_to_fapu};
 use rigid::RigidPlan;
 
 /// Motions of the surface method on already built surfaces.
@@ -158,10 +180,27 @@ pub fn clone_face(
             source.name
         )));
     }
-    // 1. Parts.
+    // 1. Parts (a one-mesh target first has its eyes, teeth and gums cut into part meshes).
     let clock = Instant::now();
+    // The target's own FAT is replaced anyway; without it its skin mesh can be cut.
+    let mut bare = target.clone();
+    bare.fat = Fat::default();
+    let (split_target, split) = split_embedded_parts(&bare);
+    let target = &split_target;
     let sparts = identify_parts(source);
-    let tparts = identify_parts(target);
+    let mut tparts = identify_parts(target);
+    for s in &split {
+        if let Some(mi) = target.mesh_index(&s.mesh) {
+            tparts.skin.retain(|&m| m != mi);
+            tparts.other.retain(|&m| m != mi);
+            for list in tparts.parts.values_mut() {
+                list.retain(|&m| m != mi);
+            }
+            tparts.parts.entry(s.part).or_default().push(mi);
+        }
+    }
+    tparts.parts.retain(|_, l| !l.is_empty());
+    report.split_parts = split;
     report.timings.push("parts", clock.elapsed().as_secs_f64());
     check_parts(source, &sparts, "source", &mut report.warnings)?;
     check_parts(target, &tparts, "target", &mut report.warnings)?;
@@ -206,6 +245,20 @@ pub fn clone_face(
         parts: &sparts,
         targets: &targets,
     };
+    // Split target parts the source moves only by deformation get that motion, rigidly.
+    let part_meshes = part_motion::part_motions(
+        &sparts,
+        &report.split_parts,
+        &face,
+        &ssurf,
+        &tsurf,
+        &alignment,
+        &motions,
+    );
+    let cloned = ClonedMotions {
+        skin: cloned,
+        parts: part_meshes,
+    };
     let fat = assemble_fat(
         &source_motions,
         &cloned,
@@ -215,6 +268,17 @@ pub fn clone_face(
         &rigid,
         &mut report,
     )?;
+    let mut fat = fat;
+    // Dropped FAPs lose their whole table (transform entries included): half a FAP is worse
+    // than none.
+    let dropped: Vec<&str> = report
+        .failed_faps
+        .iter()
+        .filter(|f| !f.repaired)
+        .map(|f| f.fap.as_str())
+        .collect();
+    fat.tables
+        .retain(|t| !dropped.contains(&t.key.name().as_str()));
     report.tables = fat.tables.len();
     face.fat = fat;
     report.timings.push("fat", clock.elapsed().as_secs_f64());
@@ -255,6 +319,32 @@ fn clone_skin_motions(
             .timings
             .push("rescale", clock.elapsed().as_secs_f64());
     }
+    // The guard, for every method: no FAP leaves with a feature point that does not move or
+    // a runaway factor.
+    let clock = Instant::now();
+    let rescaled = opts.method == Method::Rbf && opts.rbf_fapu_rescale;
+    report.failed_faps = guard_motions(
+        &ssurf.surface,
+        &moving,
+        &tsurf.surface,
+        &mut result.motions,
+        rescaled,
+    );
+    for f in &report.failed_faps {
+        report.warnings.push(format!(
+            "FAP {} at {}: {} (factor {:.4}); {}",
+            f.fap,
+            f.value,
+            f.reason,
+            f.factor,
+            if f.repaired {
+                "repaired by a direct nearest-vertex transfer"
+            } else {
+                "its table is dropped"
+            }
+        ));
+    }
+    report.timings.push("guard", clock.elapsed().as_secs_f64());
     Ok(result.motions)
 }
 

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::{FaceParts, Method, Part, Similarity};
+use super::{FaceParts, FapFailure, Method, Part, Similarity, SplitPart};
 use crate::clone::StepTimings;
 use crate::face::FaceModel;
 
@@ -55,6 +55,10 @@ pub struct CloneReport {
     pub fapu_rescale: BTreeMap<String, f64>,
     /// Rigid-part handling.
     pub rigid: RigidReport,
+    /// Part meshes cut out of a one-mesh target (step 1).
+    pub split_parts: Vec<SplitPart>,
+    /// Cloned FAPs that failed the guard (step 6), repaired or dropped.
+    pub failed_faps: Vec<FapFailure>,
 }
 
 /// The target with its new FAT, and the report.

@@ -1,13 +1,40 @@
-//! The RBF method's FAPU rescale: each low-level translation FAP's motion is scaled so its
-//! feature point moves FAPU-compliantly on the target (module docs of [`super`], step 6).
+//! The RBF method's FAPU rescale (module docs of [`super`], step 6) and the guard every
+//! method's cloned motions pass afterwards: a FAP whose own feature point barely moves, or
+//! whose rescale factor is far outside the faces' FAPU ratio, is repaired by a direct
+//! nearest-vertex transfer or dropped, and reported ([`FapFailure`]).
 
 use std::collections::BTreeMap;
 
 use glam::Vec3;
+use serde::Serialize;
 
 use crate::clone::{CloneSurface, SurfaceMotion};
 use crate::fat::TableKey;
+use crate::mesh::VertexIndex;
 use crate::spec::{FapuKind, FeaturePointId};
+
+/// A cloned feature point moving less than this share of its expected motion has failed.
+const MIN_MOTION_SHARE: f64 = 0.05;
+/// Largest accepted ratio (either way) between a rescale factor and the FAPU ratio, and
+/// between the cloned and the expected motion of a feature point.
+const MAX_FACTOR_RATIO: f64 = 4.0;
+
+/// A cloned FAP motion that failed the guard.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FapFailure {
+    /// Table key name (`raise_r_cornerlip`).
+    pub fap: String,
+    /// The motion's FAP value (interval border).
+    pub value: f64,
+    /// Why it failed.
+    pub reason: String,
+    /// The rescale factor it would have needed (expected / cloned feature-point motion;
+    /// infinite, `null` in JSON, when the feature point did not move at all).
+    pub factor: f64,
+    /// `true`: replaced by a direct nearest-vertex transfer that passed the check; `false`:
+    /// the FAP's table was dropped.
+    pub repaired: bool,
+}
 
 /// The feature point a low-level translation FAP is measured at, if both surfaces have it.
 fn fap_fp(key: TableKey, a: &CloneSurface, b: &CloneSurface) -> Option<(FeaturePointId, FapuKind)> {
@@ -31,8 +58,34 @@ fn offset_at(m: &SurfaceMotion, v: u32) -> Vec3 {
         .map_or(Vec3::ZERO, |i| m.offsets[i].1)
 }
 
+/// Target / source FAPU of `kind` (1 when the source's is zero).
+fn fapu_ratio(source: &CloneSurface, target: &CloneSurface, kind: FapuKind) -> f64 {
+    let s = source.fapu.unit(kind);
+    if s > 0.0 && s.is_finite() {
+        target.fapu.unit(kind) / s
+    } else {
+        1.0
+    }
+}
+
+/// Source and cloned displacement lengths of a motion's feature point and the FAPU ratio of
+/// its unit: `(ds, dt, r)`; `None` for motions the guard cannot measure.
+fn measure(
+    source: &CloneSurface,
+    src: &SurfaceMotion,
+    target: &CloneSurface,
+    dst: &SurfaceMotion,
+) -> Option<(f64, f64, f64)> {
+    let (fp, kind) = fap_fp(src.key, source, target)?;
+    let ds = offset_at(src, source.fp_vertices[&fp]).length() as f64;
+    let dt = offset_at(dst, target.fp_vertices[&fp]).length() as f64;
+    (ds > 0.0).then_some((ds, dt, fapu_ratio(source, target, kind)))
+}
+
 /// Step 6: scales each low-level translation motion so its feature point moves by the
-/// FAPU-scaled source displacement. Returns the factors by FAP name.
+/// FAPU-scaled source displacement. Returns the factors by FAP name. Factors the guard would
+/// reject (far outside the FAPU ratio, or a feature point that does not move) are not
+/// applied: [`guard_motions`] repairs those motions.
 pub(super) fn rescale_to_fapu(
     source: &CloneSurface,
     motions: &[SurfaceMotion],
@@ -41,17 +94,11 @@ pub(super) fn rescale_to_fapu(
 ) -> BTreeMap<String, f64> {
     let mut factors = BTreeMap::new();
     for (src, dst) in motions.iter().zip(out.iter_mut()) {
-        let Some((fp, kind)) = fap_fp(src.key, source, target) else {
+        let Some((ds, dt, r)) = measure(source, src, target, dst) else {
             continue;
         };
-        let ds = offset_at(src, source.fp_vertices[&fp]).length() as f64;
-        let dt = offset_at(dst, target.fp_vertices[&fp]).length() as f64;
-        if ds <= 0.0 || dt <= ds * 1e-6 {
-            continue;
-        }
-        let want = ds * target.fapu.unit(kind) / source.fapu.unit(kind);
-        let k = want / dt;
-        if !k.is_finite() {
+        let k = ds * r / dt;
+        if !k.is_finite() || check(ds, dt, r, Some(k)).is_some() {
             continue;
         }
         for o in &mut dst.offsets {
@@ -60,4 +107,191 @@ pub(super) fn rescale_to_fapu(
         factors.insert(format!("{}@{}", src.key.name(), src.value), k);
     }
     factors
+}
+
+/// Why a motion whose feature point moved `dt` (source `ds`, FAPU ratio `r`, rescale factor
+/// `k` if one applies) fails, or `None`.
+fn check(ds: f64, dt: f64, r: f64, k: Option<f64>) -> Option<String> {
+    let want = ds * r;
+    if !(dt.is_finite() && want.is_finite()) {
+        return Some("non-finite motion".into());
+    }
+    if dt < MIN_MOTION_SHARE * want {
+        return Some(format!(
+            "its feature point moves {:.2} % of the expected motion",
+            100.0 * dt / want
+        ));
+    }
+    if let Some(k) = k {
+        // The method may or may not have carried the FAPU ratio already: accept factors near
+        // 1 or near r.
+        let (lo, hi) = (r.min(1.0) / MAX_FACTOR_RATIO, r.max(1.0) * MAX_FACTOR_RATIO);
+        if !(lo..=hi).contains(&k) {
+            return Some(format!(
+                "FAPU rescale factor {k:.4} outside [{lo:.4}, {hi:.4}] (FAPU ratio {r:.4})"
+            ));
+        }
+    } else if dt > MAX_FACTOR_RATIO * want {
+        return Some(format!(
+            "its feature point moves {:.0} % of the expected motion",
+            100.0 * dt / want
+        ));
+    }
+    None
+}
+
+/// The guard (module docs of [`super`], step 6): checks every cloned low-level translation
+/// motion against its source; a failing one is replaced by a direct transfer (each target
+/// vertex takes the source displacement of its nearest source vertex in the aligned frame,
+/// times the FAPU ratio) and re-checked; if that fails too, every motion of that FAP is
+/// emptied and the key returned among the dropped ones. `rescaled` says whether step 6 ran
+/// (its factor is then part of the check).
+pub(super) fn guard_motions(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    target: &CloneSurface,
+    out: &mut [SurfaceMotion],
+    rescaled: bool,
+) -> Vec<FapFailure> {
+    let mut failures = Vec::new();
+    let mut nearest: Option<Vec<u32>> = None;
+    for (src, dst) in motions.iter().zip(out.iter_mut()) {
+        let Some((ds, dt, r)) = measure(source, src, target, dst) else {
+            continue;
+        };
+        let k = ds * r / dt;
+        let Some(reason) = check(ds, dt, r, rescaled.then_some(k)) else {
+            continue;
+        };
+        let map = nearest.get_or_insert_with(|| nearest_source_vertices(source, target));
+        let repaired = direct_transfer(src, map, r as f32);
+        let ok = measure(source, src, target, &repaired)
+            .is_some_and(|(ds2, dt2, r2)| check(ds2, dt2, r2, None).is_none());
+        *dst = if ok {
+            repaired
+        } else {
+            SurfaceMotion {
+                offsets: Vec::new(),
+                ..dst.clone()
+            }
+        };
+        failures.push(FapFailure {
+            fap: src.key.name(),
+            value: src.value,
+            reason,
+            factor: k,
+            repaired: ok,
+        });
+    }
+    // A dropped FAP loses every interval, not only the failing one.
+    for f in failures.iter().filter(|f| !f.repaired) {
+        for dst in out.iter_mut().filter(|m| m.key.name() == f.fap) {
+            dst.offsets.clear();
+        }
+    }
+    failures
+}
+
+/// The nearest source surface vertex of every target surface vertex (both in the aligned
+/// frame).
+fn nearest_source_vertices(source: &CloneSurface, target: &CloneSurface) -> Vec<u32> {
+    let index = VertexIndex::new(&source.positions);
+    target
+        .positions
+        .iter()
+        .map(|&p| index.nearest_vertex(p).map_or(u32::MAX, |n| n.0))
+        .collect()
+}
+
+/// The source motion carried to target vertices through `nearest`, scaled by `ratio`.
+fn direct_transfer(src: &SurfaceMotion, nearest: &[u32], ratio: f32) -> SurfaceMotion {
+    let offsets = nearest
+        .iter()
+        .enumerate()
+        .filter_map(|(t, &s)| {
+            let d = offset_at(src, s);
+            (s != u32::MAX && d != Vec3::ZERO).then_some((t as u32, d * ratio))
+        })
+        .collect();
+    SurfaceMotion {
+        key: src.key,
+        value: src.value,
+        offsets,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fdp::{Fapu, FapuDistances};
+    use crate::spec::FapId;
+
+    fn surface(positions: Vec<Vec3>, scale: f64) -> CloneSurface {
+        let d = FapuDistances {
+            irisd0: scale,
+            es0: scale,
+            ens0: scale,
+            mns0: scale,
+            mw0: scale,
+        };
+        CloneSurface {
+            positions,
+            triangles: vec![[0, 1, 2]],
+            fp_vertices: [(FeaturePointId::new(2, 5).unwrap(), 0)].into(),
+            fp_positions: BTreeMap::new(),
+            fapu: Fapu::from_distances(d).unwrap(),
+        }
+    }
+
+    fn motion(offsets: Vec<(u32, Vec3)>) -> SurfaceMotion {
+        SurfaceMotion {
+            // raise_r_cornerlip: measured at 2.5, MNS.
+            key: TableKey::LowLevel(FapId::new(13).unwrap()),
+            value: 512.0,
+            offsets,
+        }
+    }
+
+    #[test]
+    fn a_still_feature_point_is_repaired_not_rescaled_by_a_huge_factor() {
+        let tri = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let (s, t) = (surface(tri.clone(), 1.0), surface(tri, 2.0));
+        let src = vec![motion(vec![(0, Vec3::new(0.0, 0.1, 0.0))])];
+        let mut out = vec![motion(vec![
+            (0, Vec3::new(0.0, 1e-6, 0.0)),
+            (1, Vec3::new(0.0, 0.1, 0.0)),
+        ])];
+        let factors = rescale_to_fapu(&s, &src, &t, &mut out);
+        assert!(factors.is_empty(), "{factors:?}");
+        let f = guard_motions(&s, &src, &t, &mut out, true);
+        assert_eq!(f.len(), 1);
+        assert!(f[0].repaired && f[0].factor > 1e5, "{f:?}");
+        // Direct transfer: 2.5 takes its own source motion × the MNS ratio 2.
+        assert!(offset_at(&out[0], 0).distance(Vec3::new(0.0, 0.2, 0.0)) < 1e-6);
+        assert_eq!(offset_at(&out[0], 1), Vec3::ZERO);
+    }
+
+    #[test]
+    fn an_unrepairable_fap_is_dropped() {
+        let s = surface(vec![Vec3::ZERO, Vec3::X, Vec3::Y], 1.0);
+        // The target's 2.5 sits on the source's still vertex 1: a direct transfer fails too.
+        let t = surface(vec![Vec3::X, Vec3::ZERO, Vec3::Y], 1.0);
+        let src = vec![motion(vec![(0, Vec3::new(0.0, 0.1, 0.0))])];
+        let mut out = vec![motion(vec![(1, Vec3::new(0.0, 0.1, 0.0))])];
+        let f = guard_motions(&s, &src, &t, &mut out, false);
+        assert_eq!(f.len(), 1);
+        assert!(!f[0].repaired);
+        assert!(out[0].offsets.is_empty());
+    }
+
+    #[test]
+    fn a_compliant_motion_passes() {
+        let tri = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let (s, t) = (surface(tri.clone(), 1.0), surface(tri, 1.5));
+        let src = vec![motion(vec![(0, Vec3::new(0.0, 0.1, 0.0))])];
+        let mut out = vec![motion(vec![(0, Vec3::new(0.0, 0.12, 0.0))])];
+        let factors = rescale_to_fapu(&s, &src, &t, &mut out);
+        assert!((factors.values().next().unwrap() - 1.25).abs() < 1e-4);
+        assert!(guard_motions(&s, &src, &t, &mut out, true).is_empty());
+    }
 }

@@ -1,0 +1,69 @@
+//! Cloning between real heads: ICT head A (rig FAT, 14 FAPs) onto the reshaped head B of the
+//! ground truth (tests/support/ict_truth.rs), both methods, and alma onto the bundled
+//! one-mesh `ict` (parts split out). The ICT cases are skipped when
+//! `../shared/data/ict-facekit` is absent. Quality figures are printed once per case.
+
+#[path = "../tests/support/ict_truth.rs"]
+mod ict_truth;
+
+use std::sync::OnceLock;
+
+use fbakit::clone::eval::ground_truth_error;
+use fbakit::clone::face::{clone_face, CloneOptions, Method};
+use fbakit::export::picture::strip_fat;
+use fbakit::face::FaceModel;
+
+fn main() {
+    divan::main();
+}
+
+/// A, B's truth and B stripped of its FAT.
+fn heads() -> Option<&'static (FaceModel, FaceModel, FaceModel)> {
+    static H: OnceLock<Option<(FaceModel, FaceModel, FaceModel)>> = OnceLock::new();
+    H.get_or_init(|| {
+        let dir = ict_truth::ict_dir()?;
+        let a = ict_truth::head_a(&dir);
+        let (nose, chin) = ict_truth::anchors(&a);
+        let truth = ict_truth::head_b(&a, |p| ict_truth::reshape(p, nose, chin));
+        let target = strip_fat(&truth);
+        for method in [Method::Fmc, Method::Rbf] {
+            let out = clone_face(&a, &target, &opts(method)).expect("clone");
+            let r = ground_truth_error(&out.face, &truth).expect("truth");
+            let mut all: Vec<f64> = r.keys.iter().map(|k| k.all).collect();
+            all.sort_by(f64::total_cmp);
+            eprintln!(
+                "{}: ground truth median {:.1} %, worst {:.1} %",
+                method.name(),
+                all[all.len() / 2],
+                all.last().copied().unwrap_or(0.0)
+            );
+        }
+        Some((a, truth, target))
+    })
+    .as_ref()
+}
+
+fn opts(method: Method) -> CloneOptions {
+    CloneOptions {
+        method,
+        ..CloneOptions::default()
+    }
+}
+
+#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+fn ict_a_to_b(method: Method) {
+    let Some((a, _, b)) = heads() else { return };
+    divan::black_box(clone_face(a, b, &opts(method)).expect("clone"));
+}
+
+#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+fn alma_to_bundled_ict(method: Method) {
+    static F: OnceLock<(FaceModel, FaceModel)> = OnceLock::new();
+    let (alma, ict) = F.get_or_init(|| {
+        (
+            fbakit::face::read("alma").expect("alma"),
+            strip_fat(&fbakit::face::read("ict").expect("ict")),
+        )
+    });
+    divan::black_box(clone_face(alma, ict, &opts(method)).expect("clone"));
+}

@@ -1,0 +1,397 @@
+//! One-mesh heads: eyes, teeth and gums that are separate connected pieces of the skin mesh
+//! (the bundled `ict`) are split into part meshes before cloning, so the rigid-part step can
+//! move them (module docs of [`super`], step 1).
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+use serde::Serialize;
+
+use super::parts::{face_diagonal, fp_mesh_vertex};
+use super::Part;
+use crate::face::{FaceMesh, FaceModel};
+use crate::fdp::VertexBinding;
+use crate::mesh::{find_coincident_vertices, Mesh, Polygons};
+use crate::spec::FeaturePointId;
+
+/// A part split out of a one-mesh head.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SplitPart {
+    /// The part.
+    pub part: Part,
+    /// The mesh it was cut from.
+    pub from: String,
+    /// The new mesh's name.
+    pub mesh: String,
+    /// Its vertices.
+    pub vertices: usize,
+    /// Connected pieces it gathers (a piece straddling the lip line counts for both jaws).
+    pub pieces: usize,
+}
+
+/// Connected pieces of a mesh (polygon connectivity, coincident vertices joined): the piece
+/// of every vertex and the piece count.
+pub fn mesh_pieces(mesh: &Mesh, eps: f32) -> (Vec<usize>, usize) {
+    let n = mesh.positions.len();
+    let co = find_coincident_vertices(&mesh.positions, eps);
+    let mut parent: Vec<usize> = (0..n)
+        .map(|i| co.representative.get(i).map_or(i, |&r| r as usize))
+        .collect();
+    fn root(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    for poly in mesh.polygons.iter() {
+        for w in poly.windows(2) {
+            let (a, b) = (w[0] as usize, w[1] as usize);
+            if a < n && b < n {
+                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                if ra != rb {
+                    parent[ra] = rb;
+                }
+            }
+        }
+    }
+    let mut ids: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut piece = vec![0; n];
+    for (i, slot) in piece.iter_mut().enumerate() {
+        let r = root(&mut parent, i);
+        let k = ids.len();
+        *slot = *ids.entry(r).or_insert(k);
+    }
+    (piece, ids.len())
+}
+
+/// Where a piece goes.
+#[derive(Clone, Copy, PartialEq)]
+enum Fate {
+    Skin,
+    Part(Part),
+    /// Cut at the lip line: polygons above to the upper teeth, below to the lower.
+    Jaws,
+}
+
+/// The face's landmarks the recognition needs (face frame).
+struct Landmarks {
+    pupils: [(Part, Vec3); 2],
+    lip_y: f32,
+    lip_z: f32,
+    mouth_x: f32,
+    es: f32,
+    mns: f32,
+    mw: f32,
+}
+
+impl Landmarks {
+    fn of(face: &FaceModel) -> Option<Landmarks> {
+        let p = |s: &str| {
+            s.parse::<FeaturePointId>()
+                .ok()
+                .and_then(|id| face.feature_points.position(id))
+        };
+        let d = face.fapu().ok()?.distances;
+        let (l, r) = (p("3.5")?, p("3.6")?);
+        let (u, lo) = (p("2.2")?, p("2.3")?);
+        Some(Landmarks {
+            pupils: [(Part::LeftEye, l), (Part::RightEye, r)],
+            lip_y: (u.y + lo.y) / 2.0,
+            lip_z: u.z.min(lo.z),
+            mouth_x: (u.x + lo.x) / 2.0,
+            es: d.es0 as f32,
+            mns: d.mns0 as f32,
+            mw: d.mw0 as f32,
+        })
+    }
+
+    /// Eyeball: a roughly spherical piece (distance to its centroid varying < 35 %) whose
+    /// centroid is within 0.4 ES0 of a pupil. Mouth: a piece centred between the lip corners,
+    /// within 1.5 MNS0 of the lip line and behind the lips: teeth or gums, by side of the lip
+    /// line, cut there when it reaches well into both jaws (ICT's gums and tongue).
+    fn fate(&self, pts: &[Vec3]) -> Fate {
+        let c = pts.iter().copied().sum::<Vec3>() / pts.len() as f32;
+        let dist: Vec<f32> = pts.iter().map(|p| p.distance(c)).collect();
+        let mean = dist.iter().sum::<f32>() / dist.len() as f32;
+        let var = dist.iter().map(|d| (d - mean).powi(2)).sum::<f32>() / dist.len() as f32;
+        let round = mean > 0.0 && var.sqrt() / mean < 0.35;
+        for (part, pupil) in self.pupils {
+            if round && c.distance(pupil) < 0.4 * self.es {
+                return Fate::Part(part);
+            }
+        }
+        let (lo, hi) = pts.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |a, p| {
+            (a.0.min(p.y), a.1.max(p.y))
+        });
+        let in_mouth = (c.x - self.mouth_x).abs() < 0.75 * self.mw
+            && (c.y - self.lip_y).abs() < 1.5 * self.mns
+            && c.z < self.lip_z;
+        if !in_mouth {
+            return Fate::Skin;
+        }
+        if lo < self.lip_y - 0.5 * self.mns && hi > self.lip_y + 0.5 * self.mns {
+            Fate::Jaws
+        } else if c.y > self.lip_y {
+            Fate::Part(Part::UpperTeeth)
+        } else {
+            Fate::Part(Part::LowerTeeth)
+        }
+    }
+}
+
+/// Splits eyeballs, teeth and gums out of the skin meshes of a face that has no such part
+/// meshes (a one-mesh head), recognised by shape and place: roughly spherical pieces near
+/// the pupils are eyeballs, pieces behind the lips near the lip line are teeth or gums of
+/// the jaw on their side (cut along the lip line when they reach well into both). Only
+/// meshes no FAT table deforms are cut (a FAT would need remapping). Returns the face (unchanged
+/// when nothing was split) and the new part meshes.
+pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
+    let Some(lm) = Landmarks::of(face) else {
+        return (face.clone(), Vec::new());
+    };
+    let frames = face.frames();
+    let diag = face_diagonal(face, &frames);
+    // Meshes holding a skin feature point (2.1: the chin) are the candidates.
+    let Some(chin) = "2.1".parse::<FeaturePointId>().ok() else {
+        return (face.clone(), Vec::new());
+    };
+    let Some((mi, _)) = fp_mesh_vertex(face, &frames, chin, diag * 1e-4) else {
+        return (face.clone(), Vec::new());
+    };
+    let name = face.meshes[mi].name.clone();
+    if face
+        .fat
+        .tables
+        .iter()
+        .any(|t| t.meshes.iter().any(|m| m.mesh == name))
+    {
+        return (face.clone(), Vec::new());
+    }
+    let mesh = &face.meshes[mi].mesh;
+    let world: Vec<Vec3> = mesh
+        .positions
+        .iter()
+        .map(|&p| frames.meshes[mi].transform_point3(p))
+        .collect();
+    let (piece, count) = mesh_pieces(mesh, diag * 1e-6);
+    if count < 2 {
+        return (face.clone(), Vec::new());
+    }
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
+    for (v, &k) in piece.iter().enumerate() {
+        members[k].push(v);
+    }
+    let core = (0..count).max_by_key(|&k| members[k].len()).unwrap_or(0);
+    let fates: Vec<Fate> = (0..count)
+        .map(|k| {
+            if k == core {
+                Fate::Skin
+            } else {
+                let pts: Vec<Vec3> = members[k].iter().map(|&v| world[v]).collect();
+                lm.fate(&pts)
+            }
+        })
+        .collect();
+    // Polygons by destination.
+    let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
+    let mut pieces: BTreeMap<Part, std::collections::BTreeSet<usize>> = BTreeMap::new();
+    for (pi, poly) in mesh.polygons.iter().enumerate() {
+        let Some(&v0) = poly.first() else { continue };
+        let k = piece.get(v0 as usize).copied().unwrap_or(core);
+        let part = match fates[k] {
+            Fate::Skin => None,
+            Fate::Part(p) => Some(p),
+            Fate::Jaws => {
+                let y = poly
+                    .iter()
+                    .filter_map(|&v| world.get(v as usize))
+                    .map(|p| p.y)
+                    .sum::<f32>()
+                    / poly.len() as f32;
+                Some(if y > lm.lip_y {
+                    Part::UpperTeeth
+                } else {
+                    Part::LowerTeeth
+                })
+            }
+        };
+        if let Some(p) = part {
+            pieces.entry(p).or_default().insert(k);
+        }
+        dest.entry(part).or_default().push(pi);
+    }
+    if dest.keys().all(|p| p.is_none()) {
+        return (face.clone(), Vec::new());
+    }
+    let mut out = face.clone();
+    out.scene = None;
+    // Skin keeps its polygons and every vertex no part polygon uses (isolated ones too).
+    let mut used_by_part = vec![false; mesh.positions.len()];
+    for (p, polys) in &dest {
+        if p.is_some() {
+            for &pi in polys {
+                for &v in mesh.polygons.get(pi).unwrap_or(&[]) {
+                    if let Some(u) = used_by_part.get_mut(v as usize) {
+                        *u = true;
+                    }
+                }
+            }
+        }
+    }
+    let skin_polys = dest.get(&None).cloned().unwrap_or_default();
+    for &pi in &skin_polys {
+        for &v in mesh.polygons.get(pi).unwrap_or(&[]) {
+            if let Some(u) = used_by_part.get_mut(v as usize) {
+                *u = false;
+            }
+        }
+    }
+    let skin_vertices: Vec<u32> = (0..mesh.positions.len() as u32)
+        .filter(|&v| !used_by_part[v as usize])
+        .collect();
+    let (skin_mesh, skin_map) = sub_mesh(mesh, &skin_polys, Some(&skin_vertices));
+    let mut maps: Vec<(String, BTreeMap<u32, u32>)> = vec![(name.clone(), skin_map)];
+    out.meshes[mi].mesh = skin_mesh;
+    let mut report = Vec::new();
+    for (p, polys) in &dest {
+        let Some(p) = p else { continue };
+        let (m, map) = sub_mesh(mesh, polys, None);
+        let new_name = unique_mesh_name(&out, &format!("{name}_{}", p.name()));
+        report.push(SplitPart {
+            part: *p,
+            from: name.clone(),
+            mesh: new_name.clone(),
+            vertices: m.positions.len(),
+            pieces: pieces.get(p).map_or(0, |s| s.len()),
+        });
+        out.meshes.push(FaceMesh {
+            name: new_name.clone(),
+            transform: face.meshes[mi].transform,
+            mesh: Mesh {
+                name: new_name.clone(),
+                ..m
+            },
+            color: face.meshes[mi].color,
+        });
+        maps.push((new_name, map));
+    }
+    rebind_feature_points(&mut out, face, mi, &maps);
+    (out, report)
+}
+
+/// Feature points bound to the cut mesh follow their vertex into its new mesh.
+fn rebind_feature_points(
+    out: &mut FaceModel,
+    face: &FaceModel,
+    mi: usize,
+    maps: &[(String, BTreeMap<u32, u32>)],
+) {
+    let ids: Vec<FeaturePointId> = face.feature_points.iter().map(|f| f.id).collect();
+    for id in ids {
+        let Some((m, v)) = face.fp_vertex(id) else {
+            continue;
+        };
+        if m != mi {
+            // Bound elsewhere: make the mesh explicit (the face has several meshes now).
+            if let Some(fp) = out.feature_points.get(id).cloned() {
+                if let Some(mut b) = fp.binding.clone() {
+                    b.mesh = Some(face.meshes[m].name.clone());
+                    let mut fp = fp;
+                    fp.binding = Some(b);
+                    out.feature_points.insert(fp);
+                }
+            }
+            continue;
+        }
+        let Some(fp) = out.feature_points.get(id).cloned() else {
+            continue;
+        };
+        let mut fp = fp;
+        fp.binding = maps.iter().find_map(|(name, map)| {
+            map.get(&v).map(|&nv| VertexBinding {
+                mesh: Some(name.clone()),
+                vertices: vec![nv],
+            })
+        });
+        out.feature_points.insert(fp);
+    }
+}
+
+/// The polygons `polys` of `mesh` (and `keep` vertices, default those polygons use) as a new
+/// mesh; returns it and old → new vertex indices. UVs and normals keep their arrays.
+fn sub_mesh(mesh: &Mesh, polys: &[usize], keep: Option<&[u32]>) -> (Mesh, BTreeMap<u32, u32>) {
+    let mut vertices: Vec<u32> = match keep {
+        Some(k) => k.to_vec(),
+        None => polys
+            .iter()
+            .flat_map(|&pi| mesh.polygons.get(pi).unwrap_or(&[]).iter().copied())
+            .collect(),
+    };
+    vertices.sort_unstable();
+    vertices.dedup();
+    let map: BTreeMap<u32, u32> = vertices
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (v, i as u32))
+        .collect();
+    let pick = |src: &Polygons, remap: bool| {
+        let mut out = Polygons::new();
+        for &pi in polys {
+            let poly = src.get(pi).unwrap_or(&[]);
+            let p: Vec<u32> = if remap {
+                poly.iter().filter_map(|v| map.get(v).copied()).collect()
+            } else {
+                poly.to_vec()
+            };
+            out.push(&p);
+        }
+        out
+    };
+    fn subset<T: Copy>(all: &[T], n: usize, vertices: &[u32]) -> Vec<T> {
+        if all.len() == n {
+            vertices.iter().map(|&v| all[v as usize]).collect()
+        } else {
+            Vec::new()
+        }
+    }
+    let n = mesh.positions.len();
+    let m = Mesh {
+        name: mesh.name.clone(),
+        positions: vertices
+            .iter()
+            .map(|&v| mesh.positions[v as usize])
+            .collect(),
+        colors: if mesh.colors.len() == mesh.positions.len() {
+            vertices.iter().map(|&v| mesh.colors[v as usize]).collect()
+        } else {
+            Vec::new()
+        },
+        polygons: pick(&mesh.polygons, true),
+        // Per-corner attributes keep their arrays; per-vertex ones follow the vertices.
+        uvs: match &mesh.uv_polygons {
+            Some(_) => mesh.uvs.clone(),
+            None => subset(&mesh.uvs, n, &vertices),
+        },
+        uv_polygons: mesh.uv_polygons.as_ref().map(|p| pick(p, false)),
+        normals: match &mesh.normal_polygons {
+            Some(_) => mesh.normals.clone(),
+            None => subset(&mesh.normals, n, &vertices),
+        },
+        normal_polygons: mesh.normal_polygons.as_ref().map(|p| pick(p, false)),
+        groups: Vec::new(),
+        flags: mesh.flags,
+    };
+    (m, map)
+}
+
+/// `base`, or `base_2`, ...: a name no mesh or transform has.
+fn unique_mesh_name(face: &FaceModel, base: &str) -> String {
+    let mut name = base.to_string();
+    let mut k = 1;
+    while face.mesh_index(&name).is_some() || face.transform_index(&name).is_some() {
+        k += 1;
+        name = format!("{base}_{k}");
+    }
+    name
+}

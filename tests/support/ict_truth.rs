@@ -1,0 +1,133 @@
+//! A real-head ground truth for cloning, from the ICT-FaceKit rig (shared by the
+//! `clone_ict` test and bench).
+//!
+//! Head A: the ICT neutral with the FAT `face_from_rig` builds from its ARKit shapes,
+//! restricted to [`FAPS`]. Head B: A's neutral under a smooth symmetric shape change
+//! ([`reshape`]: wider jaw, longer nose, fuller cheeks), feature points carried over by vertex.
+//! B's true FAT is A's tables with every per-vertex rate unchanged and multiplied by
+//! B/A's FAPU ratio of the FAP's unit. Why that is the truth: FAT rates are per unit of FAP
+//! value, and a FAP unit is a fraction of the face's own FAPU distance, so the same FAP value
+//! must move B's feature points by B's FAPU; with the same topology and a smooth, mild shape
+//! change every vertex keeps its anatomical role, and the rig is linear, so carrying each
+//! vertex's motion over and scaling it is the motion B's animator would make (the ICT-based
+//! ground truth of the issue was made exactly so). `B×10 + offset` checks units and position.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use fbakit::face::FaceModel;
+use fbakit::fdp::landmarks::{feature_points_from_landmarks, read_landmark_ids, LandmarkScheme};
+use fbakit::rig::fap_map::FapMap;
+use fbakit::rig::fat_build::face_from_rig;
+use fbakit::spec::{FapId, FapuKind};
+use glam::Vec3;
+
+/// The FAPs of head A's FAT: jaw, lids, lip corners, brows.
+pub const FAPS: [u8; 14] = [
+    3,  // open_jaw
+    14, // thrust_jaw
+    15, // shift_jaw
+    19, // close_t_l_eyelid
+    20, // close_t_r_eyelid
+    12, // raise_l_cornerlip
+    13, // raise_r_cornerlip
+    6,  // stretch_l_cornerlip
+    7,  // stretch_r_cornerlip
+    31, // raise_l_i_eyebrow
+    32, // raise_r_i_eyebrow
+    35, // raise_l_o_eyebrow
+    36, // raise_r_o_eyebrow
+    33, // raise_l_m_eyebrow
+];
+
+pub fn ict_dir() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/ict-facekit");
+    if dir.join("generic_neutral_mesh.obj").is_file() {
+        Some(dir)
+    } else {
+        eprintln!("note: {} not found; skipping", dir.display());
+        None
+    }
+}
+
+/// Head A: the ICT neutral with its rig FAT restricted to [`FAPS`].
+pub fn head_a(dir: &Path) -> FaceModel {
+    let rig = fbakit::rig::read_rig(dir).unwrap();
+    let ids = read_landmark_ids(&dir.join("vertex_indices.json")).unwrap();
+    let found =
+        feature_points_from_landmarks(&rig.meshes[0].mesh, LandmarkScheme::Ibug68, &ids.ids)
+            .unwrap();
+    let (mut face, _) =
+        face_from_rig(&rig, Some(found.feature_point_set()), &FapMap::arkit()).unwrap();
+    face.fat.tables.retain(
+        |t| matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if FAPS.contains(&f.number())),
+    );
+    face.name = "ict_a".into();
+    face
+}
+
+/// The smooth symmetric shape change from A to B (face frame, centimetres, centred on A's
+/// landmarks `nose` = 9.3 and `chin` = 2.1).
+pub fn reshape(p: Vec3, nose: Vec3, chin: Vec3) -> Vec3 {
+    let g = |c: Vec3, s: f32| (-(p - c).length_squared() / (2.0 * s * s)).exp();
+    let mut q = p;
+    // Longer nose: forward around the tip.
+    q.z += 0.6 * g(nose, 1.8);
+    // Wider jaw: sideways, growing below the mouth.
+    let jaw = g(Vec3::new(0.0, chin.y + 1.0, chin.z - 4.0), 5.0);
+    q.x += 0.12 * p.x * jaw;
+    // Fuller cheeks, both sides.
+    for side in [-1.0, 1.0] {
+        let c = Vec3::new(side * 4.5, nose.y - 1.0, nose.z - 3.0);
+        q += Vec3::new(side * 0.35, 0.0, 0.2) * g(c, 2.0);
+    }
+    q
+}
+
+/// `a` with every position through `f` (feature points carried over) and its FAT's rates
+/// scaled by the FAPU ratio: the face and its true FAT.
+pub fn head_b(a: &FaceModel, f: impl Fn(Vec3) -> Vec3) -> FaceModel {
+    let mut b = a.clone();
+    b.name = "ict_b".into();
+    b.scene = None;
+    // `a` has no transforms (a rig face): local = world.
+    for m in &mut b.meshes {
+        for p in &mut m.mesh.positions {
+            *p = f(*p);
+        }
+        m.mesh.normals.clear();
+        m.mesh.normal_polygons = None;
+    }
+    let ids: Vec<_> = b.feature_points.iter().map(|p| p.id).collect();
+    for id in ids {
+        let mut fp = b.feature_points.get(id).unwrap().clone();
+        fp.position = fp.position.map(&f);
+        b.feature_points.insert(fp);
+    }
+    let (fa, fb) = (a.fapu().unwrap(), b.fapu().unwrap());
+    for t in &mut b.fat.tables {
+        let kind = match t.key {
+            fbakit::fat::TableKey::LowLevel(fap) => fap.info().fapu.unwrap_or(FapuKind::Mns),
+            _ => FapuKind::Mns,
+        };
+        let r = (fb.unit(kind) / fa.unit(kind)) as f32;
+        for m in &mut t.meshes {
+            for d in &mut m.displacements {
+                *d *= r;
+            }
+        }
+    }
+    b
+}
+
+/// The nose tip and chin of `a`.
+pub fn anchors(a: &FaceModel) -> (Vec3, Vec3) {
+    let p = |s: &str| a.feature_points.position(s.parse().unwrap()).unwrap();
+    (p("9.3"), p("2.1"))
+}
+
+/// FAP by number (for messages).
+pub fn fap(n: u8) -> FapId {
+    FapId::new(n).unwrap()
+}
