@@ -250,7 +250,7 @@ pub fn run(a: PlayArgs) -> Result<u8> {
     if a.json {
         print_json(&report)?;
     } else {
-        print!("{}", report_text(&report));
+        super::print_text(&report_text(&report));
         super::print_warnings(&report.warnings);
     }
     Ok(EXIT_OK)
