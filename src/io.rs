@@ -247,6 +247,57 @@ impl AtomicDir {
     }
 }
 
+/// Opens a folder of frame files for writing as an [`AtomicDir`]: `path` may be new (its
+/// missing parents are created) or an existing directory that holds only files `is_ours`
+/// recognises (frames of an earlier run, which the commit replaces). Anything else in it is
+/// refused, so a mistyped `-o ~/` can never replace a directory of other files.
+pub fn open_frame_dir(path: &Path, is_ours: impl Fn(&str) -> bool) -> Result<AtomicDir> {
+    if path.exists() {
+        if !path.is_dir() {
+            return Err(Error::Invalid(format!(
+                "{}: exists and is not a directory",
+                path.display()
+            )));
+        }
+        let entries = std::fs::read_dir(path).map_err(|e| Error::output(path, e))?;
+        for entry in entries {
+            let entry = entry.map_err(|e| Error::output(path, e))?;
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            let is_file = entry.file_type().is_ok_and(|t| t.is_file());
+            if !(is_file && is_ours(&name)) {
+                return Err(Error::Invalid(format!(
+                    "{}: exists and holds `{name}`, which is not a frame of an earlier \
+                     run; choose an empty or new directory",
+                    path.display()
+                )));
+            }
+        }
+    }
+    // A trailing slash names the same directory; the temporary sibling needs its parent.
+    let clean: PathBuf = path.components().collect();
+    let parent = parent_dir(&clean);
+    if parent.exists() && !parent.is_dir() {
+        // `create_dir_all` would say "File exists", which reads as the wrong problem.
+        return Err(Error::output(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::NotADirectory,
+                format!("{} is not a directory", parent.display()),
+            ),
+        ));
+    }
+    std::fs::create_dir_all(parent).map_err(|e| Error::output(path, e))?;
+    AtomicDir::create(&clean)
+}
+
+/// Whether `name` is `PREFIX` + digits + `SUFFIX` (frame files such as `frame_00012.png`).
+pub fn is_numbered_file(name: &str, prefix: &str, suffix: &str) -> bool {
+    name.strip_prefix(prefix)
+        .and_then(|r| r.strip_suffix(suffix))
+        .is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))
+}
+
 /// Temporary files are created private (0600); an output should get the permissions a plain
 /// `File::create` would give it: 0666 less the process umask. The mask is read from
 /// `/proc/self/status` (setting it to read it would race with other threads); where that is

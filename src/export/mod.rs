@@ -13,6 +13,7 @@
 //! The player ([`crate::player`]) only computes frames; everything that turns frames into
 //! files lives here.
 
+pub mod budget;
 pub mod gltf;
 pub mod movie;
 pub mod obj_sequence;
