@@ -538,8 +538,17 @@ impl<'a> Reader<'a> {
         }
         let (rate_tok, roff) = h.frame_rate;
         let frame_rate = match parse_f64(rate_tok) {
-            Some(r) if r.is_finite() && r > 0.0 => r,
-            _ => return Err(self.error(line, roff, "a frame rate (a finite number > 0)")),
+            Some(r) if r.is_finite() && r > 0.0 && r <= super::model::MAX_FRAME_RATE => r,
+            _ => {
+                return Err(self.error(
+                    line,
+                    roff,
+                    format!(
+                        "a frame rate (a number > 0 and <= {})",
+                        super::model::MAX_FRAME_RATE
+                    ),
+                ))
+            }
         };
         let (count_tok, coff) = h.frame_count;
         let declared = match uint(count_tok) {
@@ -777,11 +786,15 @@ impl<'a> Reader<'a> {
                     format!("a value for FAP {fap} ({})", fap.name()),
                 ));
             };
-            if !v.is_finite() {
+            if !(v.is_finite() && v.abs() <= super::model::MAX_ABS_FAP_VALUE) {
                 return Err(self.error(
                     line,
                     off(j),
-                    format!("a finite value for FAP {fap} ({})", fap.name()),
+                    format!(
+                        "a finite value within ±{:e} for FAP {fap} ({})",
+                        super::model::MAX_ABS_FAP_VALUE,
+                        fap.name()
+                    ),
                 ));
             }
             if !fap.info().accepts(v) {

@@ -124,10 +124,14 @@ impl<'a> Player<'a> {
     pub fn new(face: &'a FaceModel, stream: &FapStream, opts: PlayOptions) -> Result<Player<'a>> {
         face.check_structure()?;
         let evaluator = face.evaluator()?;
-        if !(stream.frame_rate.is_finite() && stream.frame_rate > 0.0) {
+        if !(stream.frame_rate.is_finite()
+            && stream.frame_rate > 0.0
+            && stream.frame_rate <= crate::fap::MAX_FRAME_RATE)
+        {
             return Err(Error::Invalid(format!(
-                "stream frame rate {} is not a finite positive number",
-                stream.frame_rate
+                "stream frame rate {} is not a number in (0, {}]",
+                stream.frame_rate,
+                crate::fap::MAX_FRAME_RATE
             )));
         }
         let (timeline, fps) = match opts.fps {
