@@ -746,6 +746,15 @@ fn unwritable_outputs_are_failures_that_leave_nothing() {
         None,
     );
     check_only_blocker("clone output");
+    let target = blocker.join("man");
+    case(
+        "man pages folder",
+        &[&"man", &"-o", &target],
+        Expect::Failure,
+        "blocker",
+        None,
+    );
+    check_only_blocker("man pages folder");
     let target = blocker.join("x.csv");
     let mesh = lab.file("tri.obj", TRIANGLE_OBJ.as_bytes());
     let ids = lab.file("ids.txt", b"0 1 2");
