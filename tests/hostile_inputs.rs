@@ -864,3 +864,48 @@ fn landmark_ids_cannot_be_hostile() {
         );
     }
 }
+
+#[test]
+fn a_frame_sequence_stopped_midway_leaves_nothing() {
+    // The library side of `play -o frames/`: a sequence dropped after some frames (what an
+    // error in a later frame does) leaves neither the folder nor a temporary sibling.
+    let face = fbakit::face::read("alma").unwrap();
+    let (stream, _) = fbakit::fap::read_stream_file(
+        &Path::new(SAMPLES).join("speech.fap"),
+        &fbakit::fap::ReadOptions::lenient(),
+    )
+    .unwrap();
+    let mut player =
+        fbakit::player::Player::new(&face, &stream, fbakit::player::PlayOptions::default())
+            .unwrap();
+    let lab = Lab::new();
+    let out = lab.out("midway");
+    let frames = out.join("frames");
+    let mut seq = fbakit::export::obj_sequence::ObjSequence::new(&face, &frames, 25.0).unwrap();
+    let mut frame = player.new_frame();
+    for _ in 0..3 {
+        assert!(player.next_frame(&mut frame));
+        seq.write_frame(&frame).unwrap();
+    }
+    assert!(!frames.exists(), "frames appear only when finished");
+    drop(seq);
+    let left: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
+    assert!(left.is_empty(), "left behind {left:?}");
+    // Finished, the folder is there whole.
+    let mut seq = fbakit::export::obj_sequence::ObjSequence::new(&face, &frames, 25.0).unwrap();
+    player.rewind();
+    assert!(player.next_frame(&mut frame));
+    seq.write_frame(&frame).unwrap();
+    seq.finish().unwrap();
+    let mut names: Vec<_> = std::fs::read_dir(&frames)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["frame_00000.obj", "frames.json"]);
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        1,
+        "no temporary left"
+    );
+}
