@@ -1,6 +1,7 @@
 //! Replays the seed corpora of the fuzz targets `face`, `gltf_rig`, `landmark_ids` and
 //! `weights_csv` (`fuzz/seeds/<target>/`) through the same library calls on the stable
-//! toolchain, plus truncations and single-byte flips of each seed: no input may panic.
+//! toolchain, plus truncations and single-byte flips of each seed, and the inputs the
+//! targets once crashed on (`tests/fuzz-regressions/<target>/`): no input may panic.
 
 use std::path::{Path, PathBuf};
 
@@ -42,6 +43,12 @@ fn replay(target: &str, check: impl Fn(&[u8])) {
         for v in variants(&bytes) {
             check(&v);
         }
+    }
+    let crashes = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fuzz-regressions")
+        .join(target);
+    for f in std::fs::read_dir(crashes).into_iter().flatten() {
+        check(&std::fs::read(f.unwrap().path()).unwrap());
     }
 }
 
