@@ -1050,15 +1050,15 @@ mod tests {
         assert_eq!(err(""), "t.fap:1:1: expected a header line `<version> <name> <frame_rate> <frame_count>`, found end of input");
         assert_eq!(
             err("2.1 x 0 1\n"),
-            "t.fap:1:7: expected a frame rate (a finite number > 0), found `0`"
+            "t.fap:1:7: expected a frame rate (a number > 0 and <= 1000), found `0`"
         );
         assert_eq!(
             err("2.1 x -25 1\n"),
-            "t.fap:1:7: expected a frame rate (a finite number > 0), found `-25`"
+            "t.fap:1:7: expected a frame rate (a number > 0 and <= 1000), found `-25`"
         );
         assert_eq!(
             err("2.1 x NaN 1\n"),
-            "t.fap:1:7: expected a frame rate (a finite number > 0), found `NaN`"
+            "t.fap:1:7: expected a frame rate (a number > 0 and <= 1000), found `NaN`"
         );
         assert_eq!(
             err("2.1 x 25 1.5\n"),
@@ -1071,7 +1071,7 @@ mod tests {
         assert_eq!(err(&format!("2.1 x 25 1\n{m}\n")), "t.fap:3:1: expected the value line of the frame whose mask is on line 2, found end of input");
         assert_eq!(
             err(&format!("2.1 x 25 1\n{m}\n0 inf\n")),
-            "t.fap:3:3: expected a finite value for FAP 3 (open_jaw), found `inf`"
+            "t.fap:3:3: expected a finite value within ±1e9 for FAP 3 (open_jaw), found `inf`"
         );
         assert_eq!(
             err(&format!("2.1 x 25 1\n{m}\n0\n")),
