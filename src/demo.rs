@@ -281,7 +281,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     let (truth, target_face) = bundled_face(&samples, BundledFace::Bruno)?;
     let target = strip_fat(&truth);
     clock.lap("load");
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    std::fs::create_dir_all(out_dir).map_err(|e| Error::output(out_dir, e))?;
 
     let other = match opts.method {
         Method::Fmc => Method::Rbf,

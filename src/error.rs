@@ -227,12 +227,46 @@ impl Error {
     }
 }
 
+/// Untrusted text made safe for a terminal: control characters (C0, DEL and C1, which
+/// terminals read as escape sequences) become visible escapes such as `\x1b`, `\x07` and
+/// `\0`; line feeds and tabs are kept so multi-line reports stay readable. Text without
+/// control characters is returned as is, without copying.
+pub fn escape_control(text: &str) -> std::borrow::Cow<'_, str> {
+    let unsafe_char = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !text.chars().any(unsafe_char) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        match c {
+            '\0' => out.push_str("\\0"),
+            '\r' => out.push_str("\\r"),
+            // Every `char::is_control` character is below U+0100.
+            c if unsafe_char(c) => out.push_str(&format!("\\x{:02x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
 /// Result with the crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn control_characters_are_escaped() {
+        assert!(matches!(
+            escape_control("plain\ttext\n"),
+            std::borrow::Cow::Borrowed(_)
+        ));
+        assert_eq!(
+            escape_control("a\x1b]0;x\x07\x1b[2J\0\r\u{9b}\x7fz\n"),
+            "a\\x1b]0;x\\x07\\x1b[2J\\0\\r\\x9b\\x7fz\n"
+        );
+    }
 
     #[test]
     fn location_counts_lines_and_characters() {

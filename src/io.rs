@@ -17,23 +17,46 @@ use crate::error::{Error, Result};
 pub const DEFAULT_MAX_INPUT_BYTES: u64 = 1 << 30;
 
 /// Reads a whole file, refusing files larger than `max_bytes`.
+///
+/// The size is checked from the file's metadata before anything is read, so refusing a huge
+/// (or sparse) file costs nothing; the read itself is still bounded, for files that grow or
+/// report no size (pipes, `/proc`).
 pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut buf = Vec::new();
+    let meta = file.metadata().map_err(|e| Error::io(path, e))?;
+    if meta.is_dir() {
+        return Err(Error::io(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "is a directory, not a file",
+            ),
+        ));
+    }
+    if meta.is_file() && meta.len() > max_bytes {
+        return Err(too_large(path, Some(meta.len()), max_bytes));
+    }
+    // Never reserve more than the file claims: a hostile size cannot cost memory up front.
+    let mut buf = Vec::with_capacity(meta.len().min(max_bytes) as usize);
     // Read one byte past the limit to detect an oversized file without trusting metadata.
     file.take(max_bytes.saturating_add(1))
         .read_to_end(&mut buf)
         .map_err(|e| Error::io(path, e))?;
     if buf.len() as u64 > max_bytes {
-        return Err(Error::io(
-            path,
-            std::io::Error::new(
-                std::io::ErrorKind::FileTooLarge,
-                format!("file is larger than the {max_bytes}-byte input limit"),
-            ),
-        ));
+        return Err(too_large(path, None, max_bytes));
     }
     Ok(buf)
+}
+
+fn too_large(path: &Path, size: Option<u64>, max_bytes: u64) -> Error {
+    let what = match size {
+        Some(n) => format!("the file has {n} bytes, more than the {max_bytes}-byte input limit"),
+        None => format!("file is larger than the {max_bytes}-byte input limit"),
+    };
+    Error::io(
+        path,
+        std::io::Error::new(std::io::ErrorKind::FileTooLarge, what),
+    )
 }
 
 /// Reads a whole UTF-8 text file (bounded by [`DEFAULT_MAX_INPUT_BYTES`]).
@@ -224,6 +247,57 @@ impl AtomicDir {
     }
 }
 
+/// Opens a folder of frame files for writing as an [`AtomicDir`]: `path` may be new (its
+/// missing parents are created) or an existing directory that holds only files `is_ours`
+/// recognises (frames of an earlier run, which the commit replaces). Anything else in it is
+/// refused, so a mistyped `-o ~/` can never replace a directory of other files.
+pub fn open_frame_dir(path: &Path, is_ours: impl Fn(&str) -> bool) -> Result<AtomicDir> {
+    if path.exists() {
+        if !path.is_dir() {
+            return Err(Error::Invalid(format!(
+                "{}: exists and is not a directory",
+                path.display()
+            )));
+        }
+        let entries = std::fs::read_dir(path).map_err(|e| Error::output(path, e))?;
+        for entry in entries {
+            let entry = entry.map_err(|e| Error::output(path, e))?;
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            let is_file = entry.file_type().is_ok_and(|t| t.is_file());
+            if !(is_file && is_ours(&name)) {
+                return Err(Error::Invalid(format!(
+                    "{}: exists and holds `{name}`, which is not a frame of an earlier \
+                     run; choose an empty or new directory",
+                    path.display()
+                )));
+            }
+        }
+    }
+    // A trailing slash names the same directory; the temporary sibling needs its parent.
+    let clean: PathBuf = path.components().collect();
+    let parent = parent_dir(&clean);
+    if parent.exists() && !parent.is_dir() {
+        // `create_dir_all` would say "File exists", which reads as the wrong problem.
+        return Err(Error::output(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::NotADirectory,
+                format!("{} is not a directory", parent.display()),
+            ),
+        ));
+    }
+    std::fs::create_dir_all(parent).map_err(|e| Error::output(path, e))?;
+    AtomicDir::create(&clean)
+}
+
+/// Whether `name` is `PREFIX` + digits + `SUFFIX` (frame files such as `frame_00012.png`).
+pub fn is_numbered_file(name: &str, prefix: &str, suffix: &str) -> bool {
+    name.strip_prefix(prefix)
+        .and_then(|r| r.strip_suffix(suffix))
+        .is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))
+}
+
 /// Temporary files are created private (0600); an output should get the permissions a plain
 /// `File::create` would give it: 0666 less the process umask. The mask is read from
 /// `/proc/self/status` (setting it to read it would race with other threads); where that is
@@ -247,18 +321,40 @@ fn set_default_permissions(_file: &std::fs::File) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Decompresses gzip data, refusing output larger than `max_bytes`.
+/// Largest ratio of decompressed to compressed size accepted once the output passes
+/// [`GZIP_RATIO_FLOOR`] bytes. Text faces compress 3 to 10 times; a gzip bomb (zeros)
+/// about 1000 times, so a bomb is refused after a few MB instead of at the full limit.
+pub const MAX_GZIP_RATIO: u64 = 64;
+
+/// Output size below which the [`MAX_GZIP_RATIO`] is not applied (small, very regular files
+/// are legitimate).
+pub const GZIP_RATIO_FLOOR: u64 = 8 << 20;
+
+/// Decompresses gzip data, refusing output larger than `max_bytes` or larger than
+/// [`MAX_GZIP_RATIO`] times the compressed size (beyond [`GZIP_RATIO_FLOOR`]).
+///
+/// The output is decompressed in a stream and grows as it arrives: a refused input costs at
+/// most the bytes decompressed before the limit, never the limit allocated up front.
 pub fn gunzip_bounded(data: &[u8], max_bytes: u64) -> std::io::Result<Vec<u8>> {
+    let by_ratio = (data.len() as u64)
+        .saturating_mul(MAX_GZIP_RATIO)
+        .max(GZIP_RATIO_FLOOR);
+    let limit = max_bytes.min(by_ratio);
     let mut out = Vec::new();
     MultiGzDecoder::new(data)
-        .take(max_bytes.saturating_add(1))
+        .take(limit.saturating_add(1))
         .read_to_end(&mut out)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
-    if out.len() as u64 > max_bytes {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::FileTooLarge,
-            format!("decompresses to more than the {max_bytes}-byte input limit"),
-        ));
+    if out.len() as u64 > limit {
+        let why = if limit < max_bytes {
+            format!(
+                "decompresses to more than {MAX_GZIP_RATIO} times its compressed size \
+                 ({limit} bytes; a gzip bomb?)"
+            )
+        } else {
+            format!("decompresses to more than the {max_bytes}-byte input limit")
+        };
+        return Err(std::io::Error::new(std::io::ErrorKind::FileTooLarge, why));
     }
     Ok(out)
 }
@@ -381,5 +477,28 @@ mod tests {
         // Garbage is an error, not a panic.
         assert!(gunzip_bounded(b"\x1f\x8b\x08garbage", 100).is_err());
         assert!(gunzip_bounded(&bomb[..bomb.len() / 2], 1 << 30).is_err());
+        // A bomb under the size limit is still refused by its ratio, early.
+        let mut big = Vec::new();
+        gzip(&vec![0u8; 40 << 20], &mut big).unwrap();
+        let e = gunzip_bounded(&big, 1 << 30).unwrap_err();
+        assert!(e.to_string().contains("gzip bomb"), "{e}");
+    }
+
+    #[test]
+    fn size_is_checked_before_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("sparse.wrl");
+        std::fs::File::create(&p).unwrap().set_len(1 << 31).unwrap();
+        let t = std::time::Instant::now();
+        let e = read_bounded(&p, DEFAULT_MAX_INPUT_BYTES).unwrap_err();
+        assert!(t.elapsed().as_millis() < 500, "refused without reading");
+        let m = e.to_string();
+        assert!(
+            m.contains("sparse.wrl") && m.contains("2147483648") && m.contains("1073741824"),
+            "{m}"
+        );
+        assert!(e.is_input_error());
+        let e = read_bounded(dir.path(), 100).unwrap_err();
+        assert!(e.is_input_error(), "{e}");
     }
 }

@@ -65,7 +65,7 @@ pub fn man(a: ManArgs) -> Result<u8> {
             a.output.display()
         )));
     }
-    std::fs::create_dir_all(&a.output).map_err(|e| Error::io(&a.output, e))?;
+    std::fs::create_dir_all(&a.output).map_err(|e| Error::output(&a.output, e))?;
     let mut pages = Vec::new();
     let mut cmd = Cli::command();
     cmd.build();

@@ -200,7 +200,7 @@ fn info(a: InfoArgs) -> Result<u8> {
     if a.json {
         print_json(&summary)?;
     } else {
-        print!("{}", summary.to_text());
+        super::print_text(&summary.to_text());
     }
     Ok(EXIT_OK)
 }
@@ -220,12 +220,12 @@ fn validate(a: ValidateArgs) -> Result<u8> {
         }))?;
     } else {
         for d in &findings {
-            println!("{d}");
+            outln!("{d}");
         }
         if errors == 0 {
-            println!("{}: valid", a.file.display());
+            outln!("{}: valid", a.file.display());
         } else {
-            println!(
+            outln!(
                 "{}: {} problem(s), {} warning(s)",
                 a.file.display(),
                 errors,

@@ -111,7 +111,7 @@ fn info(a: InfoArgs) -> Result<u8> {
     if a.json {
         print_json(&s)?;
     } else {
-        print!("{}", info_text(&s));
+        super::print_text(&info_text(&s));
     }
     Ok(EXIT_OK)
 }
@@ -185,12 +185,12 @@ fn validate(a: ValidateArgs) -> Result<u8> {
             "problems": findings,
         }))?;
     } else if findings.is_empty() {
-        println!("{}: valid", a.file.display());
+        outln!("{}: valid", a.file.display());
     } else {
         for f in &findings {
-            println!("{f}");
+            outln!("{f}");
         }
-        println!("{}: {} problem(s)", a.file.display(), findings.len());
+        outln!("{}: {} problem(s)", a.file.display(), findings.len());
     }
     Ok(if findings.is_empty() {
         EXIT_OK

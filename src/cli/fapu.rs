@@ -81,7 +81,7 @@ pub fn run(args: FapuArgs) -> Result<u8> {
     if args.json {
         print_json(&report)?;
     } else {
-        print!("{}", text(&report));
+        super::print_text(&text(&report));
     }
     Ok(EXIT_OK)
 }

@@ -179,7 +179,7 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
     if args.json {
         print_json(&report)?;
     } else {
-        print!("{}", text(&report));
+        super::print_text(&text(&report));
     }
     Ok(EXIT_OK)
 }

@@ -8,6 +8,14 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+/// `println!` for lines that quote file content: control characters escaped (see
+/// [`print_text`]). Defined before the submodules so they can use it.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::cli::print_text(&format!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 mod candide;
 mod clone;
 mod docs;
@@ -348,6 +356,8 @@ pub fn wants_json(args: &[std::ffi::OsString]) -> bool {
 /// Prints an error to stderr (one line of text, or one JSON object under `--json`) and
 /// returns `code`.
 pub fn print_error(message: &str, code: u8, json: bool) -> ExitCode {
+    // Messages quote file content and names; the same escaped text in both forms.
+    let message = fbakit::error::escape_control(message);
     if json {
         let kind = if code == EXIT_BAD_INPUT {
             "bad-input"
@@ -382,9 +392,15 @@ pub fn print_warnings<S: AsRef<str>>(warnings: &[S]) {
         let w = w.as_ref().trim();
         let w = w.strip_prefix("warning:").map_or(w, str::trim_start);
         if seen.insert(w.to_string()) {
-            eprintln!("warning: {w}");
+            eprintln!("warning: {}", fbakit::error::escape_control(w));
         }
     }
+}
+
+/// Prints text that quotes file content (names, versions, findings) on stdout, its control
+/// characters escaped (see [`fbakit::error::escape_control`]).
+pub fn print_text(text: &str) {
+    print!("{}", fbakit::error::escape_control(text));
 }
 
 /// Prints any serialisable value as pretty JSON on stdout.

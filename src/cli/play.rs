@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use fbakit::error::{Error, Result};
+use fbakit::export::budget;
 use fbakit::export::gltf::export_face_with_units;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
@@ -195,6 +196,14 @@ pub fn run(a: PlayArgs) -> Result<u8> {
             frames: a.frames.clone(),
         },
     )?;
+    let per_frame = match format {
+        PlayFormat::Glb | PlayFormat::Gltf => budget::clip_bytes_per_frame(&face),
+        PlayFormat::Obj => budget::obj_bytes_per_frame(&face),
+        // A sheet renders a fixed number of frames whatever the span.
+        PlayFormat::Png if is_png_file(&a.output) => 0,
+        PlayFormat::Png => budget::image_bytes_per_frame(a.size.0, a.size.1),
+    };
+    check_budget(&a.output, &player.frame_range(), per_frame)?;
     let bar = progress(player.frame_count() as u64, "playing");
     let files_written = match format {
         PlayFormat::Glb | PlayFormat::Gltf => {
@@ -250,10 +259,19 @@ pub fn run(a: PlayArgs) -> Result<u8> {
     if a.json {
         print_json(&report)?;
     } else {
-        print!("{}", report_text(&report));
+        super::print_text(&report_text(&report));
         super::print_warnings(&report.warnings);
     }
     Ok(EXIT_OK)
+}
+
+/// Refuses an output estimated too large ([`budget::check`]), saying how to play less.
+pub fn check_budget(output: &Path, frames: &Range<usize>, bytes_per_frame: u64) -> Result<()> {
+    budget::check(output, frames, bytes_per_frame).map_err(|e| {
+        Error::Invalid(format!(
+            "{e}; play fewer with --frames a..b or a lower --fps"
+        ))
+    })
 }
 
 /// Whether OUT names a single PNG file (a sheet) rather than a directory of frames.
@@ -279,7 +297,10 @@ fn write_pngs(
         image.write_png(&a.output)?;
         return Ok(1);
     }
-    std::fs::create_dir_all(&a.output).map_err(|e| Error::io(&a.output, e))?;
+    // Frames go into a temporary sibling renamed at the end: a failure leaves nothing.
+    let dir = fbakit::io::open_frame_dir(&a.output, |n| {
+        fbakit::io::is_numbered_file(n, "frame_", ".png")
+    })?;
     let view = FaceView::new(face)?;
     let camera = view.front_camera();
     let opts = RenderOptions::sized(a.size.0, a.size.1);
@@ -289,10 +310,17 @@ fn write_pngs(
     while player.next_frame(&mut frame) {
         frame.pose.world_positions_into(&mut positions);
         let image = view.render(&positions, &camera, &opts);
-        image.write_png(&a.output.join(format!("frame_{:05}.png", frame.index)))?;
+        let file = format!("frame_{:05}.png", frame.index);
+        image
+            .write_png(&dir.temp_path().join(&file))
+            .map_err(|e| match e {
+                Error::Output { source, .. } => Error::output(dir.path().join(&file), source),
+                other => other,
+            })?;
         n += 1;
         bar.inc(1);
     }
+    dir.commit()?;
     Ok(n)
 }
 

@@ -138,6 +138,27 @@ pub fn write_video(
     warnings: Vec<String>,
 ) -> Result<RenderReport> {
     ignore_sigpipe();
+    // Refuse an absurd span (a stream numbered up to frame 9 999 999) before any output.
+    let span = fbakit::player::Player::new(
+        face,
+        stream,
+        fbakit::player::PlayOptions {
+            fps: job.fps,
+            frames: None,
+        },
+    )?
+    .frame_range();
+    let image = fbakit::export::budget::image_bytes_per_frame(job.size.0, job.size.1);
+    let per_frame = match job.format {
+        // H.264 keeps a talking face far under a byte a pixel.
+        VideoFormat::Mp4 => image / 16,
+        _ => image,
+    };
+    fbakit::export::budget::check(job.output, &span, per_frame).map_err(|e| {
+        Error::Invalid(format!(
+            "{e}; render fewer with a lower --fps or a shorter stream (`fbakit play --frames` cuts one)"
+        ))
+    })?;
     let settings = VideoSettings {
         width: job.size.0,
         height: job.size.1,

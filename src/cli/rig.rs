@@ -106,9 +106,9 @@ pub fn run(cmd: RigCommand) -> Result<u8> {
             if a.json {
                 print_json(&i)?;
             } else {
-                println!("rig {}: {} vertices", i.name, i.vertices);
+                outln!("rig {}: {} vertices", i.name, i.vertices);
                 for m in &i.meshes {
-                    println!(
+                    outln!(
                         "  mesh {:<24} {:>8} vertices {:>8} faces  {}",
                         m.name,
                         m.vertices,
@@ -116,11 +116,13 @@ pub fn run(cmd: RigCommand) -> Result<u8> {
                         m.materials.join(" ")
                     );
                 }
-                println!("{} shapes:", i.shapes.len());
+                outln!("{} shapes:", i.shapes.len());
                 for s in &i.shapes {
-                    println!(
+                    outln!(
                         "  {:<24} weight {:<5} moves {} vertices",
-                        s.name, s.default_weight, s.moved_vertices
+                        s.name,
+                        s.default_weight,
+                        s.moved_vertices
                     );
                 }
             }

@@ -82,6 +82,20 @@ pub fn run(a: ViewArgs) -> Result<u8> {
                     frames: a.frames.clone(),
                 },
             )?;
+            if player.frame_count() > fbakit::export::viewer::MAX_FRAMES {
+                return Err(Error::Invalid(format!(
+                    "{}: {} frames, more than the {} the viewer embeds; play fewer with \
+                     --frames a..b or a lower --fps",
+                    a.output.display(),
+                    player.frame_count(),
+                    fbakit::export::viewer::MAX_FRAMES
+                )));
+            }
+            super::play::check_budget(
+                &a.output,
+                &player.frame_range(),
+                fbakit::export::budget::clip_bytes_per_frame(&face),
+            )?;
             missing = player
                 .missing_tables()
                 .into_iter()

@@ -1,5 +1,6 @@
 //! Outputs: what a face or a played animation becomes for people and other tools.
 //!
+//! - [`budget`]: the size estimate every played output passes before its first frame.
 //! - [`gltf`]: a face with its FAT as glTF 2.0 morph targets and transform nodes, optionally
 //!   with a played clip as an animation.
 //! - [`obj_sequence`]: one OBJ file per played frame plus a `frames.json` index.
@@ -13,6 +14,7 @@
 //! The player ([`crate::player`]) only computes frames; everything that turns frames into
 //! files lives here.
 
+pub mod budget;
 pub mod gltf;
 pub mod movie;
 pub mod obj_sequence;

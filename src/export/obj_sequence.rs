@@ -2,8 +2,9 @@
 //!
 //! Each frame is one OBJ with all meshes merged in face coordinates (one `o` object per mesh,
 //! polygons as the face has them), named `frame_NNNNN.obj` after the output frame number and
-//! written atomically. [`ObjSequence::finish`] writes `frames.json`, a small index of the
-//! files with their times.
+//! written into a temporary sibling directory. [`ObjSequence::finish`] writes `frames.json`,
+//! a small index of the files with their times, and renames the directory into place; a
+//! sequence dropped before that (an error mid-way) leaves nothing behind.
 
 use std::path::{Path, PathBuf};
 
@@ -40,17 +41,17 @@ pub struct ObjIndex {
 /// Writes played frames as OBJ files into a directory.
 #[derive(Debug)]
 pub struct ObjSequence {
-    dir: PathBuf,
+    dir: crate::io::AtomicDir,
     scene: ObjScene,
     index: ObjIndex,
 }
 
 impl ObjSequence {
-    /// Prepares writing `face`'s frames into `dir` (created if missing).
+    /// Prepares writing `face`'s frames into `dir`: new, or a directory holding only the
+    /// frames of an earlier sequence, which [`ObjSequence::finish`] replaces.
     pub fn new(face: &FaceModel, dir: &Path, fps: f64) -> Result<ObjSequence> {
-        std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-            path: dir.to_path_buf(),
-            source: e,
+        let dir = crate::io::open_frame_dir(dir, |name| {
+            name == "frames.json" || crate::io::is_numbered_file(name, "frame_", ".obj")
         })?;
         let mut mesh = Mesh {
             name: face.name.clone(),
@@ -79,7 +80,7 @@ impl ObjSequence {
         mesh.polygons = polygons;
         mesh.positions.reserve(offset as usize);
         Ok(ObjSequence {
-            dir: dir.to_path_buf(),
+            dir,
             scene: ObjScene {
                 mesh,
                 material_libraries: Vec::new(),
@@ -100,8 +101,9 @@ impl ObjSequence {
             positions.extend(frame.pose.world_positions(m));
         }
         let file = format!("frame_{:05}.obj", frame.index);
-        let path = self.dir.join(&file);
-        write_obj_file(&self.scene, &path)?;
+        let path = self.dir.path().join(&file);
+        write_obj_file(&self.scene, &self.dir.temp_path().join(&file))
+            .map_err(|e| named_output(e, &path))?;
         self.index.frames.push(ObjFrameEntry {
             index: frame.index,
             time: frame.time,
@@ -110,12 +112,22 @@ impl ObjSequence {
         Ok(path)
     }
 
-    /// Writes `frames.json` and returns its path.
+    /// Writes `frames.json`, moves the directory into place and returns the index's path.
     pub fn finish(self) -> Result<PathBuf> {
-        let path = self.dir.join("frames.json");
+        let path = self.dir.path().join("frames.json");
         let text = serde_json::to_string_pretty(&self.index)
             .map_err(|e| Error::Invalid(format!("cannot encode frames.json: {e}")))?;
-        crate::io::write_atomic(&path, text.as_bytes())?;
+        crate::io::write_atomic(&self.dir.temp_path().join("frames.json"), text.as_bytes())
+            .map_err(|e| named_output(e, &path))?;
+        self.dir.commit()?;
         Ok(path)
+    }
+}
+
+/// A write error named after the file the user will see, not its temporary directory.
+fn named_output(e: Error, path: &Path) -> Error {
+    match e {
+        Error::Output { source, .. } | Error::Io { source, .. } => Error::output(path, source),
+        other => other,
     }
 }

@@ -413,8 +413,8 @@ impl GifSink {
             )));
         }
         let mut out = AtomicFile::create(path, ".gif")?;
-        let file = out.file().try_clone().map_err(|e| Error::io(path, e))?;
-        let gif_err = |e: gif::EncodingError| Error::io(path, std::io::Error::other(e));
+        let file = out.file().try_clone().map_err(|e| Error::output(path, e))?;
+        let gif_err = |e: gif::EncodingError| Error::output(path, std::io::Error::other(e));
         let mut encoder = gif::Encoder::new(
             std::io::BufWriter::new(file),
             settings.width as u16,
@@ -453,7 +453,7 @@ impl FrameSink for GifSink {
         f.delay = gif_delay(self.frames, self.settings.fps);
         encoder
             .write_frame(&f)
-            .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
+            .map_err(|e| Error::output(&path, std::io::Error::other(e)))?;
         self.frames += 1;
         Ok(())
     }
@@ -468,8 +468,8 @@ impl FrameSink for GifSink {
             // `into_inner` writes the trailer; the buffered writer is then flushed.
             let mut w = encoder
                 .into_inner()
-                .map_err(|e| Error::io(&path, std::io::Error::other(e)))?;
-            w.flush().map_err(|e| Error::io(&path, e))?;
+                .map_err(|e| Error::output(&path, std::io::Error::other(e)))?;
+            w.flush().map_err(|e| Error::output(&path, e))?;
         }
         out.commit()?;
         Ok(VideoOutput {
@@ -492,9 +492,7 @@ pub fn png_frame_name(k: usize) -> String {
 
 /// Whether `name` is a frame file an earlier render wrote.
 fn is_frame_file(name: &str) -> bool {
-    name.strip_prefix("frame_")
-        .and_then(|r| r.strip_suffix(".png"))
-        .is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))
+    crate::io::is_numbered_file(name, "frame_", ".png")
 }
 
 /// One PNG per frame in a directory that appears whole at the end.
@@ -508,33 +506,10 @@ pub struct PngFolderSink {
 impl PngFolderSink {
     /// Checks the output path and creates the temporary sibling directory.
     pub fn open(path: &Path, settings: &VideoSettings) -> Result<PngFolderSink> {
-        if path.exists() {
-            if !path.is_dir() {
-                return Err(Error::Invalid(format!(
-                    "{}: exists and is not a directory",
-                    path.display()
-                )));
-            }
-            let entries = std::fs::read_dir(path).map_err(|e| Error::io(path, e))?;
-            for entry in entries {
-                let entry = entry.map_err(|e| Error::io(path, e))?;
-                let name = entry.file_name();
-                let name = name.to_string_lossy();
-                let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-                if !(is_file && is_frame_file(&name)) {
-                    return Err(Error::Invalid(format!(
-                        "{}: exists and holds `{name}`, which is not a frame of an earlier \
-                         render; choose an empty or new directory",
-                        path.display()
-                    )));
-                }
-            }
-        }
-        // A trailing slash names the same directory; the temporary sibling needs its parent.
-        let clean: PathBuf = path.components().collect();
+        let dir = crate::io::open_frame_dir(path, is_frame_file)?;
         Ok(PngFolderSink {
             settings: settings.clone(),
-            dir: Some(AtomicDir::create(&clean)?),
+            dir: Some(dir),
             frames: 0,
             bytes: 0,
         })
@@ -549,12 +524,14 @@ impl FrameSink for PngFolderSink {
             .as_ref()
             .ok_or_else(|| Error::Invalid("the PNG sink was already finished".into()))?;
         let path = dir.temp_path().join(png_frame_name(self.frames));
-        let file = std::fs::File::create(&path).map_err(|e| Error::io(&path, e))?;
+        // Errors name the frame as it will be called, never the temporary directory.
+        let named = || dir.path().join(png_frame_name(self.frames));
+        let file = std::fs::File::create(&path).map_err(|e| Error::output(named(), e))?;
         let mut w = std::io::BufWriter::new(file);
         frame
             .encode_png(&mut w)
             .and_then(|()| w.flush())
-            .map_err(|e| Error::io(dir.path().join(png_frame_name(self.frames)), e))?;
+            .map_err(|e| Error::output(named(), e))?;
         self.bytes += file_size(&path)?;
         self.frames += 1;
         Ok(())

@@ -429,7 +429,7 @@ pub fn write_morph_set(
     face.check_structure()?;
     let mut eval = face.evaluator()?;
     let mut out = eval.output();
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, e))?;
 
     let neutral_frames = face.frames();
     let neutral = merged_mesh(face, &neutral_frames.meshes, None)?;

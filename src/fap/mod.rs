@@ -22,7 +22,8 @@ mod write;
 
 pub use convert::{is_json_path, read_stream_file, write_stream_file};
 pub use model::{
-    ExpressionParams, FapFrame, FapMask, FapStream, VisemeParams, DEFAULT_VERSION, NUM_LOW_LEVEL,
+    ExpressionParams, FapFrame, FapMask, FapStream, VisemeParams, DEFAULT_VERSION,
+    MAX_ABS_FAP_VALUE, MAX_FRAME_RATE, NUM_LOW_LEVEL,
 };
 pub use parse::{
     read_fap_file, read_fap_str, validate_fap_file, validate_fap_str, ReadMode, ReadOptions,

@@ -17,6 +17,14 @@ pub const NUM_LOW_LEVEL: usize = NUM_FAPS - 2;
 /// The version written when a stream does not name one (Xface, Greta and HMI write `2.1`).
 pub const DEFAULT_VERSION: &str = "2.1";
 
+/// Largest FAP value magnitude read (in FAPU; a wide-open jaw is about 1024). Beyond it a
+/// value is an input error: a FAPU times 1e39 overflows the `f32` of glTF weights and meshes.
+pub const MAX_ABS_FAP_VALUE: f64 = 1e9;
+
+/// Highest stream frame rate read (fps). Faster rates make frame times that `f32` glTF
+/// keys cannot tell apart (1e39 fps puts every key at 0 s).
+pub const MAX_FRAME_RATE: f64 = 1000.0;
+
 /// A whole ASCII FAP stream.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FapStream {
@@ -57,9 +65,12 @@ impl FapStream {
     /// positive, or frame numbers that do not strictly increase.
     pub fn structural_problems(&self) -> Vec<String> {
         let mut out = Vec::new();
-        if !(self.frame_rate.is_finite() && self.frame_rate > 0.0) {
+        if !(self.frame_rate.is_finite()
+            && self.frame_rate > 0.0
+            && self.frame_rate <= MAX_FRAME_RATE)
+        {
             out.push(format!(
-                "frame rate {} is not a finite positive number",
+                "frame rate {} is not a number in (0, {MAX_FRAME_RATE}]",
                 self.frame_rate
             ));
         }
@@ -489,6 +500,11 @@ impl<'de> Deserialize<'de> for FapFrame {
             let v = value.as_f64().filter(|v| v.is_finite()).ok_or_else(|| {
                 D::Error::custom(format!("FAP `{name}`: {value} is not a number"))
             })?;
+            if v.abs() > MAX_ABS_FAP_VALUE {
+                return Err(D::Error::custom(format!(
+                    "FAP `{name}`: {value} is beyond ±{MAX_ABS_FAP_VALUE:e}"
+                )));
+            }
             frame.set(id, v);
         }
         Ok(frame)

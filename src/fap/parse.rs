@@ -538,8 +538,17 @@ impl<'a> Reader<'a> {
         }
         let (rate_tok, roff) = h.frame_rate;
         let frame_rate = match parse_f64(rate_tok) {
-            Some(r) if r.is_finite() && r > 0.0 => r,
-            _ => return Err(self.error(line, roff, "a frame rate (a finite number > 0)")),
+            Some(r) if r.is_finite() && r > 0.0 && r <= super::model::MAX_FRAME_RATE => r,
+            _ => {
+                return Err(self.error(
+                    line,
+                    roff,
+                    format!(
+                        "a frame rate (a number > 0 and <= {})",
+                        super::model::MAX_FRAME_RATE
+                    ),
+                ))
+            }
         };
         let (count_tok, coff) = h.frame_count;
         let declared = match uint(count_tok) {
@@ -777,11 +786,15 @@ impl<'a> Reader<'a> {
                     format!("a value for FAP {fap} ({})", fap.name()),
                 ));
             };
-            if !v.is_finite() {
+            if !(v.is_finite() && v.abs() <= super::model::MAX_ABS_FAP_VALUE) {
                 return Err(self.error(
                     line,
                     off(j),
-                    format!("a finite value for FAP {fap} ({})", fap.name()),
+                    format!(
+                        "a finite value within ±{:e} for FAP {fap} ({})",
+                        super::model::MAX_ABS_FAP_VALUE,
+                        fap.name()
+                    ),
                 ));
             }
             if !fap.info().accepts(v) {
@@ -1037,15 +1050,15 @@ mod tests {
         assert_eq!(err(""), "t.fap:1:1: expected a header line `<version> <name> <frame_rate> <frame_count>`, found end of input");
         assert_eq!(
             err("2.1 x 0 1\n"),
-            "t.fap:1:7: expected a frame rate (a finite number > 0), found `0`"
+            "t.fap:1:7: expected a frame rate (a number > 0 and <= 1000), found `0`"
         );
         assert_eq!(
             err("2.1 x -25 1\n"),
-            "t.fap:1:7: expected a frame rate (a finite number > 0), found `-25`"
+            "t.fap:1:7: expected a frame rate (a number > 0 and <= 1000), found `-25`"
         );
         assert_eq!(
             err("2.1 x NaN 1\n"),
-            "t.fap:1:7: expected a frame rate (a finite number > 0), found `NaN`"
+            "t.fap:1:7: expected a frame rate (a number > 0 and <= 1000), found `NaN`"
         );
         assert_eq!(
             err("2.1 x 25 1.5\n"),
@@ -1058,7 +1071,7 @@ mod tests {
         assert_eq!(err(&format!("2.1 x 25 1\n{m}\n")), "t.fap:3:1: expected the value line of the frame whose mask is on line 2, found end of input");
         assert_eq!(
             err(&format!("2.1 x 25 1\n{m}\n0 inf\n")),
-            "t.fap:3:3: expected a finite value for FAP 3 (open_jaw), found `inf`"
+            "t.fap:3:3: expected a finite value within ±1e9 for FAP 3 (open_jaw), found `inf`"
         );
         assert_eq!(
             err(&format!("2.1 x 25 1\n{m}\n0\n")),

@@ -109,7 +109,9 @@ pub struct Player<'a> {
     fps: f64,
     range: Range<usize>,
     next: usize,
-    missing: Vec<MissingTable>,
+    /// Counted on first request: the count walks every frame, and a player whose span is
+    /// refused (too long to output) must cost nothing to make.
+    missing: std::sync::OnceLock<Vec<MissingTable>>,
     output: FatOutput,
 }
 
@@ -122,10 +124,14 @@ impl<'a> Player<'a> {
     pub fn new(face: &'a FaceModel, stream: &FapStream, opts: PlayOptions) -> Result<Player<'a>> {
         face.check_structure()?;
         let evaluator = face.evaluator()?;
-        if !(stream.frame_rate.is_finite() && stream.frame_rate > 0.0) {
+        if !(stream.frame_rate.is_finite()
+            && stream.frame_rate > 0.0
+            && stream.frame_rate <= crate::fap::MAX_FRAME_RATE)
+        {
             return Err(Error::Invalid(format!(
-                "stream frame rate {} is not a finite positive number",
-                stream.frame_rate
+                "stream frame rate {} is not a number in (0, {}]",
+                stream.frame_rate,
+                crate::fap::MAX_FRAME_RATE
             )));
         }
         let (timeline, fps) = match opts.fps {
@@ -157,7 +163,6 @@ impl<'a> Player<'a> {
                 r.start..r.end.min(total)
             }
         };
-        let missing = missing_tables(&evaluator, &timeline, range.clone());
         let output = evaluator.output();
         Ok(Player {
             face,
@@ -166,7 +171,7 @@ impl<'a> Player<'a> {
             fps,
             next: range.start,
             range,
-            missing,
+            missing: std::sync::OnceLock::new(),
             output,
         })
     }
@@ -194,12 +199,16 @@ impl<'a> Player<'a> {
     /// Keys used by the played frames that the face has no table for, each once, in
     /// [`TableKey`] order.
     pub fn missing_tables(&self) -> Vec<(TableKey, usize)> {
-        self.missing.iter().map(|m| (m.key, m.frames)).collect()
+        self.missing_table_records()
+            .iter()
+            .map(|m| (m.key, m.frames))
+            .collect()
     }
 
     /// Same as [`Player::missing_tables`], as serialisable records.
     pub fn missing_table_records(&self) -> &[MissingTable] {
-        &self.missing
+        self.missing
+            .get_or_init(|| missing_tables(&self.evaluator, &self.timeline, self.range.clone()))
     }
 
     /// A frame with buffers sized for this face.
@@ -261,6 +270,16 @@ impl<'a> Player<'a> {
     /// The per-frame data of every played frame for a glTF animation, computed without
     /// evaluating vertex motion (only transform entries), so it is cheap even for big faces.
     pub fn animation(&self) -> Result<Vec<AnimationFrame>> {
+        // The clip is built whole in memory: refuse absurd spans before allocating them.
+        if self.range.len() > crate::export::budget::MAX_PLAYED_FRAMES {
+            return Err(Error::Invalid(format!(
+                "frames {}..{} are {} frames, more than the {} an animation holds",
+                self.range.start,
+                self.range.end,
+                self.range.len(),
+                crate::export::budget::MAX_PLAYED_FRAMES
+            )));
+        }
         let face = self.face;
         let transform_fat = Fat {
             tables: face

@@ -45,7 +45,9 @@ pub fn read_gltf(path: &Path) -> Result<Rig> {
 
 /// Reads a glTF rig from memory; `path` names the file in errors and locates external buffers.
 pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
+    check_glb_header(bytes, path)?;
     let gltf = Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(path, e))?;
+    check_attribute_indices(&gltf.document, path)?;
     validate(&gltf.document, path)?;
     let buffers = load_buffers(&gltf, path)?;
     let mut reader = Reader {
@@ -100,6 +102,52 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
     }
     reader.rig.check()?;
     Ok(reader.rig)
+}
+
+/// A GLB header whose total length is below the header's own 12 bytes: the `gltf` crate
+/// subtracts without checking (a panic under overflow checks; found by fuzzing).
+fn check_glb_header(bytes: &[u8], file: &Path) -> Result<()> {
+    if let Some(len) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+    {
+        if len < 12 {
+            return Err(Error::Invalid(format!(
+                "{}: not a readable glTF file: the GLB header gives a length of {len} bytes, \
+                 less than the header itself",
+                file.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Vertex attributes (and morph target attributes) that name an accessor past the end: the
+/// `gltf` crate's validation indexes `accessors` with them unchecked (a panic; found by
+/// fuzzing), so they are refused first.
+fn check_attribute_indices(doc: &Document, file: &Path) -> Result<()> {
+    let json = doc.as_json();
+    let count = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let targets = prim.targets.iter().flatten().flat_map(|t| {
+                [t.positions, t.normals, t.tangents]
+                    .into_iter()
+                    .flatten()
+                    .map(|i| i.value())
+            });
+            let mut all = prim.attributes.values().map(|i| i.value()).chain(targets);
+            if let Some(i) = all.find(|&i| i >= count) {
+                return Err(located(
+                    file,
+                    &format!("meshes[{m}].primitives[{p}]"),
+                    format!("an attribute names accessor {i}, but there are {count}"),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// An error at JSON path `at` of `file`.

@@ -1,0 +1,115 @@
+//! Replays the seed corpora of the fuzz targets `face`, `gltf_rig`, `landmark_ids` and
+//! `weights_csv` (`fuzz/seeds/<target>/`) through the same library calls on the stable
+//! toolchain, plus truncations and single-byte flips of each seed, and the inputs the
+//! targets once crashed on (`tests/fuzz-regressions/<target>/`): no input may panic.
+
+use std::path::{Path, PathBuf};
+
+/// The names the `face` target's first byte picks from.
+const FACE_NAMES: [&str; 4] = ["x.wrl", "x.wrl.gz", "x.obj", "x.glb"];
+
+fn seeds(target: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fuzz/seeds")
+        .join(target);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|d| d.map(|e| e.unwrap().path()).collect())
+        .unwrap_or_default();
+    files.sort();
+    assert!(!files.is_empty(), "seeds in {}", dir.display());
+    files
+}
+
+/// Each seed, then variants: cut at a few places and with one byte flipped at a few places.
+fn variants(bytes: &[u8]) -> Vec<Vec<u8>> {
+    let mut out = vec![bytes.to_vec()];
+    let n = bytes.len();
+    for cut in [1, n / 4, n / 2, n.saturating_sub(3)] {
+        out.push(bytes[..cut.min(n)].to_vec());
+    }
+    for at in [1, n / 3, n / 2, (2 * n) / 3, n.saturating_sub(1)] {
+        if at < n {
+            let mut v = bytes.to_vec();
+            v[at] ^= 0x5A;
+            out.push(v);
+        }
+    }
+    out
+}
+
+fn replay(target: &str, check: impl Fn(&[u8])) {
+    for seed in seeds(target) {
+        let bytes = std::fs::read(&seed).unwrap();
+        for v in variants(&bytes) {
+            check(&v);
+        }
+    }
+    let crashes = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fuzz-regressions")
+        .join(target);
+    for f in std::fs::read_dir(crashes).into_iter().flatten() {
+        check(&std::fs::read(f.unwrap().path()).unwrap());
+    }
+}
+
+fn face(data: &[u8]) {
+    let Some((&pick, content)) = data.split_first() else {
+        return;
+    };
+    let name = FACE_NAMES[usize::from(pick) % FACE_NAMES.len()];
+    let _ = fbakit::face::read_bytes(name, content, &fbakit::face::FaceReadOptions::default());
+}
+
+#[test]
+fn face_seeds() {
+    // The unmodified seeds are faces.
+    for seed in seeds("face") {
+        let bytes = std::fs::read(&seed).unwrap();
+        let name = FACE_NAMES[usize::from(bytes[0]) % FACE_NAMES.len()];
+        fbakit::face::read_bytes(name, &bytes[1..], &Default::default())
+            .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+    }
+    replay("face", face);
+}
+
+#[test]
+fn gltf_rig_seeds() {
+    for seed in seeds("gltf_rig") {
+        let bytes = std::fs::read(&seed).unwrap();
+        fbakit::rig::gltf_read::read_gltf_bytes(&bytes, &seed)
+            .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+    }
+    replay("gltf_rig", |d| {
+        let _ = fbakit::rig::gltf_read::read_gltf_bytes(d, Path::new("fuzz.glb"));
+    });
+}
+
+#[test]
+fn landmark_ids_seeds() {
+    replay("landmark_ids", |d| {
+        let Ok(text) = std::str::from_utf8(d) else {
+            return;
+        };
+        if let Ok(ids) = fbakit::fdp::landmarks::parse_landmark_ids(Path::new("fuzz.json"), text) {
+            let _ = ids.check(68, 1000, "iBUG-68 landmarks");
+            let _ = ids.check(468, 468, "MediaPipe landmarks");
+        }
+    });
+}
+
+#[test]
+fn weights_csv_seeds() {
+    for seed in seeds("weights_csv") {
+        let text = std::fs::read_to_string(&seed).unwrap();
+        fbakit::rig::weights_csv::parse_weights_csv(&seed, &text, None)
+            .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+    }
+    replay("weights_csv", |d| {
+        let Ok(text) = std::str::from_utf8(d) else {
+            return;
+        };
+        let file = Path::new("fuzz.csv");
+        let _ = fbakit::rig::weights_csv::parse_weights_csv(file, text, None);
+        let _ = fbakit::rig::weights_csv::parse_weights_csv(file, text, Some(30.0));
+    });
+}
