@@ -15,6 +15,7 @@
 //! Positions are a flat `Vec<Vec3>` and faces a flat index buffer with offsets, so later stages
 //! (FAT evaluation, ray casting, rendering) index straight into them.
 
+pub mod components;
 pub mod geometry;
 pub mod obj;
 pub mod orient;

@@ -257,9 +257,13 @@ pub fn face_from_rig(
                     Ok(d.as_dvec3().dot(dir.as_dvec3()) / unit)
                 }
                 None => {
-                    let comp = components
-                        .entry(use_.fp_mesh)
-                        .or_insert_with(|| connected_components(&rig.meshes[use_.fp_mesh].mesh));
+                    let comp = components.entry(use_.fp_mesh).or_insert_with(|| {
+                        crate::mesh::components::connected_components(
+                            &rig.meshes[use_.fp_mesh].mesh,
+                            &[],
+                        )
+                        .0
+                    });
                     eyeball_angle(rig, use_, delta, comp).map(|a| a / unit)
                 }
             };
@@ -555,35 +559,6 @@ fn high_level_table(rig: &Rig, key: TableKey, delta: &SparseMotion) -> FaceDefTa
         m.displacements.push(o / full);
     }
     t
-}
-
-/// Connected-component label of every vertex of `mesh` (vertices sharing a polygon).
-fn connected_components(mesh: &crate::mesh::Mesh) -> Vec<u32> {
-    let n = mesh.vertex_count();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            let p = parent[x as usize];
-            parent[x as usize] = parent[p as usize];
-            x = p;
-        }
-        x
-    }
-    for poly in mesh.polygons.iter() {
-        let Some(&first) = poly.first() else { continue };
-        if first as usize >= n {
-            continue;
-        }
-        for &v in &poly[1..] {
-            if (v as usize) < n {
-                let (a, b) = (find(&mut parent, first), find(&mut parent, v));
-                if a != b {
-                    parent[a as usize] = b;
-                }
-            }
-        }
-    }
-    (0..n as u32).map(|v| find(&mut parent, v)).collect()
 }
 
 /// The rotation (radians, about the FAP's axis) of the mesh piece holding the use's feature

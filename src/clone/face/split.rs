@@ -32,37 +32,15 @@ pub struct SplitPart {
 /// Connected pieces of a mesh (polygon connectivity, coincident vertices joined): the piece
 /// of every vertex and the piece count.
 pub fn mesh_pieces(mesh: &Mesh, eps: f32) -> (Vec<usize>, usize) {
-    let n = mesh.positions.len();
     let co = find_coincident_vertices(&mesh.positions, eps);
-    let mut parent: Vec<usize> = (0..n)
-        .map(|i| co.representative.get(i).map_or(i, |&r| r as usize))
+    let joined: Vec<(u32, u32)> = co
+        .representative
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| (i as u32, r))
         .collect();
-    fn root(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    for poly in mesh.polygons.iter() {
-        for w in poly.windows(2) {
-            let (a, b) = (w[0] as usize, w[1] as usize);
-            if a < n && b < n {
-                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-                if ra != rb {
-                    parent[ra] = rb;
-                }
-            }
-        }
-    }
-    let mut ids: BTreeMap<usize, usize> = BTreeMap::new();
-    let mut piece = vec![0; n];
-    for (i, slot) in piece.iter_mut().enumerate() {
-        let r = root(&mut parent, i);
-        let k = ids.len();
-        *slot = *ids.entry(r).or_insert(k);
-    }
-    (piece, ids.len())
+    let (piece, count) = crate::mesh::components::connected_components(mesh, &joined);
+    (piece.into_iter().map(|p| p as usize).collect(), count)
 }
 
 /// Where a piece goes.

@@ -102,7 +102,7 @@ impl Skin {
     /// `landmark_vertices`.
     pub fn new(mesh: &Mesh, frame: &FaceFrame, landmark_vertices: &[u32]) -> Skin {
         let local: Vec<Vec3> = mesh.positions.iter().map(|&p| frame.to_local(p)).collect();
-        let (component, component_count) = components(mesh);
+        let (component, component_count) = crate::mesh::components::connected_components(mesh, &[]);
         let mut skin_component = vec![false; component_count];
         for &v in landmark_vertices {
             if let Some(&c) = component.get(v as usize) {
@@ -176,50 +176,6 @@ fn triangle_z(a: Vec3, b: Vec3, c: Vec3, x: f32, y: f32) -> Option<f32> {
         return None;
     }
     Some((a.z + u * (b.z - a.z) + v * (c.z - a.z)) as f32)
-}
-
-/// Connected components over the polygons (union-find); returns the component of every
-/// vertex (numbered densely) and the count.
-pub(super) fn components(mesh: &Mesh) -> (Vec<u32>, usize) {
-    let n = mesh.positions.len();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut a: u32) -> u32 {
-        while parent[a as usize] != a {
-            let g = parent[parent[a as usize] as usize];
-            parent[a as usize] = g;
-            a = g;
-        }
-        a
-    }
-    for poly in mesh.polygons.iter() {
-        let Some((&first, rest)) = poly.split_first() else {
-            continue;
-        };
-        if first as usize >= n {
-            continue;
-        }
-        for &v in rest {
-            if v as usize >= n {
-                continue;
-            }
-            let (ra, rb) = (find(&mut parent, first), find(&mut parent, v));
-            if ra != rb {
-                parent[ra as usize] = rb;
-            }
-        }
-    }
-    let mut label = vec![u32::MAX; n];
-    let mut count = 0u32;
-    let mut out = vec![0u32; n];
-    for v in 0..n as u32 {
-        let r = find(&mut parent, v);
-        if label[r as usize] == u32::MAX {
-            label[r as usize] = count;
-            count += 1;
-        }
-        out[v as usize] = label[r as usize];
-    }
-    (out, count as usize)
 }
 
 /// Least-squares sphere through points: (centre, radius, RMS distance to the sphere).
