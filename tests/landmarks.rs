@@ -296,42 +296,27 @@ fn cli_writes_points_that_fapu_and_both_cloners_accept() {
         .unwrap();
     assert!((es - es0).abs() < 1e-4, "{es} vs {es0}");
 
-    // XML output works too and reads back.
-    let xml = tmp.path().join("ict-fp.xml");
-    let out = fbakit(&[
-        "fp",
-        "from-landmarks",
-        neutral.to_str().unwrap(),
-        "--ibug68",
-        ids.to_str().unwrap(),
-        "-o",
-        xml.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let back = fbakit::fdp::read_feature_points(&xml).unwrap();
-    assert_eq!(back.points.len(), points.len());
-    // Xface .fdp too: the points, bound on the mesh file's name, and the FAPU in its head.
+    // fbakit XML and Xface .fdp (points on the mesh file's name, the FAPU in its head) are
+    // written too and read back.
     let fdp = tmp.path().join("ict-fp.fdp");
-    let out = fbakit(&[
-        "fp",
-        "from-landmarks",
-        neutral.to_str().unwrap(),
-        "--ibug68",
-        ids.to_str().unwrap(),
-        "-o",
-        fdp.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let xface = fbakit::fdp::read_feature_points(&fdp).unwrap();
-    assert_eq!(xface.points.len(), points.len());
+    for out_path in [tmp.path().join("ict-fp.xml"), fdp.clone()] {
+        let out = fbakit(&[
+            "fp",
+            "from-landmarks",
+            neutral.to_str().unwrap(),
+            "--ibug68",
+            ids.to_str().unwrap(),
+            "-o",
+            out_path.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let back = fbakit::fdp::read_feature_points(&out_path).unwrap();
+        assert_eq!(back.points.len(), points.len(), "{}", out_path.display());
+    }
     let info = fbakit(&[
         "face",
         "info",

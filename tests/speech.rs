@@ -36,6 +36,30 @@ fn wav_seconds(path: &Path) -> (f64, Vec<i16>) {
     (samples.len() as f64 / rate, samples)
 }
 
+/// The stream kinds (`codec_type=...` lines) and the duration of a media file, by ffprobe.
+fn probe(dir: &Path, file: &str) -> (String, f64) {
+    let p = Command::new("ffprobe")
+        .args([
+            "-v",
+            "error",
+            "-show_entries",
+            "stream=codec_type:format=duration",
+            "-of",
+            "default=nw=1",
+            file,
+        ])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&p.stdout).into_owned();
+    let duration = text
+        .lines()
+        .find_map(|l| l.strip_prefix("duration="))
+        .and_then(|d| d.parse().ok())
+        .unwrap_or_else(|| panic!("no duration in {text}"));
+    (text, duration)
+}
+
 /// The visemes a word shows, in order, without rest and without repeats.
 fn viseme_sequence(text: &str) -> Vec<u8> {
     let (_, anim) = say(text, "en", &SpeechOptions::default()).unwrap();
@@ -242,29 +266,10 @@ fn talking_head_mp4_from_typed_text() {
         ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    let p = Command::new("ffprobe")
-        .args([
-            "-v",
-            "error",
-            "-show_entries",
-            "stream=codec_type:format=duration",
-            "-of",
-            "default=nw=1",
-            "hello.mp4",
-        ])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&p.stdout);
+    let (text, duration) = probe(dir.path(), "hello.mp4");
     assert!(text.contains("codec_type=video"), "{text}");
     assert!(text.contains("codec_type=audio"), "{text}");
     let (audio, _) = wav_seconds(&dir.path().join("hello.wav"));
-    let duration: f64 = text
-        .lines()
-        .find_map(|l| l.strip_prefix("duration="))
-        .unwrap()
-        .parse()
-        .unwrap();
     assert!(
         (duration - audio).abs() < 0.1,
         "mp4 {duration} s, wav {audio} s"
@@ -325,27 +330,8 @@ fn one_command_from_typed_text_to_a_talking_head() {
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(r["talking_head"]["audio"].is_string(), "{r:#}");
     let audio = r["audio_seconds"].as_f64().unwrap();
-    let p = Command::new("ffprobe")
-        .args([
-            "-v",
-            "error",
-            "-show_entries",
-            "stream=codec_type:format=duration",
-            "-of",
-            "default=nw=1",
-            "hi.mp4",
-        ])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&p.stdout);
+    let (text, duration) = probe(dir.path(), "hi.mp4");
     assert!(text.contains("codec_type=audio"), "{text}");
-    let duration: f64 = text
-        .lines()
-        .find_map(|l| l.strip_prefix("duration="))
-        .unwrap()
-        .parse()
-        .unwrap();
     assert!(
         (duration - audio).abs() < 0.1,
         "mp4 {duration} s, speech {audio} s"
