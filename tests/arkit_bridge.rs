@@ -4,7 +4,6 @@
 //! `../shared/data/ict-facekit` print a note and return when it is absent.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use fbakit::face::FaceModel;
@@ -20,6 +19,10 @@ use fbakit::rig::Rig;
 use fbakit::rig::{BlendShape, RigMesh, ShapeDelta};
 use fbakit::spec::FapId;
 use glam::Vec3;
+
+mod support;
+use support::cli::fbakit;
+use support::validator::validate;
 
 #[path = "../examples/make_arkit_amplitudes.rs"]
 mod make_arkit_amplitudes;
@@ -302,44 +305,6 @@ fn bundled_amplitudes_match_a_fresh_measurement() {
     }
     // The bundled table is what the library embeds.
     assert_eq!(fbakit::rig::arkit_amplitudes::arkit_amplitudes(), bundled);
-}
-
-fn fbakit(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-/// Khronos validator reports for `files`, or `None` (with a note) when it is not installed.
-fn validate(files: &[PathBuf]) -> Option<Vec<serde_json::Value>> {
-    let script = Path::new(MANIFEST).join("tests/support/validate-gltf.mjs");
-    let out = match Command::new("node").arg(script).args(files).output() {
-        Ok(o) => o,
-        Err(e) => {
-            eprintln!("note: skipping glTF validation: cannot run node ({e})");
-            return None;
-        }
-    };
-    if out.status.code() == Some(3) {
-        eprintln!(
-            "note: skipping glTF validation: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        );
-        return None;
-    }
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(
-        String::from_utf8(out.stdout)
-            .unwrap()
-            .lines()
-            .map(|l| serde_json::from_str(l).unwrap())
-            .collect(),
-    )
 }
 
 #[test]

@@ -7,44 +7,8 @@
 
 mod support;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
 use support::gltf_scenes::{grid_scene, tiny_scene, two_mesh_scene};
-
-fn script() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/support/validate-gltf.mjs")
-}
-
-/// Validator reports (one JSON object per file), or `None` when the validator is unavailable.
-fn validate(files: &[PathBuf]) -> Option<Vec<serde_json::Value>> {
-    let out = match Command::new("node").arg(script()).args(files).output() {
-        Ok(o) => o,
-        Err(e) => {
-            eprintln!("note: skipping glTF validator test: cannot run node ({e})");
-            return None;
-        }
-    };
-    if out.status.code() == Some(3) {
-        eprintln!(
-            "note: skipping glTF validator test: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        );
-        return None;
-    }
-    assert!(
-        out.status.success(),
-        "validator script failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let reports: Vec<serde_json::Value> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(reports.len(), files.len());
-    Some(reports)
-}
+use support::validator::validate;
 
 #[test]
 fn generated_files_pass_the_khronos_validator() {
