@@ -57,3 +57,60 @@ fn clone_writes_a_face_and_reports() {
     let o = fbakit().args(["clone", "--help"]).output().unwrap();
     assert!(String::from_utf8_lossy(&o.stdout).contains("Examples"));
 }
+
+#[test]
+fn eval_ground_truth_clones_and_measures() {
+    // alma cloned onto alma: fmc's self-clone is exact, so the truth comes back.
+    let o = fbakit()
+        .args([
+            "eval",
+            "ground-truth",
+            "alma",
+            "--source",
+            "alma",
+            "--method",
+            "fmc",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let row = &rows[0];
+    assert_eq!(row["method"], "fmc");
+    assert!(row["keys"].as_array().unwrap().len() >= 80);
+    assert!(row["median_all"].as_f64().unwrap() < 1e-3, "{row}");
+    assert!(row["median_scaled"].as_f64().unwrap() <= row["median_all"].as_f64().unwrap());
+
+    // A clone made elsewhere is measured with --cloned; a face without a FAT is no truth.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bruno-from-alma.wrl");
+    let o = fbakit()
+        .args(["clone", "alma", "bruno", "--method", "fmc", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = fbakit()
+        .args(["eval", "ground-truth", "bruno", "--cloned"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.starts_with("cloned: median "), "{text}");
+    assert!(text.contains("open_jaw"), "{text}");
+    let o = fbakit()
+        .args(["eval", "ground-truth"])
+        .arg(&out)
+        .args(["--source", "alma"])
+        .output()
+        .unwrap();
+    // The cloned face has a FAT, so it is a valid truth; without --source/--cloned it is usage.
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = fbakit()
+        .args(["eval", "ground-truth", "bruno"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}

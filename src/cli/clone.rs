@@ -3,7 +3,10 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use fbakit::clone::eval::{compliance, self_clone_error_with, ComplianceReport};
+use fbakit::clone::eval::{
+    clone_against_truth, compliance, ground_truth_error, self_clone_error_with, ComplianceReport,
+    GroundTruthReport,
+};
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
 use fbakit::error::{Error, Result};
 use fbakit::export::write_face;
@@ -68,6 +71,125 @@ pub enum EvalCommand {
     /// Clone a face onto itself and report formula (1) of Fratarcangeli & Schaerf 2005 (%).
     #[command(after_help = "Example:\n  fbakit eval self-clone alma.wrl --method rbf")]
     SelfClone(SelfCloneArgs),
+    /// Clone a source onto a face whose true FAT is known and compare with that truth: per
+    /// table, Σ‖d_true − d_cloned‖ / Σ‖d_true‖ over every vertex (%), also after the best
+    /// non-negative scale of the cloned motion (where things move, apart from how far).
+    #[command(
+        after_help = "The target is TRUTH without its FAT; TRUTH's own tables are the answer.\n\n\
+Examples:\n  fbakit eval ground-truth bruno --source alma\n  \
+fbakit eval ground-truth truth.wrl --source src.wrl --method fmc --json\n  \
+fbakit eval ground-truth truth.wrl --cloned cloned.wrl"
+    )]
+    GroundTruth(GroundTruthArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct GroundTruthArgs {
+    /// The face with its true FAT (a face file or a bundled name).
+    pub truth: PathBuf,
+    /// Source face to clone from (with a FAT).
+    #[arg(
+        long,
+        value_name = "FACE",
+        required_unless_present = "cloned",
+        conflicts_with = "cloned"
+    )]
+    pub source: Option<PathBuf>,
+    /// Instead of cloning: a face already cloned onto TRUTH's geometry, to measure.
+    #[arg(long, value_name = "FACE")]
+    pub cloned: Option<PathBuf>,
+    /// Surface method(s) to measure (repeat the option); every method when not given.
+    #[arg(long, value_enum)]
+    pub method: Vec<MethodArg>,
+    /// Feature points of an OBJ source.
+    #[arg(long, value_name = "FILE")]
+    pub fp_source: Option<PathBuf>,
+    /// Feature points of an OBJ truth (and of an OBJ --cloned face).
+    #[arg(long, value_name = "FILE")]
+    pub fp_truth: Option<PathBuf>,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize)]
+struct TruthRow {
+    method: Option<fbakit::clone::face::Method>,
+    seconds: Option<f64>,
+    failed_faps: Vec<String>,
+    #[serde(flatten)]
+    report: GroundTruthReport,
+}
+
+fn run_ground_truth(a: GroundTruthArgs) -> Result<u8> {
+    let truth = read_face(&a.truth, a.fp_truth.as_deref())?;
+    let mut rows = Vec::new();
+    if let Some(cloned) = &a.cloned {
+        let face = read_face(cloned, a.fp_truth.as_deref())?;
+        rows.push(TruthRow {
+            method: None,
+            seconds: None,
+            failed_faps: Vec::new(),
+            report: ground_truth_error(&face, &truth)?,
+        });
+    } else if let Some(source) = &a.source {
+        let source = read_face(source, a.fp_source.as_deref())?;
+        let methods: Vec<MethodArg> = if a.method.is_empty() {
+            <MethodArg as clap::ValueEnum>::value_variants().to_vec()
+        } else {
+            a.method.clone()
+        };
+        for m in methods {
+            let opts = CloneOptions {
+                method: m.into(),
+                ..CloneOptions::default()
+            };
+            let t = std::time::Instant::now();
+            let run = clone_against_truth(&source, &truth, &opts)?;
+            print_warnings(&run.outcome.report.warnings);
+            rows.push(TruthRow {
+                method: Some(opts.method),
+                seconds: Some(t.elapsed().as_secs_f64()),
+                failed_faps: run
+                    .outcome
+                    .report
+                    .failed_faps
+                    .iter()
+                    .map(|f| f.fap.clone())
+                    .collect(),
+                report: run.report,
+            });
+        }
+    }
+    if a.json {
+        print_json(&rows)?;
+        return Ok(EXIT_OK);
+    }
+    for row in &rows {
+        let name = row.method.map_or("cloned", |m| m.name());
+        let worst = row
+            .report
+            .worst
+            .as_ref()
+            .map_or(String::new(), |(k, e)| format!(", worst {k} {e:.1} %"));
+        let secs = row
+            .seconds
+            .map_or(String::new(), |s| format!(" ({s:.2} s)"));
+        println!(
+            "{name}{secs}: median {:.1} %, mean {:.1} %, median after best scale {:.1} %{worst}",
+            row.report.median_all, row.report.mean_all, row.report.median_scaled
+        );
+        if !row.failed_faps.is_empty() {
+            println!("  failed the guard: {}", row.failed_faps.join(", "));
+        }
+        for k in &row.report.keys {
+            println!(
+                "  {:<26} {:>7.2} %  scaled {:>7.2} %  skin {:>7.2} %",
+                k.key, k.all, k.scaled, k.skin
+            );
+        }
+    }
+    Ok(EXIT_OK)
 }
 
 #[derive(Debug, clap::Args)]
@@ -268,6 +390,7 @@ fn print_compliance(c: &ComplianceReport) {
 
 pub fn run_eval(cmd: EvalCommand) -> Result<u8> {
     match cmd {
+        EvalCommand::GroundTruth(a) => return run_ground_truth(a),
         EvalCommand::Compliance(a) => {
             let face = read_face(&a.face, a.fp.as_deref())?;
             let c = compliance(&face)?;

@@ -10,7 +10,13 @@
 //!   also moves 2.1 backwards, which is right but not "along").
 //! - [`ground_truth_error`]: a cloned face against the same face with its true FAT: per table
 //!   and value, `Σ‖d_true − d_cloned‖ / Σ‖d_true‖` over every vertex of every mesh (posed
-//!   with transforms), and over the skin meshes only, averaged per key, in percent.
+//!   with transforms), and over the skin meshes only, averaged per key, in percent; and the
+//!   same over every mesh after the best non-negative scale `s` of the cloned motion
+//!   (`min over s ≥ 0 of Σ‖d_true − s·d_cloned‖`, per table and value), which judges where
+//!   things move apart from how far (FAPU rescaling).
+//! - [`clone_against_truth`]: clones a source onto a face whose true FAT is known (the target
+//!   is the truth without its FAT) and measures the result with [`ground_truth_error`]:
+//!   `fbakit eval ground-truth`.
 //!
 //! Posing composes a FAT rotation after the neutral one (`R₀·ΔR`), as [`super::face`] does.
 
@@ -20,7 +26,8 @@ use glam::Vec3;
 use serde::Serialize;
 
 use super::face::{
-    build_skin_surface, clone_surface, identify_parts, CloneOptions, Method, Similarity,
+    build_skin_surface, clone_face, clone_surface, identify_parts, CloneOptions, CloneOutcome,
+    Method, Similarity,
 };
 use super::quality::morph_target_error;
 use super::SurfaceMotion;
@@ -184,6 +191,8 @@ pub struct KeyError {
     pub all: f64,
     /// Over the skin meshes.
     pub skin: f64,
+    /// Over every mesh, after the best non-negative scale of the cloned motion.
+    pub scaled: f64,
 }
 
 /// Result of [`ground_truth_error`].
@@ -195,6 +204,12 @@ pub struct GroundTruthReport {
     pub mean_all: f64,
     /// Mean over keys, skin meshes.
     pub mean_skin: f64,
+    /// Median over keys, every mesh.
+    pub median_all: f64,
+    /// Median over keys, every mesh, after the best scale per key and value.
+    pub median_scaled: f64,
+    /// The key with the largest error over every mesh, and that error.
+    pub worst: Option<(String, f64)>,
 }
 
 impl GroundTruthReport {
@@ -247,7 +262,7 @@ pub fn ground_truth_error(cloned: &FaceModel, truth: &FaceModel) -> Result<Groun
         }
         matched.push(row);
     }
-    let mut per_key: BTreeMap<TableKey, (f64, f64, usize)> = BTreeMap::new();
+    let mut per_key: BTreeMap<TableKey, [f64; 4]> = BTreeMap::new();
     for t in fat_to_morph_targets(&truth.fat) {
         let a = [Activation {
             key: t.key,
@@ -256,41 +271,150 @@ pub fn ground_truth_error(cloned: &FaceModel, truth: &FaceModel) -> Result<Groun
         let pc = cloned.pose_with(&mut ec, &mut oc, &a);
         let pt = truth.pose_with(&mut et, &mut ot, &a);
         let (mut num, mut den, mut snum, mut sden) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        let (mut tc, mut cc) = (0.0f64, 0.0f64);
+        let mut pairs = Vec::with_capacity(matched.iter().map(Vec::len).sum());
         for mi in 0..pt.len() {
             let is_skin = skin.contains(&mi);
             for v in 0..pt[mi].len() {
                 let (cm, cv) = matched[mi][v];
-                let dt = pt[mi][v] - nt[mi][v];
-                let dc = pc[cm][cv] - nc[cm][cv];
-                let e = (dt - dc).length() as f64;
-                let l = dt.length() as f64;
+                let dt = (pt[mi][v] - nt[mi][v]).as_dvec3();
+                let dc = (pc[cm][cv] - nc[cm][cv]).as_dvec3();
+                let e = (dt - dc).length();
+                let l = dt.length();
                 num += e;
                 den += l;
                 if is_skin {
                     snum += e;
                     sden += l;
                 }
+                tc += dt.dot(dc);
+                cc += dc.length_squared();
+                pairs.push((dt, dc));
             }
         }
-        let all = if den > 0.0 { num / den * 100.0 } else { 0.0 };
-        let sk = if sden > 0.0 { snum / sden * 100.0 } else { 0.0 };
-        let e = per_key.entry(t.key).or_insert((0.0, 0.0, 0));
-        e.0 += all;
-        e.1 += sk;
-        e.2 += 1;
+        let scaled_num = best_scale_error(&pairs, if cc > 0.0 { tc / cc } else { 0.0 });
+        let pct = |n: f64, d: f64| if d > 0.0 { n / d * 100.0 } else { 0.0 };
+        let e = per_key.entry(t.key).or_insert([0.0; 4]);
+        e[0] += pct(num, den);
+        e[1] += pct(snum, sden);
+        e[2] += pct(scaled_num, den);
+        e[3] += 1.0;
     }
     let mut report = GroundTruthReport::default();
-    for (key, (a, s, n)) in per_key {
+    for (key, [a, s, sc, n]) in per_key {
         report.keys.push(KeyError {
             key: key.name(),
-            all: a / n as f64,
-            skin: s / n as f64,
+            all: a / n,
+            skin: s / n,
+            scaled: sc / n,
         });
     }
     if !report.keys.is_empty() {
         let n = report.keys.len() as f64;
         report.mean_all = report.keys.iter().map(|k| k.all).sum::<f64>() / n;
         report.mean_skin = report.keys.iter().map(|k| k.skin).sum::<f64>() / n;
+        report.median_all = median(report.keys.iter().map(|k| k.all).collect());
+        report.median_scaled = median(report.keys.iter().map(|k| k.scaled).collect());
+        report.worst = report
+            .keys
+            .iter()
+            .max_by(|a, b| a.all.total_cmp(&b.all))
+            .map(|k| (k.key.clone(), k.all));
     }
     Ok(report)
+}
+
+/// `min over s ≥ 0 of Σ‖t − s·c‖` for `(t, c)` pairs. The sum is convex in `s`, so a golden
+/// section search over a bracket that holds both 1 and the least-squares scale `ls` finds it
+/// (never worse than `s = 1`).
+fn best_scale_error(pairs: &[(glam::DVec3, glam::DVec3)], ls: f64) -> f64 {
+    let f = |s: f64| -> f64 { pairs.iter().map(|(t, c)| (*t - *c * s).length()).sum() };
+    let (mut lo, mut hi) = (0.0f64, 2.0f64.max(2.0 * ls));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..60 {
+        if f1 <= f2 {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - g * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + g * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    f1.min(f2).min(f(1.0))
+}
+
+/// Median of `v` (mean of the two middle values for an even count; 0 when empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n {
+        0 => 0.0,
+        _ if n % 2 == 1 => v[n / 2],
+        _ => (v[n / 2 - 1] + v[n / 2]) / 2.0,
+    }
+}
+
+/// `face` as a cloning target: its meshes and feature points without the FAT (and without
+/// the scene it was read from, which carried that FAT).
+pub fn without_fat(face: &FaceModel) -> FaceModel {
+    let mut f = face.clone();
+    f.fat = crate::fat::Fat::default();
+    f.scene = None;
+    f
+}
+
+/// One clone measured against the truth: [`clone_against_truth`]'s result.
+#[derive(Clone, Debug)]
+pub struct TruthRun {
+    /// The clone (face and report).
+    pub outcome: CloneOutcome,
+    /// Its error against the truth.
+    pub report: GroundTruthReport,
+}
+
+/// Clones `source`'s FAT onto `truth` without its FAT and measures the result against
+/// `truth`'s own FAT ([`ground_truth_error`]). `truth` must have a FAT.
+pub fn clone_against_truth(
+    source: &FaceModel,
+    truth: &FaceModel,
+    opts: &CloneOptions,
+) -> Result<TruthRun> {
+    if truth.fat.tables.is_empty() {
+        return Err(Error::Invalid(format!(
+            "face `{}` has no FAT to compare with: the truth must be a face with its true tables",
+            truth.name
+        )));
+    }
+    let outcome = clone_face(source, &without_fat(truth), opts)?;
+    let report = ground_truth_error(&outcome.face, truth)?;
+    Ok(TruthRun { outcome, report })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn best_scale_removes_a_uniform_scale_only() {
+        let t = [
+            DVec3::X,
+            DVec3::new(0.0, 2.0, 0.0),
+            DVec3::new(1.0, 1.0, 1.0),
+        ];
+        let half: Vec<_> = t.iter().map(|&d| (d, d * 0.5)).collect();
+        let sum: f64 = t.iter().map(|d| d.length()).sum();
+        assert!(best_scale_error(&half, 2.0) < 1e-9 * sum);
+        // A wrong direction is not repaired by scaling: the best is s = 0 here (error = Σ‖t‖).
+        let wrong: Vec<_> = t.iter().map(|&d| (d, -d)).collect();
+        assert!((best_scale_error(&wrong, -1.0) - sum).abs() < 1e-9 * sum);
+        assert_eq!(median(vec![3.0, 1.0, 2.0, 10.0]), 2.5);
+        assert_eq!(median(vec![]), 0.0);
+    }
 }

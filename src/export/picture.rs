@@ -14,7 +14,7 @@ use crate::face::parts::{split_mesh, FacePart};
 use crate::face::FaceModel;
 use crate::fap::FapStream;
 use crate::fat::eval::Activation;
-use crate::fat::{Fat, TableKey};
+use crate::fat::TableKey;
 use crate::mesh::orient::orient_outwards;
 use crate::mesh::Aabb;
 use crate::player::{PlayOptions, Player, PlayerFrame};
@@ -271,10 +271,7 @@ pub fn turntable_sheet(
 /// `face` without its FAT (and without the source scene): a mesh with feature points, what a
 /// cloning target is.
 pub fn strip_fat(face: &FaceModel) -> FaceModel {
-    let mut f = face.clone();
-    f.fat = Fat::default();
-    f.scene = None;
-    f
+    crate::clone::eval::without_fat(face)
 }
 
 /// `face` posed with `key` at `value`, drawn front-on at `size` pixels with `caption` at
