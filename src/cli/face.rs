@@ -30,6 +30,13 @@ pub enum FaceCommand {
                             fbakit face convert head.obj head.wrl --fp head.csv"
     )]
     Convert(ConvertArgs),
+    /// Subdivide every mesh of a face (Loop or midpoint); its FAT is carried to the new
+    /// vertices exactly, so the denser face plays like the original.
+    #[command(
+        after_help = "Examples:\n  fbakit face subdivide candide -o candide-dense.wrl --rounds 3\n  \
+                            fbakit face subdivide head.obj --fp head.csv --scheme midpoint -o head-fine.obj"
+    )]
+    Subdivide(super::face_subdivide::SubdivideArgs),
     /// Build a face with a FAT from a neutral OBJ and a folder of morph OBJs.
     #[command(
         long_about = "Build a face with a FAT from a neutral OBJ and a folder of morph OBJs, \
@@ -181,6 +188,7 @@ pub fn run(cmd: FaceCommand) -> Result<u8> {
         FaceCommand::Info(a) => info(a),
         FaceCommand::Validate(a) => validate(a),
         FaceCommand::Convert(a) => convert(a),
+        FaceCommand::Subdivide(a) => super::face_subdivide::run(a),
         FaceCommand::FromMorphs(a) => from_morphs(a),
         FaceCommand::ToMorphs(a) => to_morphs(a),
         FaceCommand::Export(a) => super::face_export::run_face_export(a),

@@ -22,6 +22,7 @@ mod docs;
 pub mod face;
 pub mod face_export;
 pub(crate) mod face_from_rig;
+mod face_subdivide;
 pub mod fap;
 mod fap_arkit;
 mod fapu;

@@ -20,6 +20,7 @@ pub mod morphs;
 pub mod parts;
 pub mod pose;
 pub mod read;
+pub mod subdivide;
 pub mod summary;
 pub mod units;
 pub mod validate;

@@ -20,6 +20,7 @@ pub mod geometry;
 pub mod obj;
 pub mod orient;
 pub mod spatial;
+pub mod subdivide;
 pub(crate) mod text;
 
 use glam::{Vec2, Vec3};

@@ -1,0 +1,82 @@
+//! The whole clone of a dense CANDIDE-3 face (Loop-subdivided three times: 5 993 vertices,
+//! 46 tables) onto the bundled real head `ict` (24 591 vertices, one mesh), per method.
+//! Skipped when `../shared/data/candide3` is absent. Each method's step timings (one run)
+//! and the process's peak memory are printed before the measured runs.
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use fbakit::clone::face::{clone_face, CloneOptions, Method};
+use fbakit::face::candide::candide_face;
+use fbakit::face::subdivide::subdivide_face;
+use fbakit::face::FaceModel;
+use fbakit::mesh::subdivide::Scheme;
+
+fn main() {
+    divan::main();
+}
+
+/// Dense CANDIDE and the bundled head.
+fn faces() -> Option<&'static (FaceModel, FaceModel)> {
+    static F: OnceLock<Option<(FaceModel, FaceModel)>> = OnceLock::new();
+    F.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/candide3");
+        if !dir.join("candide3.wfm").is_file() {
+            eprintln!("note: {} not found; skipping", dir.display());
+            return None;
+        }
+        let model = fbakit::candide::read_wfm_file(&dir.join("candide3.wfm")).expect("wfm");
+        let fp = fbakit::fdp::csv::read_csv_file(&dir.join("feature-points.csv"))
+            .expect("fp")
+            .to_set();
+        let candide = candide_face(&model, &fp, &[]).expect("candide face");
+        let dense = subdivide_face(&candide, Scheme::Loop, 3).expect("subdivide");
+        let ict = fbakit::face::read("ict").expect("bundled ict");
+        for method in [Method::Fmc, Method::Rbf] {
+            let out = clone_face(&dense, &ict, &opts(method)).expect("clone");
+            let steps: Vec<String> = out
+                .report
+                .timings
+                .steps
+                .iter()
+                .map(|(s, t)| format!("{s} {:.0} ms", t * 1e3))
+                .collect();
+            eprintln!(
+                "{} ({} → {} vertices): {:.0} ms: {}",
+                method.name(),
+                dense.vertex_count(),
+                ict.vertex_count(),
+                out.report.timings.total() * 1e3,
+                steps.join(", ")
+            );
+        }
+        if let Some(peak) = peak_rss_mb() {
+            eprintln!("peak memory so far (faces read, both clones run): {peak:.0} MB");
+        }
+        Some((dense, ict))
+    })
+    .as_ref()
+}
+
+/// The process's peak resident set (Linux `VmHWM`), in MB.
+fn peak_rss_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+fn opts(method: Method) -> CloneOptions {
+    CloneOptions {
+        method,
+        ..CloneOptions::default()
+    }
+}
+
+#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+fn dense_candide_to_ict(method: Method) {
+    let Some((source, target)) = faces() else {
+        return;
+    };
+    divan::black_box(clone_face(source, target, &opts(method)).expect("clone"));
+}
