@@ -254,10 +254,10 @@ impl AtomicDir {
 pub fn open_frame_dir(path: &Path, is_ours: impl Fn(&str) -> bool) -> Result<AtomicDir> {
     if path.exists() {
         if !path.is_dir() {
-            return Err(Error::Invalid(format!(
-                "{}: exists and is not a directory",
-                path.display()
-            )));
+            return Err(crate::format::OutputPathError::NotADirectory {
+                path: path.to_path_buf(),
+            }
+            .into());
         }
         let entries = std::fs::read_dir(path).map_err(|e| Error::output(path, e))?;
         for entry in entries {
@@ -266,11 +266,11 @@ pub fn open_frame_dir(path: &Path, is_ours: impl Fn(&str) -> bool) -> Result<Ato
             let name = name.to_string_lossy();
             let is_file = entry.file_type().is_ok_and(|t| t.is_file());
             if !(is_file && is_ours(&name)) {
-                return Err(Error::Invalid(format!(
-                    "{}: exists and holds `{name}`, which is not a frame of an earlier \
-                     run; choose an empty or new directory",
-                    path.display()
-                )));
+                return Err(crate::format::OutputPathError::ForeignEntry {
+                    path: path.to_path_buf(),
+                    entry: name.into_owned(),
+                }
+                .into());
             }
         }
     }

@@ -75,13 +75,12 @@ pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, Face
         // A folder is a face only as an OBJ blendshape rig (a neutral plus shape OBJs); a
         // folder with a neutral is a rig, and its own errors (a shape of the wrong size) stand.
         if let Err(e) = crate::rig::obj_folder::find_neutral(path) {
-            return Err(Error::Invalid(format!(
-                "{}: is a directory and not a rig folder ({e}); expected a face file (.wrl, \
-                 .wrl.gz, .obj, .wfm, .glb, .gltf), a folder of rig shape OBJs or a bundled \
-                 face name ({})",
-                path.display(),
-                BundledFace::NAMES.join(", ")
-            )));
+            return Err(super::FaceError::NotAFaceFolder {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+                bundled: BundledFace::NAMES.join(", "),
+            }
+            .into());
         }
         let rig = crate::rig::obj_folder::read_obj_rig(path)?;
         return super::from_rig::rig_face(path, &rig, opts.feature_points.as_deref());
@@ -195,11 +194,10 @@ fn candide(
     opts: &FaceReadOptions,
 ) -> Result<(FaceModel, FaceReadReport)> {
     let Some(fp) = &opts.feature_points else {
-        return Err(Error::Invalid(format!(
-            "{}: a CANDIDE-3 model needs its feature-point table to become a face; give it \
-             with --fp (e.g. feature-points.csv beside candide3.wfm)",
-            path.display()
-        )));
+        return Err(super::FaceError::CandideNeedsFeaturePoints {
+            path: path.to_path_buf(),
+        }
+        .into());
     };
     // CANDIDE files carry Latin-1 author names in comments; only ASCII matters to the model.
     let text = String::from_utf8_lossy(bytes);
@@ -220,7 +218,7 @@ fn attach_file(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     attach_feature_points(face, file.points, &[&alias])
-        .map_err(|e| Error::Invalid(format!("{}: {e}", fp.display())))
+        .map_err(|e| super::FaceError::in_file(fp, e).into())
 }
 
 #[cfg(test)]

@@ -6,7 +6,8 @@ use std::path::Path;
 use super::model::FapStream;
 use super::parse::{read_fap_str, ReadMode, ReadOptions};
 use super::write::write_fap_file;
-use crate::error::{Diagnostic, Error, Location, ParseError, Result, Severity};
+use super::FapError;
+use crate::error::{Diagnostic, EncodeError, Error, Location, ParseError, Result, Severity};
 
 /// Whether `path` names a JSON file (extension `.json`, any case).
 pub fn is_json_path(path: &Path) -> bool {
@@ -35,12 +36,12 @@ pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, V
     })?;
     let structural = stream.structural_problems();
     if let Some(p) = structural.first() {
-        return Err(Error::Invalid(format!("{}: {p}", path.display())));
+        return Err(content(path, p));
     }
     let values = stream.value_problems();
     if opts.mode == ReadMode::Strict {
         if let Some(p) = values.first() {
-            return Err(Error::Invalid(format!("{}: {p}", path.display())));
+            return Err(content(path, p));
         }
     }
     let warnings = values
@@ -54,6 +55,14 @@ pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, V
     Ok((stream, warnings))
 }
 
+fn content(path: &Path, problem: &str) -> Error {
+    FapError::Content {
+        file: path.to_path_buf(),
+        problem: problem.to_string(),
+    }
+    .into()
+}
+
 /// Writes `stream` atomically as JSON (pretty) or canonical `.fap`, by the extension of `path`.
 pub fn write_stream_file(path: &Path, stream: &FapStream) -> Result<()> {
     use crate::format::OutputFormat;
@@ -64,7 +73,7 @@ pub fn write_stream_file(path: &Path, stream: &FapStream) -> Result<()> {
     )?;
     if format == OutputFormat::Json {
         let text = serde_json::to_string_pretty(stream)
-            .map_err(|e| Error::Invalid(format!("cannot encode JSON: {e}")))?;
+            .map_err(|e| EncodeError::new("JSON", e))?;
         crate::io::write_atomic(path, format!("{text}\n").as_bytes())
     } else {
         write_fap_file(path, stream)

@@ -14,6 +14,7 @@
 //! ```
 
 mod convert;
+mod error;
 mod model;
 mod parse;
 mod summary;
@@ -21,6 +22,7 @@ mod timeline;
 mod write;
 
 pub use convert::{is_json_path, read_stream_file, write_stream_file};
+pub use error::FapError;
 pub use model::{
     ExpressionParams, FapFrame, FapMask, FapStream, VisemeParams, DEFAULT_VERSION,
     MAX_ABS_FAP_VALUE, MAX_FRAME_RATE, NUM_LOW_LEVEL,

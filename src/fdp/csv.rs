@@ -12,7 +12,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::error::{Error, Location, ParseError, Result};
+use crate::error::{EncodeError, Error, Location, ParseError, Result};
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
 use crate::spec::FeaturePointId;
 
@@ -241,7 +241,7 @@ pub fn parse_csv(file: &Path, text: &str) -> Result<FeaturePointTable> {
 /// Writes the table as CSV text (always with all four columns).
 pub fn to_csv_string(table: &FeaturePointTable) -> Result<String> {
     let mut w = ::csv::WriterBuilder::new().from_writer(Vec::new());
-    let enc = |e: ::csv::Error| Error::Invalid(format!("cannot encode CSV: {e}"));
+    let enc = |e: ::csv::Error| EncodeError::new("CSV", e);
     w.write_record(["fp", "vertices", "combine", "description"])
         .map_err(enc)?;
     for r in &table.rows {
@@ -256,8 +256,8 @@ pub fn to_csv_string(table: &FeaturePointTable) -> Result<String> {
     }
     let bytes = w
         .into_inner()
-        .map_err(|e| Error::Invalid(format!("cannot encode CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::Invalid(format!("cannot encode CSV: {e}")))
+        .map_err(|e| EncodeError::new("CSV", e))?;
+    String::from_utf8(bytes).map_err(|e| EncodeError::new("CSV", e).into())
 }
 
 /// Writes the table to `path` atomically.

@@ -65,7 +65,7 @@ impl FeaturePointFile {
     pub fn fapu(&self) -> Result<(FapuSource, FapuMeasurement)> {
         match self.fapu {
             Some(d) => {
-                let fapu = Fapu::from_distances(d).map_err(Error::Invalid)?;
+                let fapu = Fapu::from_distances(d)?;
                 Ok((
                     FapuSource::File,
                     FapuMeasurement {

@@ -71,12 +71,14 @@
 mod builder;
 pub mod container;
 mod document;
+mod error;
 pub mod json;
 mod layout;
 mod normals;
 mod scene_data;
 
 pub use builder::SceneBuilder;
+pub use error::GltfError;
 pub use container::{parse_glb, GlbChunks, GltfDocument};
 pub use normals::area_weighted_normals;
 pub use scene_data::{

@@ -24,7 +24,7 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 
 use super::text::{fail, integer, newline_or_eof, real, rest_of_line, unsigned, PErr, Res};
-use super::{FaceGroup, Mesh, Polygons};
+use super::{FaceGroup, Mesh, MeshError, Polygons};
 use crate::error::{Diagnostic, Error, Location, ParseError, Result, Severity};
 
 /// Warnings kept per file; the rest are counted in one last warning.
@@ -688,7 +688,7 @@ pub fn read_obj_positions_file(path: &Path) -> Result<Vec<Vec3>> {
 
 /// Writes `scene` as canonical OBJ text (see the module docs).
 ///
-/// Fails with [`Error::Invalid`] if the mesh is structurally invalid ([`Mesh::validate`]),
+/// Fails with a [`MeshError`] if the mesh is structurally invalid ([`Mesh::validate`]),
 /// holds non-finite numbers, or a name contains a line break — such a file could not be read
 /// back.
 pub fn write_obj_string(scene: &ObjScene) -> Result<String> {
@@ -704,19 +704,18 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
     let m = &scene.mesh;
     let v = m.validate();
     if !v.is_valid() {
-        return Err(Error::Invalid(format!(
-            "cannot write an invalid mesh as OBJ: {v:?}"
-        )));
+        return Err(MeshError::InvalidMesh {
+            details: format!("{v:?}"),
+        }
+        .into());
     }
     if m.polygons.iter().any(|p| p.len() < 3) {
-        return Err(Error::Invalid("OBJ faces need at least 3 corners".into()));
+        return Err(MeshError::DegenerateFace.into());
     }
     let finite2 = m.uvs.iter().all(|v| v.is_finite());
     let finite3 = m.normals.iter().chain(&m.colors).all(|v| v.is_finite());
     if !finite2 || !finite3 {
-        return Err(Error::Invalid(
-            "cannot write non-finite uvs, normals or colours".into(),
-        ));
+        return Err(MeshError::NonFiniteAttributes.into());
     }
     // A trailing `\` would read back as a line continuation.
     let bad_name = |s: &str| s.contains(['\n', '\r', '#']) || s.trim() != s || s.ends_with('\\');
@@ -729,10 +728,10 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
     });
     for n in names.chain(scene.material_libraries.iter().map(String::as_str)) {
         if bad_name(n) {
-            return Err(Error::Invalid(format!(
-                "name `{}` cannot be written to OBJ (line break, `#`, outer spaces or trailing `\\`)",
-                n.escape_debug()
-            )));
+            return Err(MeshError::UnwritableName {
+                name: n.escape_debug().to_string(),
+            }
+            .into());
         }
     }
     if m.groups
@@ -740,9 +739,7 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
         .flat_map(|g| &g.groups)
         .any(|g| g.is_empty() || g.contains([' ', '\t']))
     {
-        return Err(Error::Invalid(
-            "OBJ group names cannot be empty or contain spaces".into(),
-        ));
+        return Err(MeshError::BadGroupName.into());
     }
     Ok(())
 }

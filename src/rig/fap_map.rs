@@ -123,18 +123,18 @@ impl FapMap {
                         .map(|t| t.shape.as_str())
                         .filter(|s| names.find(s).is_none())
                         .collect();
-                    return Err(Error::Invalid(format!(
-                        "{}:{}: unknown shape{} {} (rig `{}` has no such blend shape)",
-                        file.display(),
-                        row.line,
-                        if missing.len() == 1 { "" } else { "s" },
-                        missing
+                    return Err(super::RigError::UnknownShapes {
+                        file: file.to_path_buf(),
+                        line: row.line,
+                        plural: missing.len() != 1,
+                        shapes: missing
                             .iter()
                             .map(|s| format!("`{s}`"))
                             .collect::<Vec<_>>()
                             .join(", "),
-                        rig.name
-                    )));
+                        rig: rig.name.clone(),
+                    }
+                    .into());
                 }
             }
         }

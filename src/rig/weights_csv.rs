@@ -155,10 +155,11 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
     };
     if let Some(f) = fps {
         if !(f.is_finite() && f > 0.0 && f <= 1000.0) {
-            return Err(crate::error::Error::Invalid(format!(
-                "{}: frame rate {f} is not between 0 and 1000",
-                file.display()
-            )));
+            return Err(super::RigError::CsvFrameRate {
+                file: file.to_path_buf(),
+                fps: f,
+            }
+            .into());
         }
     }
     let body_start = if text.starts_with('\u{feff}') { 3 } else { 0 };
@@ -335,10 +336,9 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
             let rate = match fps {
                 Some(f) => f,
                 None => rate_from_times(&t).ok_or_else(|| {
-                    crate::error::Error::Invalid(format!(
-                        "{}: cannot detect the frame rate (fewer than two distinct times); give --fps",
-                        file.display()
-                    ))
+                    super::RigError::UndetectableRate {
+                        file: file.to_path_buf(),
+                    }
                 })?,
             };
             (t, rate, fps.is_none())
@@ -353,10 +353,9 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
                     + 1.0
             } else {
                 fps.ok_or_else(|| {
-                    crate::error::Error::Invalid(format!(
-                        "{}: the timecodes never cross a second, so their frame rate cannot be detected; give --fps",
-                        file.display()
-                    ))
+                    super::RigError::UndetectableTimecodeRate {
+                        file: file.to_path_buf(),
+                    }
                 })?
             };
             let t: Vec<f64> = stamps

@@ -8,7 +8,8 @@ use glam::Vec3;
 use super::parts::{face_diagonal, fp_mesh_vertex};
 use super::Similarity;
 use crate::clone::CloneSurface;
-use crate::error::{Error, Result};
+use crate::clone::CloneError;
+use crate::error::Result;
 use crate::face::{FaceFrames, FaceModel};
 use crate::fdp::{Fapu, FeaturePoint, FeaturePointSet};
 use crate::mesh::find_coincident_vertices;
@@ -57,10 +58,11 @@ pub fn build_skin_surface(
     let diag = face_diagonal(face, &frames);
     let (positions, triangles, starts) = concatenate_skin(face, &frames, skin, frame);
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "face `{}`: skin vertex {i} has a non-finite position",
-            face.name
-        )));
+        return Err(CloneError::NonFiniteSkin {
+            face: face.name.clone(),
+            vertex: i,
+        }
+        .into());
     }
     let (fp_positions, fapu) = framed_feature_points(face, frame)?;
     // Weld, keeping the closed mouth apart.
@@ -141,7 +143,10 @@ fn framed_feature_points(
         }
     }
     let fapu = Fapu::from_feature_points(&fp_set)
-        .map_err(|e| Error::Invalid(format!("face `{}`: {e}", face.name)))?;
+        .map_err(|e| CloneError::Fapu {
+            face: face.name.clone(),
+            source: Box::new(e),
+        })?;
     Ok((fp_positions, fapu))
 }
 
