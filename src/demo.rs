@@ -254,9 +254,7 @@ fn measure(
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum DemoError {
     /// The bundled samples are not beside the working directory.
-    #[error(
-        "cannot find the bundled samples (samples/speech.fap); run from the fbakit checkout"
-    )]
+    #[error("cannot find the bundled samples (samples/speech.fap); run from the fbakit checkout")]
     SamplesNotFound,
 }
 

@@ -18,7 +18,7 @@ use crate::mesh::Mesh;
 use crate::spec::{FapId, FapuKind};
 
 pub use error::CandideError;
-pub use wfm::{read_wfm_file, read_wfm_str};
+pub use wfm::{parse_wfm, read_wfm_file, read_wfm_from};
 
 /// One animation unit: an action unit vector (`AUV..`) or an MPEG-4 FAP unit (`FAP..`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -164,10 +164,8 @@ pub fn parse_shape_spec(spec: &str) -> Result<Vec<(String, f32)>> {
             .parse()
             .ok()
             .filter(|v: &f32| v.is_finite())
-            .ok_or_else(|| {
-                CandideError::ShapeSpecValue {
-                    item: item.trim().to_string(),
-                }
+            .ok_or_else(|| CandideError::ShapeSpecValue {
+                item: item.trim().to_string(),
             })?;
         out.push((name.to_string(), value));
     }

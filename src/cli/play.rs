@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use fbakit::error::{Error, Result};
-use fbakit::export::{budget, ExportError};
 use fbakit::export::gltf::export_face_with_units;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
+use fbakit::export::{budget, ExportError};
 use fbakit::format::OutputFormat;
 use fbakit::player::{PlayOptions, Player};
 use fbakit::render::RenderOptions;

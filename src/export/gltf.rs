@@ -43,10 +43,10 @@ use glam::{Quat, Vec3};
 
 use super::ExportError;
 use crate::error::Result;
-use crate::fat::FatError;
 use crate::face::FaceModel;
 use crate::fat::eval::Activation;
 use crate::fat::morph::default_value;
+use crate::fat::FatError;
 use crate::fat::{interval_weights, TableKey, TransformField};
 use crate::gltf::{
     AnimationData, ChannelData, ChannelValues, GltfDocument, Interpolation, MaterialData, MeshData,
@@ -90,12 +90,12 @@ impl FaceMorphs {
                 return Err(FatError::NeutralTable { key: table.key }.into());
             }
             for m in &table.meshes {
-                let mi = face.mesh_index(&m.mesh).ok_or_else(|| {
-                    FatError::UnknownMesh {
+                let mi = face
+                    .mesh_index(&m.mesh)
+                    .ok_or_else(|| FatError::UnknownMesh {
                         key: table.key,
                         mesh: m.mesh.clone(),
-                    }
-                })?;
+                    })?;
                 let count = face.meshes[mi].mesh.vertex_count();
                 if let Some(bad) = m.coord_index.iter().find(|&&i| i as usize >= count) {
                     return Err(ExportError::CoordIndexOutOfRange {

@@ -75,10 +75,9 @@ impl FaceView {
             }
         }
         let meshes = render_meshes(&neutral, &parts);
-        let neutral_bounds = bounds(&meshes)
-            .ok_or_else(|| super::ExportError::NothingToDraw {
-                face: face.name.clone(),
-            })?;
+        let neutral_bounds = bounds(&meshes).ok_or_else(|| super::ExportError::NothingToDraw {
+            face: face.name.clone(),
+        })?;
         Ok(FaceView {
             parts,
             neutral_bounds,

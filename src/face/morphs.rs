@@ -138,27 +138,24 @@ pub struct MorphSetReport {
 /// Reads a manifest: a JSON object mapping morph file stems to FAP values.
 pub fn read_manifest(path: &Path) -> Result<BTreeMap<String, f64>> {
     let text = crate::io::read_text(path)?;
-    let map: BTreeMap<String, serde_json::Value> = serde_json::from_str(&text).map_err(|e| {
-        FaceError::ManifestSyntax {
+    let map: BTreeMap<String, serde_json::Value> =
+        serde_json::from_str(&text).map_err(|e| FaceError::ManifestSyntax {
             location: Location {
                 file: path.to_path_buf(),
                 line: e.line(),
                 column: e.column(),
             },
             message: e.to_string(),
-        }
-    })?;
+        })?;
     map.into_iter()
         .map(|(k, v)| {
             let x = v
                 .as_f64()
                 .filter(|x| x.is_finite() && *x != 0.0)
-                .ok_or_else(|| {
-                    FaceError::ManifestValue {
-                        file: path.to_path_buf(),
-                        name: k.clone(),
-                        value: v.to_string(),
-                    }
+                .ok_or_else(|| FaceError::ManifestValue {
+                    file: path.to_path_buf(),
+                    name: k.clone(),
+                    value: v.to_string(),
                 })?;
             Ok((k, x))
         })
@@ -195,9 +192,7 @@ pub fn face_from_morph_set(
     let mesh_name = face.meshes[0].name.clone();
     let tolerance = match options.tolerance {
         Some(t) if t.is_finite() && t >= 0.0 => t,
-        Some(t) => {
-            return Err(FaceError::BadTolerance { tolerance: t }.into())
-        }
+        Some(t) => return Err(FaceError::BadTolerance { tolerance: t }.into()),
         None => {
             let diag = neutral_mesh.bounds().map_or(1.0, |b| b.diagonal() as f64);
             DEFAULT_RELATIVE_TOLERANCE * diag
@@ -517,12 +512,13 @@ pub fn face_from_morph_meshes(
     let mut targets = Vec::with_capacity(morphs.len());
     for (key, value, m) in morphs {
         targets.push(
-            morph_target(*key, *value, name, &neutral, m, tolerance)
-                .map_err(|e| FaceError::Morph {
+            morph_target(*key, *value, name, &neutral, m, tolerance).map_err(|e| {
+                FaceError::Morph {
                     key: *key,
                     value: *value,
                     source: Box::new(e),
-                })?,
+                }
+            })?,
         );
     }
     let mut face = FaceModel::single_mesh(name, neutral);

@@ -54,6 +54,15 @@ impl FaceReadOptions {
 
 /// Reads a face from a file, or a bundled face by name (`alma`, `bruno`) when no file of
 /// that name exists. See the module docs.
+///
+/// ```
+/// let alma = fbakit::face::read("alma")?;
+/// assert!(!alma.fat.tables.is_empty());
+/// // Errors are typed: a missing file is an I/O error on that path, exit code 2 in the CLI.
+/// let err = fbakit::face::read("no-such-face.wrl").unwrap_err();
+/// assert!(err.is_input_error());
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
 pub fn read(path: impl AsRef<Path>) -> Result<FaceModel> {
     read_with(path.as_ref(), &FaceReadOptions::default()).map(|(face, _)| face)
 }
@@ -170,13 +179,13 @@ fn text_of(path: &Path, bytes: &[u8], expected: &str) -> Result<String> {
 }
 
 fn vrml_face(path: &Path, text: &str, name: &str) -> Result<(FaceModel, FaceReadReport)> {
-    let scene = crate::vrml::parse_vrml(path, text)?;
+    let scene = crate::vrml::parse_vrml(text, path)?;
     face_from_scene(scene, name)
 }
 
 fn obj_face(path: &Path, bytes: &[u8], name: &str) -> Result<(FaceModel, FaceReadReport)> {
     let text = text_of(path, bytes, "UTF-8 OBJ text")?;
-    let (obj, diagnostics) = crate::mesh::obj::read_obj_str(&text, path)?;
+    let (obj, diagnostics) = crate::mesh::obj::parse_obj(&text, path)?;
     let face = FaceModel::single_mesh(name, obj.mesh);
     let report = FaceReadReport {
         diagnostics,
@@ -201,7 +210,7 @@ fn candide(
     };
     // CANDIDE files carry Latin-1 author names in comments; only ASCII matters to the model.
     let text = String::from_utf8_lossy(bytes);
-    let model = crate::candide::read_wfm_str(&text, path)?;
+    let model = crate::candide::parse_wfm(&text, path)?;
     let points = crate::fdp::read_feature_points(fp)?.points;
     let face = super::candide::candide_face(&model, &points, &[])?;
     Ok((face, FaceReadReport::default()))

@@ -64,8 +64,8 @@ pub fn merged_mesh(
     for (mi, fm) in face.meshes.iter().enumerate() {
         let m = &fm.mesh;
         let frame = mesh_frames.get(mi).copied().unwrap_or(Affine3A::IDENTITY);
-        let base = u32::try_from(out.positions.len())
-            .map_err(|_| super::FaceError::TooManyVertices)?;
+        let base =
+            u32::try_from(out.positions.len()).map_err(|_| super::FaceError::TooManyVertices)?;
         let uv_base = out.uvs.len() as u32;
         let n_base = out.normals.len() as u32;
         out.groups.push(FaceGroup {

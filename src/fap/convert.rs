@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::model::FapStream;
-use super::parse::{read_fap_str, ReadMode, ReadOptions};
+use super::parse::{parse_fap, ReadMode, ReadOptions};
 use super::write::write_fap_file;
 use super::FapError;
 use crate::error::{Diagnostic, EncodeError, Error, Location, ParseError, Result, Severity};
@@ -18,10 +18,20 @@ pub fn is_json_path(path: &Path) -> bool {
 /// Reads a `.fap` or `.json` stream. JSON input is checked like `.fap` input: frame rate and
 /// frame order are errors; negative unidirectional values are errors in strict mode and
 /// unlocated warnings in lenient mode.
+///
+/// ```
+/// use fbakit::fap::{read_stream_file, ReadOptions};
+/// let (stream, warnings) = read_stream_file("samples/speech.fap".as_ref(), &ReadOptions::lenient())?;
+/// assert!(stream.frame_rate > 0.0);
+/// for w in &warnings {
+///     eprintln!("{w}"); // located: file:line:column: warning: ...
+/// }
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
 pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, Vec<Diagnostic>)> {
     let text = crate::io::read_text(path)?;
     if !is_json_path(path) {
-        return read_fap_str(&text, path, opts);
+        return parse_fap(&text, path, opts);
     }
     let stream: FapStream = serde_json::from_str(&text).map_err(|e| {
         Error::Parse(ParseError {
@@ -72,8 +82,7 @@ pub fn write_stream_file(path: &Path, stream: &FapStream) -> Result<()> {
         "a FAP stream",
     )?;
     if format == OutputFormat::Json {
-        let text = serde_json::to_string_pretty(stream)
-            .map_err(|e| EncodeError::new("JSON", e))?;
+        let text = serde_json::to_string_pretty(stream).map_err(|e| EncodeError::new("JSON", e))?;
         crate::io::write_atomic(path, format!("{text}\n").as_bytes())
     } else {
         write_fap_file(path, stream)

@@ -21,7 +21,9 @@ pub enum FatError {
         mesh: String,
     },
     /// A `coordIndex` entry beyond the mesh's vertices.
-    #[error("{key}: coordIndex {index} is out of range for mesh `{mesh}` with {vertex_count} vertices")]
+    #[error(
+        "{key}: coordIndex {index} is out of range for mesh `{mesh}` with {vertex_count} vertices"
+    )]
     CoordIndexOutOfRange {
         /// The table.
         key: TableKey,

@@ -156,11 +156,9 @@ impl FatEvaluator {
                 let mesh = meshes
                     .iter()
                     .position(|(name, _)| *name == m.mesh)
-                    .ok_or_else(|| {
-                        FatError::UnknownMesh {
-                            key: table.key,
-                            mesh: m.mesh.clone(),
-                        }
+                    .ok_or_else(|| FatError::UnknownMesh {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
                     })?;
                 let count = meshes[mesh].1;
                 if let Some(bad) = m.coord_index.iter().find(|&&i| i as usize >= count) {
@@ -193,11 +191,9 @@ impl FatEvaluator {
                 let transform = transforms
                     .iter()
                     .position(|name| *name == t.transform)
-                    .ok_or_else(|| {
-                        FatError::UnknownTransform {
-                            key: table.key,
-                            transform: t.transform.clone(),
-                        }
+                    .ok_or_else(|| FatError::UnknownTransform {
+                        key: table.key,
+                        transform: t.transform.clone(),
                     })?;
                 tables[slot].transforms.push(CompiledTransform {
                     transform,

@@ -113,11 +113,11 @@ impl FeaturePointTable {
 /// Reads a feature-point CSV file.
 pub fn read_csv_file(path: &Path) -> Result<FeaturePointTable> {
     let text = crate::io::read_text(path)?;
-    parse_csv(path, &text)
+    parse_csv(&text, path)
 }
 
 /// Parses feature-point CSV text; `file` is used in error locations only.
-pub fn parse_csv(file: &Path, text: &str) -> Result<FeaturePointTable> {
+pub fn parse_csv(text: &str, file: &Path) -> Result<FeaturePointTable> {
     let mut reader = ::csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
@@ -254,9 +254,7 @@ pub fn to_csv_string(table: &FeaturePointTable) -> Result<String> {
         ])
         .map_err(enc)?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| EncodeError::new("CSV", e))?;
+    let bytes = w.into_inner().map_err(|e| EncodeError::new("CSV", e))?;
     String::from_utf8(bytes).map_err(|e| EncodeError::new("CSV", e).into())
 }
 
@@ -271,7 +269,7 @@ mod tests {
     use proptest::prelude::*;
 
     fn parse(text: &str) -> Result<FeaturePointTable> {
-        parse_csv(Path::new("t.csv"), text)
+        parse_csv(text, Path::new("t.csv"))
     }
 
     #[test]

@@ -59,7 +59,9 @@ pub enum FdpError {
         vertex_count: usize,
     },
     /// Two landmarks name the same vertex.
-    #[error("{place}: landmark {landmark} repeats vertex {vertex} of landmark {first} ({first_place})")]
+    #[error(
+        "{place}: landmark {landmark} repeats vertex {vertex} of landmark {first} ({first_place})"
+    )]
     LandmarkRepeated {
         /// Where the repeat is written.
         place: String,
@@ -85,7 +87,10 @@ pub enum FdpError {
         file: PathBuf,
     },
     /// A landmark id is not a vertex index.
-    #[error("{place}: expected a vertex index (an integer from 0 to {}), found {found}", u32::MAX)]
+    #[error(
+        "{place}: expected a vertex index (an integer from 0 to {}), found {found}",
+        u32::MAX
+    )]
     BadVertexIndex {
         /// Where it is written.
         place: String,

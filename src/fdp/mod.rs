@@ -17,8 +17,8 @@ pub use error::FdpError;
 pub use fapu::{Fapu, FapuDistances, FapuMeasurement};
 pub use feature_points::{FeaturePoint, FeaturePointSet, VertexBinding};
 pub use file::{
-    detect_format, parse_feature_points, read_feature_points, FapuSource, FeaturePointFile,
-    FeaturePointFormat, FormatExtras,
+    detect_format, parse_feature_points, read_feature_points, read_feature_points_from, FapuSource,
+    FeaturePointFile, FeaturePointFormat, FormatExtras,
 };
 pub mod csv;
 pub mod xface;

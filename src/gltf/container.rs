@@ -52,8 +52,7 @@ impl GltfDocument {
             } else {
                 8 + bin_padded
             };
-        let total = u32::try_from(total)
-            .map_err(|_| GltfError::AssetTooLarge)?;
+        let total = u32::try_from(total).map_err(|_| GltfError::AssetTooLarge)?;
         let mut out = Vec::with_capacity(total as usize);
         for word in [GLB_MAGIC, GLB_VERSION, total, json.len() as u32, CHUNK_JSON] {
             out.extend_from_slice(&word.to_le_bytes());

@@ -50,8 +50,7 @@ pub(super) fn assemble(
     for a in animations {
         root.animations.push(animation_json(&mut out, a));
     }
-    let byte_length = u32::try_from(out.bin.len())
-        .map_err(|_| super::GltfError::BufferTooLarge)?;
+    let byte_length = u32::try_from(out.bin.len()).map_err(|_| super::GltfError::BufferTooLarge)?;
     if byte_length > 0 {
         root.buffers.push(json::Buffer {
             byte_length,

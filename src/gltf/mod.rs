@@ -78,8 +78,8 @@ mod normals;
 mod scene_data;
 
 pub use builder::SceneBuilder;
-pub use error::GltfError;
 pub use container::{parse_glb, GlbChunks, GltfDocument};
+pub use error::GltfError;
 pub use normals::area_weighted_normals;
 pub use scene_data::{
     AnimationData, ChannelData, ChannelValues, Interpolation, MaterialData, MeshData, MeshId,

@@ -17,7 +17,9 @@ pub enum MeshError {
     #[error("cannot write non-finite uvs, normals or colours")]
     NonFiniteAttributes,
     /// An object, group, material or library name that would not read back.
-    #[error("name `{name}` cannot be written to OBJ (line break, `#`, outer spaces or trailing `\\`)")]
+    #[error(
+        "name `{name}` cannot be written to OBJ (line break, `#`, outer spaces or trailing `\\`)"
+    )]
     UnwritableName {
         /// The name, escaped for display.
         name: String,

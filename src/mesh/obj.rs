@@ -390,7 +390,7 @@ impl Builder {
 }
 
 /// Reads OBJ text. `file` names the source in errors and diagnostics and gives the mesh name.
-pub fn read_obj_str(text: &str, file: &Path) -> Result<(ObjScene, Vec<Diagnostic>)> {
+pub fn parse_obj(text: &str, file: &Path) -> Result<(ObjScene, Vec<Diagnostic>)> {
     let mut warnings: Vec<Diagnostic> = Vec::new();
     let mut suppressed = 0usize;
     let mut warn = |at: &str, message: String, warnings: &mut Vec<Diagnostic>| {
@@ -611,18 +611,28 @@ fn to_error(e: nom::Err<PErr<'_>>, file: &Path, text: &str, default: &str) -> Er
 /// Reads an OBJ file (UTF-8, size-bounded by [`crate::io::read_text`]).
 pub fn read_obj_file(path: &Path) -> Result<(ObjScene, Vec<Diagnostic>)> {
     let text = crate::io::read_text(path)?;
-    read_obj_str(&text, path)
+    parse_obj(&text, path)
+}
+
+/// Reads OBJ from `reader` (UTF-8, bounded by [`crate::io::DEFAULT_MAX_INPUT_BYTES`]);
+/// `source` names it in locations and warnings.
+pub fn read_obj_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+) -> Result<(ObjScene, Vec<Diagnostic>)> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_obj(&text, source)
 }
 
 /// Vertex positions (`v` statements) of OBJ text, in order; everything else is skipped.
 ///
 /// For files known to share another file's faces (blend-shape OBJs): several times faster
-/// than [`read_obj_str`] because faces are not parsed. The same numbers are accepted (3, 4 or
+/// than [`parse_obj`] because faces are not parsed. The same numbers are accepted (3, 4 or
 /// 6 finite numbers after `v`); errors name file, line and column. Text with `\` line
-/// continuations goes through [`read_obj_str`].
-pub fn read_obj_positions_str(text: &str, file: &Path) -> Result<Vec<Vec3>> {
+/// continuations goes through [`parse_obj`].
+pub fn parse_obj_positions(text: &str, file: &Path) -> Result<Vec<Vec3>> {
     if text.contains("\\\n") || text.contains("\\\r\n") {
-        return read_obj_str(text, file).map(|(s, _)| s.mesh.positions);
+        return parse_obj(text, file).map(|(s, _)| s.mesh.positions);
     }
     let body = text.strip_prefix('\u{feff}').unwrap_or(text);
     let base = text.len() - body.len();
@@ -680,10 +690,10 @@ pub fn read_obj_positions_str(text: &str, file: &Path) -> Result<Vec<Vec3>> {
     Ok(out)
 }
 
-/// [`read_obj_positions_str`] on a file (UTF-8, size-bounded by [`crate::io::read_text`]).
+/// [`parse_obj_positions`] on a file (UTF-8, size-bounded by [`crate::io::read_text`]).
 pub fn read_obj_positions_file(path: &Path) -> Result<Vec<Vec3>> {
     let text = crate::io::read_text(path)?;
-    read_obj_positions_str(&text, path)
+    parse_obj_positions(&text, path)
 }
 
 /// Writes `scene` as canonical OBJ text (see the module docs).

@@ -124,6 +124,24 @@ impl<'a> Player<'a> {
     /// Errors: the face's FAT refers to unknown meshes/transforms, the stream's frame rate
     /// (or `opts.fps`) is not finite and positive, resampling would be too long, or the
     /// requested frame range is empty or starts after the last frame.
+    ///
+    /// ```
+    /// use fbakit::error::Error;
+    /// use fbakit::player::{PlayOptions, Player, PlayerError};
+    /// let face = fbakit::face::read("alma")?;
+    /// let (stream, _) = fbakit::fap::read_stream_file(
+    ///     "samples/speech.fap".as_ref(),
+    ///     &fbakit::fap::ReadOptions::lenient(),
+    /// )?;
+    /// let mut player = Player::new(&face, &stream, PlayOptions::default())?;
+    /// let mut frame = player.new_frame();
+    /// while player.next_frame(&mut frame) {}
+    /// // A frame range past the end is a typed error callers can match.
+    /// let opts = PlayOptions { frames: Some(1_000_000..1_000_001), ..PlayOptions::default() };
+    /// let err = Player::new(&face, &stream, opts).err().unwrap();
+    /// assert!(matches!(err, Error::Player(PlayerError::EmptyFrameRange { .. })));
+    /// # Ok::<(), Error>(())
+    /// ```
     pub fn new(face: &'a FaceModel, stream: &FapStream, opts: PlayOptions) -> Result<Player<'a>> {
         face.check_structure()?;
         let evaluator = face.evaluator()?;
@@ -146,11 +164,9 @@ impl<'a> Player<'a> {
                 .ok()
                 .and_then(|n| n.checked_add(1))
                 .filter(|&n| n as u64 <= crate::fap::MAX_RESAMPLED_FRAMES)
-                .ok_or_else(|| {
-                    PlayerError::FrameNumberTooLarge {
-                        frame: n,
-                        limit: crate::fap::MAX_RESAMPLED_FRAMES,
-                    }
+                .ok_or(PlayerError::FrameNumberTooLarge {
+                    frame: n,
+                    limit: crate::fap::MAX_RESAMPLED_FRAMES,
                 })?,
             None => 0,
         };

@@ -38,8 +38,8 @@ use glam::Vec3;
 pub use self::image::{
     contact_sheet, grid, Image, ImageStats, PixelRect, MAX_IMAGE_SIDE, THUMBNAIL_SIDE,
 };
-pub use error::RenderError;
 pub use colour::{linear_to_srgb, srgb_to_linear};
+pub use error::RenderError;
 pub use raster::render;
 
 use crate::mesh::Aabb;

@@ -84,7 +84,7 @@ pub struct WeightCsv {
 /// Reads a weight CSV file (bounded read); see [`parse_weights_csv`].
 pub fn read_weights_csv(path: &Path, fps: Option<f64>) -> Result<WeightCsv> {
     let text = crate::io::read_text(path)?;
-    parse_weights_csv(path, &text, fps)
+    parse_weights_csv(&text, path, fps)
 }
 
 /// One comma-separated field: its text (trimmed, quotes removed) and byte offset.
@@ -149,7 +149,7 @@ fn parse_timecode(s: &str) -> Option<Stamp> {
 
 /// Parses a weight CSV; `file` names it in errors, `fps` overrides the detected frame rate
 /// (and is the timecode rate when the capture never crosses a second). See the module docs.
-pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<WeightCsv> {
+pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<WeightCsv> {
     let err = |offset: usize, expected: String| -> crate::error::Error {
         ParseError::at_offset(file, text, offset, expected).into()
     };
@@ -335,10 +335,8 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
             let t: Vec<f64> = stamps.iter().map(|(s, _)| s.seconds).collect();
             let rate = match fps {
                 Some(f) => f,
-                None => rate_from_times(&t).ok_or_else(|| {
-                    super::RigError::UndetectableRate {
-                        file: file.to_path_buf(),
-                    }
+                None => rate_from_times(&t).ok_or_else(|| super::RigError::UndetectableRate {
+                    file: file.to_path_buf(),
                 })?,
             };
             (t, rate, fps.is_none())
@@ -352,10 +350,8 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
                     .fold(0.0, f64::max)
                     + 1.0
             } else {
-                fps.ok_or_else(|| {
-                    super::RigError::UndetectableTimecodeRate {
-                        file: file.to_path_buf(),
-                    }
+                fps.ok_or_else(|| super::RigError::UndetectableTimecodeRate {
+                    file: file.to_path_buf(),
                 })?
             };
             let t: Vec<f64> = stamps
@@ -504,7 +500,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str, fps: Option<f64>) -> Result<WeightCsv> {
-        parse_weights_csv(Path::new("w.csv"), text, fps)
+        parse_weights_csv(text, Path::new("w.csv"), fps)
     }
 
     fn message(text: &str) -> String {

@@ -239,9 +239,7 @@ pub fn speak(text: &str, voice: &str) -> Result<Utterance> {
     let c_text = CString::new(text).map_err(|_| SpeechError::NulInText)?;
     let c_voice = CString::new(voice).map_err(|_| SpeechError::NulInVoice)?;
     let engine = ENGINE.get_or_init(load).as_ref().map_err(|e| missing(e))?;
-    let engine = engine
-        .lock()
-        .map_err(|_| SpeechError::EngineFailed)?;
+    let engine = engine.lock().map_err(|_| SpeechError::EngineFailed)?;
     if unsafe { (engine.set_voice)(c_voice.as_ptr()) } != EE_OK {
         return Err(SpeechError::UnknownVoice {
             voice: voice.to_string(),
@@ -266,10 +264,7 @@ pub fn speak(text: &str, voice: &str) -> Result<Utterance> {
     let collected = COLLECTOR.lock().map_err(|_| poisoned())?.take();
     let collected = collected.unwrap_or_default();
     if status != EE_OK {
-        return Err(SpeechError::SynthesisFailed {
-            status,
-        }
-        .into());
+        return Err(SpeechError::SynthesisFailed { status }.into());
     }
     if collected.samples.len() >= MAX_SAMPLES {
         return Err(SpeechError::TooLong.into());

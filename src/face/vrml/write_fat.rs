@@ -46,12 +46,13 @@ pub(super) fn table_nodes(
             .push(("highLevelSelect".into(), FieldValue::SFInt32(select as i32)));
         let mut mesh_refs = Vec::new();
         for m in &table.meshes {
-            let target = *mesh_node_of.get(m.mesh.as_str()).ok_or_else(|| {
-                FaceError::FatMeshNotInScene {
-                    key: table.key,
-                    mesh: m.mesh.clone(),
-                }
-            })?;
+            let target =
+                *mesh_node_of
+                    .get(m.mesh.as_str())
+                    .ok_or_else(|| FaceError::FatMeshNotInScene {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
+                    })?;
             mesh_refs.push(def_mesh_node(m, target, table.key)?);
         }
         let mut transform_refs = Vec::new();

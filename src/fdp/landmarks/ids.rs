@@ -83,11 +83,11 @@ impl LandmarkIds {
 /// Reads a landmark id file (layout chosen by content: JSON when it starts with `{` or `[`).
 pub fn read_landmark_ids(path: &Path) -> Result<LandmarkIds> {
     let text = crate::io::read_text(path)?;
-    parse_landmark_ids(path, &text)
+    parse_landmark_ids(&text, path)
 }
 
 /// Parses landmark ids; `file` names the text in messages.
-pub fn parse_landmark_ids(file: &Path, text: &str) -> Result<LandmarkIds> {
+pub fn parse_landmark_ids(text: &str, file: &Path) -> Result<LandmarkIds> {
     let trimmed = text.trim_start_matches('\u{feff}').trim_start();
     if trimmed.starts_with('{') || trimmed.starts_with('[') {
         parse_json(file, text)
@@ -204,7 +204,7 @@ mod tests {
     use super::*;
 
     fn parse(name: &str, text: &str) -> Result<LandmarkIds> {
-        parse_landmark_ids(Path::new(name), text)
+        parse_landmark_ids(text, Path::new(name))
     }
 
     #[test]
