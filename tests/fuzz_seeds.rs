@@ -57,7 +57,7 @@ fn face(data: &[u8]) {
         return;
     };
     let name = FACE_NAMES[usize::from(pick) % FACE_NAMES.len()];
-    let _ = fbakit::face::read_bytes(name, content, &fbakit::face::FaceReadOptions::default());
+    let _ = fbakit::face::read_bytes(content, name, &fbakit::face::FaceReadOptions::default());
 }
 
 #[test]
@@ -66,7 +66,7 @@ fn face_seeds() {
     for seed in seeds("face") {
         let bytes = std::fs::read(&seed).unwrap();
         let name = FACE_NAMES[usize::from(bytes[0]) % FACE_NAMES.len()];
-        fbakit::face::read_bytes(name, &bytes[1..], &Default::default())
+        fbakit::face::read_bytes(&bytes[1..], name, &Default::default())
             .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
     }
     replay("face", face);

@@ -87,8 +87,8 @@ impl BundledFace {
     pub fn read(self) -> Result<(FaceModel, FaceReadReport)> {
         let Some(fp_text) = self.feature_point_text() else {
             return super::read::read_bytes(
-                &format!("{}.wrl.gz", self.name()),
                 self.bytes(),
+                format!("{}.wrl.gz", self.name()),
                 &super::read::FaceReadOptions::default(),
             );
         };

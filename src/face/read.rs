@@ -98,15 +98,15 @@ pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, Face
     read_bytes_at(path, &bytes, opts)
 }
 
-/// Reads a face held in memory; `name` stands for the file in messages and gives the face
-/// its name (`head.obj` → `head`), and its extension picks the format unless the content or
-/// [`FaceReadOptions::format`] does.
+/// Reads a face held in memory (data first, then its source name, as every reader); `source`
+/// stands for the file in messages and gives the face its name (`head.obj` → `head`), and its
+/// extension picks the format unless the content or [`FaceReadOptions::format`] does.
 pub fn read_bytes(
-    name: &str,
     bytes: &[u8],
+    source: impl AsRef<Path>,
     opts: &FaceReadOptions,
 ) -> Result<(FaceModel, FaceReadReport)> {
-    read_bytes_at(Path::new(name), bytes, opts)
+    read_bytes_at(source.as_ref(), bytes, opts)
 }
 
 fn read_bytes_at(
@@ -258,9 +258,9 @@ mod tests {
                 }
         );
         let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-        let (face, _) = read_bytes("tri", obj.as_bytes(), &FaceReadOptions::default()).unwrap();
+        let (face, _) = read_bytes(obj.as_bytes(), "tri", &FaceReadOptions::default()).unwrap();
         assert_eq!(face.vertex_count(), 3);
-        let e = read_bytes("x", b"hello", &FaceReadOptions::default()).unwrap_err();
+        let e = read_bytes(b"hello", "x", &FaceReadOptions::default()).unwrap_err();
         assert!(e.to_string().contains("not a face file"), "{e}");
         let e = read(dir.path()).unwrap_err();
         assert!(e.to_string().contains("is a directory"), "{e}");
@@ -270,8 +270,8 @@ mod tests {
     #[test]
     fn candide_needs_its_table() {
         let e = read_bytes(
-            "c.wfm",
             b"# VERTEX LIST:\n0\n# FACE LIST:\n0\n",
+            "c.wfm",
             &FaceReadOptions::default(),
         )
         .unwrap_err();
