@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use divan::counter::BytesCount;
-use fbakit::fap::{read_fap_str, write_fap_string, FapFrame, FapStream, ReadOptions};
+use fbakit::fap::{parse_fap, write_fap_string, FapFrame, FapStream, ReadOptions};
 use fbakit::spec::FapId;
 
 fn main() {
@@ -45,7 +45,7 @@ fn stream() -> FapStream {
 fn read_strict(bencher: divan::Bencher) {
     let text = write_fap_string(&stream());
     bencher.counter(BytesCount::new(text.len())).bench(|| {
-        read_fap_str(
+        parse_fap(
             divan::black_box(&text),
             Path::new("bench.fap"),
             &ReadOptions::strict(),
@@ -58,7 +58,7 @@ fn read_strict(bencher: divan::Bencher) {
 fn read_lenient(bencher: divan::Bencher) {
     let text = write_fap_string(&stream());
     bencher.counter(BytesCount::new(text.len())).bench(|| {
-        read_fap_str(
+        parse_fap(
             divan::black_box(&text),
             Path::new("bench.fap"),
             &ReadOptions::lenient(),

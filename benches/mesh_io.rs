@@ -4,7 +4,7 @@ use std::path::Path;
 
 use divan::counter::BytesCount;
 use divan::Bencher;
-use fbakit::mesh::obj::{read_obj_str, write_obj_string, ObjScene};
+use fbakit::mesh::obj::{parse_obj, write_obj_string, ObjScene};
 use fbakit::mesh::{Mesh, Polygons};
 use glam::{Vec2, Vec3};
 
@@ -59,5 +59,5 @@ fn read_obj_50k(bencher: Bencher) {
     let text = write_obj_string(&grid_scene()).unwrap();
     bencher
         .counter(BytesCount::new(text.len()))
-        .bench(|| read_obj_str(divan::black_box(&text), Path::new("grid.obj")).unwrap());
+        .bench(|| parse_obj(divan::black_box(&text), Path::new("grid.obj")).unwrap());
 }

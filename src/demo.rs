@@ -250,6 +250,21 @@ fn measure(
     ))
 }
 
+/// Why the demo cannot run. Bad input or setup (exit code 2), like every content error.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DemoError {
+    /// The bundled samples are not beside the working directory.
+    #[error("cannot find the bundled samples (samples/speech.fap); run from the fbakit checkout")]
+    SamplesNotFound,
+}
+
+impl DemoError {
+    /// Always true.
+    pub fn is_input_error(&self) -> bool {
+        true
+    }
+}
+
 /// The end-to-end demo on the bundled samples: source `alma` (full FAT), target `bruno`
 /// stripped to meshes and feature points; clones alma→bruno, plays `speech.fap` on alma and
 /// on the cloned bruno, and writes into `out_dir` (created):
@@ -266,13 +281,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     let mut clock = Clock::new();
     let samples = match &opts.samples_dir {
         Some(d) => d.clone(),
-        None => find_samples_dir().ok_or_else(|| {
-            Error::Invalid(
-                "cannot find the bundled samples (samples/speech.fap); run from the fbakit \
-                 checkout"
-                    .into(),
-            )
-        })?,
+        None => find_samples_dir().ok_or(DemoError::SamplesNotFound)?,
     };
     let stream_path = samples.join("speech.fap");
     let (stream, stream_warnings) = read_stream_file(&stream_path, &ReadOptions::lenient())?;

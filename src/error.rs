@@ -155,7 +155,34 @@ impl fmt::Display for Diagnostic {
     }
 }
 
+/// A value could not be serialised (JSON, CSV, WAV, ...) for an output: `cannot encode {what}:
+/// {message}`.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("cannot encode {what}: {message}")]
+pub struct EncodeError {
+    /// What was being encoded, e.g. `JSON` or `frames.json`.
+    pub what: String,
+    /// The encoder's message.
+    pub message: String,
+}
+
+impl EncodeError {
+    /// An encoding failure of `what` with the encoder's error `e`.
+    pub fn new(what: impl Into<String>, e: impl fmt::Display) -> Self {
+        EncodeError {
+            what: what.into(),
+            message: e.to_string(),
+        }
+    }
+}
+
 /// Every error the library returns.
+///
+/// Each layer has its own error enum ([`crate::fap::FapError`], [`crate::fdp::FdpError`],
+/// [`crate::face::FaceError`], ...) whose variants name the domain problem; this enum wraps
+/// them transparently, so `?` converts and the message is the layer's own. Callers that care
+/// about the kind `match` on the wrapped enum, e.g.
+/// `Error::Face(FaceError::NoFat { .. })`. Located syntax errors are [`Error::Parse`].
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Reading or writing a file failed.
@@ -170,7 +197,8 @@ pub enum Error {
     /// The input is not well-formed.
     #[error(transparent)]
     Parse(#[from] ParseError),
-    /// The input is well-formed but its content is unusable (e.g. a missing feature point).
+    /// The catch-all for content problems that have no more specific type yet (the cloning
+    /// code still uses it); new code uses its layer's error enum.
     #[error("{0}")]
     Invalid(String),
     /// The requested operation or format is not supported.
@@ -190,6 +218,58 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// An output path that cannot be used (unknown extension, an input, an occupied folder).
+    #[error(transparent)]
+    OutputPath(#[from] crate::format::OutputPathError),
+    /// A value could not be serialised.
+    #[error(transparent)]
+    Encode(#[from] EncodeError),
+    /// Bad command-line usage the argument parser cannot see (options that need each other
+    /// or name the same file).
+    #[error("{0}")]
+    Usage(String),
+    /// FAP streams.
+    #[error(transparent)]
+    Fap(#[from] crate::fap::FapError),
+    /// Feature points, FAP units and landmarks.
+    #[error(transparent)]
+    Fdp(#[from] crate::fdp::FdpError),
+    /// Meshes and OBJ.
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    /// The CANDIDE-3 model.
+    #[error(transparent)]
+    Candide(#[from] crate::candide::CandideError),
+    /// glTF containers and scenes.
+    #[error(transparent)]
+    Gltf(#[from] crate::gltf::GltfError),
+    /// Facial Animation Tables.
+    #[error(transparent)]
+    Fat(#[from] crate::fat::FatError),
+    /// Face models.
+    #[error(transparent)]
+    Face(#[from] crate::face::FaceError),
+    /// Blendshape rigs and the ARKit bridge.
+    #[error(transparent)]
+    Rig(#[from] crate::rig::RigError),
+    /// Speech synthesis.
+    #[error(transparent)]
+    Speech(#[from] crate::speech::SpeechError),
+    /// Cloning (whole-face alignment and assembly).
+    #[error(transparent)]
+    Clone(#[from] crate::clone::CloneError),
+    /// Playing a stream on a face.
+    #[error(transparent)]
+    Player(#[from] crate::player::PlayerError),
+    /// Outputs: glTF, viewer, pictures, videos.
+    #[error(transparent)]
+    Export(#[from] crate::export::ExportError),
+    /// Rendering.
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    /// The demo application.
+    #[error(transparent)]
+    Demo(#[from] crate::demo::DemoError),
 }
 
 impl Error {
@@ -223,6 +303,22 @@ impl Error {
             ),
             Error::Parse(_) | Error::Invalid(_) | Error::Unsupported(_) => true,
             Error::MissingTool(_) | Error::Output { .. } => false,
+            // Content and usage problems: bad input, exit code 2 (as `Invalid` was).
+            Error::OutputPath(_) | Error::Encode(_) | Error::Usage(_) => true,
+            Error::Fap(e) => e.is_input_error(),
+            Error::Fdp(e) => e.is_input_error(),
+            Error::Mesh(e) => e.is_input_error(),
+            Error::Candide(e) => e.is_input_error(),
+            Error::Gltf(e) => e.is_input_error(),
+            Error::Fat(e) => e.is_input_error(),
+            Error::Face(e) => e.is_input_error(),
+            Error::Rig(e) => e.is_input_error(),
+            Error::Speech(e) => e.is_input_error(),
+            Error::Clone(e) => e.is_input_error(),
+            Error::Player(e) => e.is_input_error(),
+            Error::Export(e) => e.is_input_error(),
+            Error::Render(e) => e.is_input_error(),
+            Error::Demo(e) => e.is_input_error(),
         }
     }
 }

@@ -10,7 +10,51 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
+
+/// An output path a command cannot use. All variants are input errors (exit code 2).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum OutputPathError {
+    /// The path's extension names no format the command writes.
+    #[error("{}: {what} must be {accepted}; found {found}", path.display())]
+    WrongFormat {
+        /// The output path.
+        path: PathBuf,
+        /// What is being written, e.g. "`fap convert` output".
+        what: String,
+        /// The accepted formats, comma-separated.
+        accepted: String,
+        /// What the path names instead.
+        found: String,
+    },
+    /// The output is one of the command's inputs.
+    #[error("{}: refusing to write over the input file; choose another output path", path.display())]
+    WouldOverwriteInput {
+        /// The output path.
+        path: PathBuf,
+    },
+    /// A folder output exists as a file.
+    #[error("{}: exists and is not a directory", path.display())]
+    NotADirectory {
+        /// The output path.
+        path: PathBuf,
+    },
+    /// A folder output holds something that is not a frame of an earlier run.
+    #[error("{}: exists and holds `{entry}`, which is not a frame of an earlier run; choose an empty or new directory", path.display())]
+    ForeignEntry {
+        /// The output folder.
+        path: PathBuf,
+        /// The entry that is not ours.
+        entry: String,
+    },
+}
+
+impl OutputPathError {
+    /// Always true: a bad output path is bad usage.
+    pub fn is_input_error(&self) -> bool {
+        true
+    }
+}
 
 /// A kind of file fbakit writes, named by its extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -102,11 +146,13 @@ impl OutputFormat {
                         None => "no extension".to_string(),
                     },
                 };
-                Err(Error::Invalid(format!(
-                    "{}: {what} must be {}; found {found}",
-                    path.display(),
-                    list.join(", ")
-                )))
+                Err(OutputPathError::WrongFormat {
+                    path: path.to_path_buf(),
+                    what: what.to_string(),
+                    accepted: list.join(", "),
+                    found,
+                }
+                .into())
             }
         }
     }
@@ -163,10 +209,10 @@ pub fn refuse_overwriting_input(output: &Path, inputs: &[&Path]) -> Result<()> {
     };
     for input in inputs {
         if std::fs::canonicalize(input).is_ok_and(|i| i == out) {
-            return Err(Error::Invalid(format!(
-                "{}: refusing to write over the input file; choose another output path",
-                output.display()
-            )));
+            return Err(OutputPathError::WouldOverwriteInput {
+                path: output.to_path_buf(),
+            }
+            .into());
         }
     }
     Ok(())

@@ -64,6 +64,31 @@ fn too_large(path: &Path, size: Option<u64>, max_bytes: u64) -> Error {
 /// Invalid UTF-8 is an error that names the byte offset of the first bad sequence.
 pub fn read_text(path: &Path) -> Result<String> {
     let bytes = read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
+    text_from_bytes(bytes, path)
+}
+
+/// Reads all of `reader` as UTF-8 text, refusing more than `max_bytes` (like
+/// [`read_bounded`]); `source` names the input in errors. The `read_*_from` readers of every
+/// format use it with [`DEFAULT_MAX_INPUT_BYTES`].
+pub fn read_text_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+    max_bytes: u64,
+) -> Result<String> {
+    let mut bytes = Vec::new();
+    // One byte past the limit tells an oversized input from one exactly at it.
+    reader
+        .take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(source, e))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_large(source, None, max_bytes));
+    }
+    text_from_bytes(bytes, source)
+}
+
+/// `bytes` as UTF-8 text; gzip data and invalid UTF-8 are located errors in `path`.
+fn text_from_bytes(bytes: Vec<u8>, path: &Path) -> Result<String> {
     // A compressed file where text was expected deserves a hint, not a byte value.
     if bytes.starts_with(&[0x1F, 0x8B]) {
         return Err(Error::Parse(crate::error::ParseError {
@@ -254,10 +279,10 @@ impl AtomicDir {
 pub fn open_frame_dir(path: &Path, is_ours: impl Fn(&str) -> bool) -> Result<AtomicDir> {
     if path.exists() {
         if !path.is_dir() {
-            return Err(Error::Invalid(format!(
-                "{}: exists and is not a directory",
-                path.display()
-            )));
+            return Err(crate::format::OutputPathError::NotADirectory {
+                path: path.to_path_buf(),
+            }
+            .into());
         }
         let entries = std::fs::read_dir(path).map_err(|e| Error::output(path, e))?;
         for entry in entries {
@@ -266,11 +291,11 @@ pub fn open_frame_dir(path: &Path, is_ours: impl Fn(&str) -> bool) -> Result<Ato
             let name = name.to_string_lossy();
             let is_file = entry.file_type().is_ok_and(|t| t.is_file());
             if !(is_file && is_ours(&name)) {
-                return Err(Error::Invalid(format!(
-                    "{}: exists and holds `{name}`, which is not a frame of an earlier \
-                     run; choose an empty or new directory",
-                    path.display()
-                )));
+                return Err(crate::format::OutputPathError::ForeignEntry {
+                    path: path.to_path_buf(),
+                    entry: name.into_owned(),
+                }
+                .into());
             }
         }
     }

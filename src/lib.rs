@@ -32,6 +32,26 @@
 //! - [`prelude`]: the names most programs need, in one `use fbakit::prelude::*`.
 //!
 //! `ARCHITECTURE.md` in the repository draws the layers and says where new things go.
+//!
+//! Reading a face and a stream and playing one on the other:
+//!
+//! ```
+//! use fbakit::prelude::*;
+//!
+//! let face = face::read("alma")?;
+//! let (stream, _warnings) = read_stream_file("samples/speech.fap".as_ref(), &ReadOptions::lenient())?;
+//! let mut player = Player::new(&face, &stream, PlayOptions::default())?;
+//! let mut frame = player.new_frame();
+//! let mut frames = 0;
+//! while player.next_frame(&mut frame) {
+//!     frames += 1; // frame.pose holds the posed meshes
+//! }
+//! assert_eq!(frames, player.frame_count());
+//! # Ok::<(), fbakit::error::Error>(())
+//! ```
+//!
+//! Errors are one [`error::Error`] wrapping a typed enum per layer, so `?` works everywhere
+//! and callers can `match` on what went wrong (e.g. `Error::Face(face::FaceError::..)`).
 
 pub mod candide;
 pub mod clone;

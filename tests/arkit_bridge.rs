@@ -161,7 +161,7 @@ fn synthetic_rig_round_trips_exactly() {
     let (face, calibration) = face_from_rig(&rig, Some(points), &FapMap::arkit()).unwrap();
     let text = "time,JawOpen,MouthSmileLeft,eyeBlink_L,HeadYaw\n\
                 0,0,0,0,0.1\n0.04,0.5,0.25,1,0.1\n0.08,1,1,0.5,0.1\n";
-    let csv = parse_weights_csv(Path::new("w.csv"), text, None).unwrap();
+    let csv = parse_weights_csv(text, Path::new("w.csv"), None).unwrap();
     assert_eq!(csv.fps, 25.0);
     let mut bridge = ArkitBridge::new(&rig, &face, &calibration).unwrap();
     let (stream, report) = bridge.weights_to_faps(&csv, "w").unwrap();
@@ -203,7 +203,7 @@ const CROSSTALK_TOLERANCE: f32 = 0.05;
 fn weights_round_trip_through_a_fap_stream() {
     let Some(ict) = ict() else { return };
     let text = weight_csv();
-    let csv = parse_weights_csv(Path::new("capture.csv"), &text, None).unwrap();
+    let csv = parse_weights_csv(&text, Path::new("capture.csv"), None).unwrap();
     assert_eq!(csv.fps, 60.0);
     assert_eq!(csv.rows.len(), 20);
     let mut bridge = ArkitBridge::new(&ict.rig, &ict.face, &ict.report).unwrap();
@@ -283,7 +283,7 @@ fn bundled_amplitudes_match_a_fresh_measurement() {
     let fresh = make_arkit_amplitudes::table_text(&ict.rig, &ict.face, &ict.report).unwrap();
     let path = Path::new(MANIFEST).join("specs/arkit-fap-amplitudes.csv");
     let parse = |name: &str, text: &str| {
-        fbakit::rig::arkit_amplitudes::parse_amplitudes(Path::new(name), text).unwrap()
+        fbakit::rig::arkit_amplitudes::parse_amplitudes(text, Path::new(name)).unwrap()
     };
     let fresh = parse("fresh", &fresh);
     let bundled = parse("bundled", &std::fs::read_to_string(&path).unwrap());
@@ -578,7 +578,7 @@ fn cli_round_trip_on_ict() {
     assert_eq!(header.split(',').count(), 53);
     assert_eq!(back.lines().count(), 21);
     // The written CSV reads back (60 fps given: 20 frames never cross a second).
-    let w = parse_weights_csv(&weights, &back, Some(60.0)).unwrap();
+    let w = parse_weights_csv(&back, &weights, Some(60.0)).unwrap();
     assert_eq!(w.rows.len(), 20);
     let jaw = w.columns.iter().position(|c| c.name == "JawOpen").unwrap();
     let got = w.rows[2].weights[jaw];
@@ -651,7 +651,7 @@ fn full_live_link_face_header_resolves_on_ict() {
     }
     let zeros = ",0".repeat(52 + 9);
     let text = format!("{header}\n00:00:00:00.000,61{zeros}\n00:00:00:01.000,61{zeros}\n");
-    let csv = parse_weights_csv(Path::new("llf.csv"), &text, Some(60.0)).unwrap();
+    let csv = parse_weights_csv(&text, Path::new("llf.csv"), Some(60.0)).unwrap();
     let bridge = ArkitBridge::new(&ict.rig, &ict.face, &ict.report).unwrap();
     let (stream, report) = bridge.weights_to_faps(&csv, "llf").unwrap();
     assert_eq!(stream.frames.len(), 2);

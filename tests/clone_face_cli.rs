@@ -1,12 +1,9 @@
 //! `fbakit clone` and `fbakit eval` end to end on the synthetic faces.
 
-use std::process::Command;
-
 use fbakit::face::vrml::write_face_file;
 
-fn fbakit() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-}
+mod support;
+use support::cli::command as fbakit;
 
 #[test]
 fn clone_writes_a_face_and_reports() {

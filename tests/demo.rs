@@ -2,10 +2,10 @@
 //! the `play … -o x.png`, `grid` and `demo` commands through the binary.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use std::sync::OnceLock;
 
 mod support;
+use support::cli::fbakit;
 use support::validator::validate;
 
 use fbakit::clone::face::Method;
@@ -15,14 +15,6 @@ use fbakit::face::FaceModel;
 use fbakit::fat::TableKey;
 use fbakit::render::{Image, ImageStats, PixelRect, RenderOptions};
 use fbakit::spec::Expression;
-
-fn fbakit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run fbakit")
-}
 
 /// Reads a PNG written by `Image::write_png` (8-bit RGBA) back into an [`Image`].
 fn read_png(path: &Path) -> Image {

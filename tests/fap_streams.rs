@@ -4,8 +4,7 @@ use std::path::{Path, PathBuf};
 
 use fbakit::error::Severity;
 use fbakit::fap::{
-    read_fap_file, read_fap_str, validate_fap_str, write_fap_string, FapFrame, FapStream,
-    ReadOptions,
+    parse_fap, read_fap_file, validate_fap_str, write_fap_string, FapFrame, FapStream, ReadOptions,
 };
 use fbakit::spec::FapId;
 
@@ -57,7 +56,7 @@ fn xface_files_read_leniently_and_round_trip() {
         assert_eq!(distinct.len(), masks, "{file}");
         // write -> read gives the model back.
         let text = write_fap_string(&s);
-        let (back, _) = read_fap_str(&text, Path::new("out.fap"), &ReadOptions::lenient()).unwrap();
+        let (back, _) = parse_fap(&text, Path::new("out.fap"), &ReadOptions::lenient()).unwrap();
         assert_eq!(back, s, "{file}");
     }
 }
@@ -132,7 +131,7 @@ fn text_of(faps: &[(u8, f64)]) -> FapStream {
 }
 
 fn strict_err(text: &str) -> String {
-    read_fap_str(text, Path::new("h.fap"), &ReadOptions::strict())
+    parse_fap(text, Path::new("h.fap"), &ReadOptions::strict())
         .unwrap_err()
         .to_string()
 }
@@ -156,7 +155,7 @@ fn hostile_inputs_are_located_errors() {
         .starts_with("h.fap:2:136: expected the value line"));
     assert!(strict_err("\u{1}\u{2}\u{3}\u{fffd}\u{0}").starts_with("h.fap:1:1: expected a header"));
     // Empty lenient read is still an error.
-    assert!(read_fap_str("", Path::new("e"), &ReadOptions::lenient()).is_err());
+    assert!(parse_fap("", Path::new("e"), &ReadOptions::lenient()).is_err());
 }
 
 #[test]
@@ -169,7 +168,7 @@ fn megabyte_single_line_is_read_linearly() {
         "{e}"
     );
     // Leniently the extra (all-zero) entries are ignored with one warning.
-    let (s, w) = read_fap_str(
+    let (s, w) = parse_fap(
         &format!("2.1 x 25 1\n{long}\n0\n"),
         Path::new("h.fap"),
         &ReadOptions::lenient(),
@@ -282,7 +281,7 @@ mod round_trip {
         #[test]
         fn write_then_strict_read_is_identity(s in stream()) {
             let text = write_fap_string(&s);
-            let (back, w) = read_fap_str(&text, Path::new("p.fap"), &ReadOptions::strict()).unwrap();
+            let (back, w) = parse_fap(&text, Path::new("p.fap"), &ReadOptions::strict()).unwrap();
             prop_assert!(w.is_empty());
             prop_assert_eq!(&back, &s);
             // And the JSON view round-trips too.
@@ -308,7 +307,7 @@ fn committed_samples_match_the_generator() {
             committed, text,
             "{file} drifted: run `cargo run --example make_sample_faps`"
         );
-        let (s, w) = read_fap_str(&text, Path::new(file), &ReadOptions::strict()).unwrap();
+        let (s, w) = parse_fap(&text, Path::new(file), &ReadOptions::strict()).unwrap();
         assert!(w.is_empty());
         // Comments aside, the samples are in canonical form.
         let body: String = text
@@ -334,14 +333,13 @@ fn fuzz_regressions_replay() {
         };
         n += 1;
         let p = Path::new("fuzz.fap");
-        if let Ok((s, _)) = read_fap_str(text, p, &ReadOptions::strict()) {
-            let (back, _) = read_fap_str(&write_fap_string(&s), p, &ReadOptions::strict()).unwrap();
+        if let Ok((s, _)) = parse_fap(text, p, &ReadOptions::strict()) {
+            let (back, _) = parse_fap(&write_fap_string(&s), p, &ReadOptions::strict()).unwrap();
             assert_eq!(back, s, "{}", path.display());
             assert!(validate_fap_str(text, p).is_empty(), "{}", path.display());
         }
-        if let Ok((s, _)) = read_fap_str(text, p, &ReadOptions::lenient()) {
-            let (back, _) =
-                read_fap_str(&write_fap_string(&s), p, &ReadOptions::lenient()).unwrap();
+        if let Ok((s, _)) = parse_fap(text, p, &ReadOptions::lenient()) {
+            let (back, _) = parse_fap(&write_fap_string(&s), p, &ReadOptions::lenient()).unwrap();
             assert_eq!(back, s, "{}", path.display());
         }
         let _ = validate_fap_str(text, p);

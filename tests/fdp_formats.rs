@@ -2,13 +2,14 @@
 //! `fbakit fapu` command and hostile inputs.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use fbakit::fdp::csv::{parse_csv, to_csv_string};
 use fbakit::fdp::xml::{parse_xml, to_xml_string, FeaturePointDocument};
 use fbakit::fdp::{read_feature_points, Fapu, FapuSource, FeaturePointFormat, FormatExtras};
 use fbakit::spec::{FapId, FeaturePointId};
 use glam::Vec3;
+
+mod support;
 
 const MANIFEST: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -161,9 +162,9 @@ fn candide3_csv_round_trips() {
         return;
     };
     let text = std::fs::read_to_string(&csv).unwrap();
-    let t = parse_csv(&csv, &text).unwrap();
+    let t = parse_csv(&text, &csv).unwrap();
     let written = to_csv_string(&t).unwrap();
-    assert_eq!(parse_csv(Path::new("w.csv"), &written).unwrap(), t);
+    assert_eq!(parse_csv(&written, Path::new("w.csv")).unwrap(), t);
 }
 
 #[test]
@@ -173,8 +174,8 @@ fn sample_xml_round_trips_and_measures() {
     assert_eq!(file.format, FeaturePointFormat::FbakitXml);
     assert_eq!(file.points.len(), 21);
     let text = std::fs::read_to_string(&path).unwrap();
-    let doc = parse_xml(&path, &text).unwrap();
-    let again = parse_xml(Path::new("w.xml"), &to_xml_string(&doc)).unwrap();
+    let doc = parse_xml(&text, &path).unwrap();
+    let again = parse_xml(&to_xml_string(&doc), Path::new("w.xml")).unwrap();
     assert_eq!(again, doc);
     let (source, m) = file.fapu().unwrap();
     assert_eq!(source, FapuSource::FeaturePoints);
@@ -210,11 +211,7 @@ fn write_and_read_files_atomically() {
 // --- CLI ---------------------------------------------------------------------------------
 
 fn fbakit(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(MANIFEST)
-        .output()
-        .unwrap();
+    let out = support::cli::fbakit(args);
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8(out.stdout).unwrap(),
@@ -399,7 +396,7 @@ fn fuzz_regressions_replay() {
                 _ => "f.csv",
             };
             // Must not panic; the result itself does not matter.
-            let _ = fbakit::fdp::parse_feature_points(Path::new(name), text);
+            let _ = fbakit::fdp::parse_feature_points(text, Path::new(name));
         }
     }
 }

@@ -57,7 +57,7 @@ fn face(data: &[u8]) {
         return;
     };
     let name = FACE_NAMES[usize::from(pick) % FACE_NAMES.len()];
-    let _ = fbakit::face::read_bytes(name, content, &fbakit::face::FaceReadOptions::default());
+    let _ = fbakit::face::read_bytes(content, name, &fbakit::face::FaceReadOptions::default());
 }
 
 #[test]
@@ -66,7 +66,7 @@ fn face_seeds() {
     for seed in seeds("face") {
         let bytes = std::fs::read(&seed).unwrap();
         let name = FACE_NAMES[usize::from(bytes[0]) % FACE_NAMES.len()];
-        fbakit::face::read_bytes(name, &bytes[1..], &Default::default())
+        fbakit::face::read_bytes(&bytes[1..], name, &Default::default())
             .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
     }
     replay("face", face);
@@ -90,7 +90,7 @@ fn landmark_ids_seeds() {
         let Ok(text) = std::str::from_utf8(d) else {
             return;
         };
-        if let Ok(ids) = fbakit::fdp::landmarks::parse_landmark_ids(Path::new("fuzz.json"), text) {
+        if let Ok(ids) = fbakit::fdp::landmarks::parse_landmark_ids(text, Path::new("fuzz.json")) {
             let _ = ids.check(68, 1000, "iBUG-68 landmarks");
             let _ = ids.check(468, 468, "MediaPipe landmarks");
         }
@@ -101,7 +101,7 @@ fn landmark_ids_seeds() {
 fn weights_csv_seeds() {
     for seed in seeds("weights_csv") {
         let text = std::fs::read_to_string(&seed).unwrap();
-        fbakit::rig::weights_csv::parse_weights_csv(&seed, &text, None)
+        fbakit::rig::weights_csv::parse_weights_csv(&text, &seed, None)
             .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
     }
     replay("weights_csv", |d| {
@@ -109,7 +109,7 @@ fn weights_csv_seeds() {
             return;
         };
         let file = Path::new("fuzz.csv");
-        let _ = fbakit::rig::weights_csv::parse_weights_csv(file, text, None);
-        let _ = fbakit::rig::weights_csv::parse_weights_csv(file, text, Some(30.0));
+        let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, None);
+        let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, Some(30.0));
     });
 }

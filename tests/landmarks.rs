@@ -4,7 +4,6 @@
 //! Tests on `../shared/data` are skipped with a note when it is absent.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use fbakit::fdp::landmarks::{
     feature_points_from_landmarks, read_landmark_ids, LandmarkFeaturePoints, LandmarkScheme,
@@ -14,6 +13,9 @@ use fbakit::mesh::obj::read_obj_file;
 use fbakit::mesh::Mesh;
 use fbakit::spec::{FeaturePointId, Side};
 use glam::Vec3;
+
+mod support;
+use support::cli::fbakit;
 
 const MANIFEST: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -29,13 +31,6 @@ fn shared(rel: &str) -> Option<PathBuf> {
 
 fn fp(s: &str) -> FeaturePointId {
     s.parse().unwrap()
-}
-
-fn fbakit(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .output()
-        .unwrap()
 }
 
 fn mesh(path: &Path) -> Mesh {

@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use fbakit::candide::read_wfm_str;
-use fbakit::mesh::obj::{read_obj_str, write_obj_string};
+use fbakit::candide::parse_wfm;
+use fbakit::mesh::obj::{parse_obj, write_obj_string};
 
 fn inputs(target: &str) -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -25,12 +25,12 @@ fn obj_regressions() {
         let Ok(text) = std::str::from_utf8(&bytes) else {
             continue;
         };
-        let Ok((scene, _)) = read_obj_str(text, Path::new("fuzz.obj")) else {
+        let Ok((scene, _)) = parse_obj(text, Path::new("fuzz.obj")) else {
             continue;
         };
         let _ = scene.mesh.triangles();
         if let Ok(out) = write_obj_string(&scene) {
-            let (again, _) = read_obj_str(&out, Path::new("fuzz.obj")).unwrap();
+            let (again, _) = parse_obj(&out, Path::new("fuzz.obj")).unwrap();
             assert_eq!(again, scene, "{}", f.display());
         }
     }
@@ -43,7 +43,7 @@ fn wfm_regressions() {
         let Ok(text) = std::str::from_utf8(&bytes) else {
             continue;
         };
-        let Ok(model) = read_wfm_str(text, Path::new("fuzz.wfm")) else {
+        let Ok(model) = parse_wfm(text, Path::new("fuzz.wfm")) else {
             continue;
         };
         assert!(model.to_mesh().validate().is_valid(), "{}", f.display());

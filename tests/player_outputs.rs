@@ -2,18 +2,12 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::{Command, Output};
 
 use fbakit::fap::{read_fap_file, ReadOptions};
 use fbakit::player::{PlayOptions, Player};
 
-fn fbakit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run fbakit")
-}
+mod support;
+use support::cli::fbakit;
 
 /// Per frame: per mesh the summed and largest displacement length, per transform the rotation
 /// angle (degrees) — enough to see speech open the mouth, blink and smile.

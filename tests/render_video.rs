@@ -8,17 +8,12 @@ use std::process::{Command, Output};
 use fbakit::export::video::ffmpeg_available;
 use fbakit::fap::{read_fap_file, write_fap_file, ReadOptions};
 
+mod support;
+use support::cli::fbakit;
+
 /// Frames of the short test stream (the first 12 of `samples/speech.fap`, at 25 fps).
 const FRAMES: u64 = 12;
 const FPS: f64 = 25.0;
-
-fn fbakit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run fbakit")
-}
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

@@ -231,8 +231,8 @@ fn custom_map_naming_missing_shapes_is_located() {
     let (rig, _) = synthetic_rig();
     let p = Path::new("custom.csv");
     let map = parse_fap_map(
-        p,
         "fap,positive,negative,reasoning\nopen_jaw,jawOpen,,ok\nraise_l_cornerlip,grin,,no\n",
+        p,
     )
     .unwrap();
     let e = map.check_against(&rig, p).unwrap_err().to_string();
@@ -418,8 +418,8 @@ fn custom_map_lists_faps_it_has_no_row_for() {
     let (rig, points) = synthetic_rig();
     let p = Path::new("custom.csv");
     let map = parse_fap_map(
-        p,
         "fap,positive,negative,reasoning\nopen_jaw,jawOpen,,the jaw\nviseme_10,aa,,VRM aa\n",
+        p,
     )
     .unwrap();
     map.check_against(&rig, p).unwrap();

@@ -9,13 +9,8 @@ use std::process::{Command, Output};
 use fbakit::fap::{read_fap_file, ReadOptions};
 use fbakit::speech::{espeak_available, say, SpeechOptions};
 
-fn fbakit(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run fbakit")
-}
+mod support;
+use support::cli::fbakit_in as fbakit;
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

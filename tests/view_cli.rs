@@ -1,15 +1,10 @@
 //! `fbakit view` through the real binary: the page it writes, its report, and what it refuses.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn fbakit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbakit"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run fbakit")
-}
+mod support;
+use support::cli::fbakit;
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

@@ -226,7 +226,7 @@ proptest! {
             }
         }
         let text = write_vrml_string(&s);
-        let again = parse_vrml(Path::new("gen.wrl"), &text)
+        let again = parse_vrml(&text, Path::new("gen.wrl"))
             .map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
         prop_assert_eq!(&again, &s, "{}", text);
         prop_assert_eq!(write_vrml_string(&again), text);

@@ -13,5 +13,5 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let name = NAMES[usize::from(pick) % NAMES.len()];
-    let _ = fbakit::face::read_bytes(name, content, &fbakit::face::FaceReadOptions::default());
+    let _ = fbakit::face::read_bytes(content, name, &fbakit::face::FaceReadOptions::default());
 });

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use fbakit::fap::{read_fap_str, validate_fap_str, write_fap_string, ReadOptions};
+use fbakit::fap::{parse_fap, validate_fap_str, write_fap_string, ReadOptions};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -13,17 +13,17 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let p = Path::new("fuzz.fap");
-    if let Ok((s, _)) = read_fap_str(text, p, &ReadOptions::strict()) {
+    if let Ok((s, _)) = parse_fap(text, p, &ReadOptions::strict()) {
         let out = write_fap_string(&s);
-        let (back, w) = read_fap_str(&out, p, &ReadOptions::strict())
+        let (back, w) = parse_fap(&out, p, &ReadOptions::strict())
             .expect("canonical output of a strict stream reads strictly");
         assert!(w.is_empty());
         assert_eq!(back, s);
         assert!(validate_fap_str(text, p).is_empty(), "strict-valid text has no findings");
     }
-    if let Ok((s, _)) = read_fap_str(text, p, &ReadOptions::lenient()) {
+    if let Ok((s, _)) = parse_fap(text, p, &ReadOptions::lenient()) {
         let out = write_fap_string(&s);
-        let (back, _) = read_fap_str(&out, p, &ReadOptions::lenient())
+        let (back, _) = parse_fap(&out, p, &ReadOptions::lenient())
             .expect("canonical output of a lenient stream reads leniently");
         assert_eq!(back, s);
     }

@@ -9,13 +9,13 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let parsed = fbakit::fdp::xml::parse_xml(Path::new("f.xml"), text);
+    let parsed = fbakit::fdp::xml::parse_xml(text, Path::new("f.xml"));
     if let Ok(doc) = parsed {
         let text2 = fbakit::fdp::xml::to_xml_string(&doc);
-        let back = fbakit::fdp::xml::parse_xml(Path::new("w.xml"), &text2)
+        let back = fbakit::fdp::xml::parse_xml(&text2, Path::new("w.xml"))
             .expect("written XML must read back");
         assert_eq!(back, doc);
     }
     // The format-detecting entry point must not panic either.
-    let _ = fbakit::fdp::parse_feature_points(Path::new("f.xml"), text);
+    let _ = fbakit::fdp::parse_feature_points(text, Path::new("f.xml"));
 });

@@ -9,13 +9,13 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let parsed = fbakit::fdp::csv::parse_csv(Path::new("f.csv"), text);
+    let parsed = fbakit::fdp::csv::parse_csv(text, Path::new("f.csv"));
     if let Ok(table) = parsed {
         let text2 = fbakit::fdp::csv::to_csv_string(&table).expect("CSV writes");
-        let back = fbakit::fdp::csv::parse_csv(Path::new("w.csv"), &text2)
+        let back = fbakit::fdp::csv::parse_csv(&text2, Path::new("w.csv"))
             .expect("written CSV must read back");
         assert_eq!(back, table);
     }
     // The format-detecting entry point must not panic either.
-    let _ = fbakit::fdp::parse_feature_points(Path::new("f.csv"), text);
+    let _ = fbakit::fdp::parse_feature_points(text, Path::new("f.csv"));
 });

@@ -10,7 +10,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    if let Ok(ids) = fbakit::fdp::landmarks::parse_landmark_ids(Path::new("fuzz.json"), text) {
+    if let Ok(ids) = fbakit::fdp::landmarks::parse_landmark_ids(text, Path::new("fuzz.json")) {
         let _ = ids.check(68, 1000, "iBUG-68 landmarks");
         let _ = ids.check(468, 468, "MediaPipe landmarks");
     }

@@ -10,13 +10,13 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let Ok((scene, _)) = fbakit::mesh::obj::read_obj_str(text, Path::new("fuzz.obj")) else {
+    let Ok((scene, _)) = fbakit::mesh::obj::parse_obj(text, Path::new("fuzz.obj")) else {
         return;
     };
     let _ = scene.mesh.triangles();
     let _ = scene.mesh.validate();
     if let Ok(out) = fbakit::mesh::obj::write_obj_string(&scene) {
-        let (again, _) = fbakit::mesh::obj::read_obj_str(&out, Path::new("fuzz.obj"))
+        let (again, _) = fbakit::mesh::obj::parse_obj(&out, Path::new("fuzz.obj"))
             .expect("written OBJ reads back");
         assert_eq!(again, scene);
     }

@@ -11,6 +11,6 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let file = Path::new("fuzz.csv");
-    let _ = fbakit::rig::weights_csv::parse_weights_csv(file, text, None);
-    let _ = fbakit::rig::weights_csv::parse_weights_csv(file, text, Some(30.0));
+    let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, None);
+    let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, Some(30.0));
 });

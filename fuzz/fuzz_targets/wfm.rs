@@ -10,7 +10,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let Ok(model) = fbakit::candide::read_wfm_str(text, Path::new("fuzz.wfm")) else {
+    let Ok(model) = fbakit::candide::parse_wfm(text, Path::new("fuzz.wfm")) else {
         return;
     };
     assert!(model.to_mesh().validate().is_valid());

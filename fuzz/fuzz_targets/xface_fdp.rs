@@ -9,10 +9,10 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let parsed = fbakit::fdp::xface::parse_xface(Path::new("f.fdp"), text);
+    let parsed = fbakit::fdp::xface::parse_xface(text, Path::new("f.fdp"));
     if let Ok(f) = parsed {
         let _ = f.to_set();
     }
     // The format-detecting entry point must not panic either.
-    let _ = fbakit::fdp::parse_feature_points(Path::new("f.fdp"), text);
+    let _ = fbakit::fdp::parse_feature_points(text, Path::new("f.fdp"));
 });

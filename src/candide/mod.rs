@@ -7,16 +7,18 @@
 //! face is `g = ḡ + S·σ + A·α`: each unit adds `value × displacement` to its vertices.
 //! Units are in the model's arbitrary length scale (head height ≈ 2).
 
+mod error;
 pub mod wfm;
 
 use glam::Vec3;
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::spec::{FapId, FapuKind};
 
-pub use wfm::{read_wfm_file, read_wfm_str};
+pub use error::CandideError;
+pub use wfm::{parse_wfm, read_wfm_file, read_wfm_from};
 
 /// One animation unit: an action unit vector (`AUV..`) or an MPEG-4 FAP unit (`FAP..`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -109,23 +111,25 @@ impl CandideModel {
         for (name, value) in values {
             let name = name.as_ref();
             if !value.is_finite() {
-                return Err(Error::Invalid(format!(
-                    "shape unit `{name}`: value {value} is not finite"
-                )));
+                return Err(CandideError::NonFiniteShapeValue {
+                    unit: name.to_string(),
+                    value: *value,
+                }
+                .into());
             }
             let unit = self.shape_unit(name).ok_or_else(|| {
                 let valid: Vec<&str> = self.shape_units.iter().map(|u| u.name.as_str()).collect();
-                Error::Invalid(format!(
-                    "unknown shape unit `{name}`; valid names: {}",
-                    valid.join(", ")
-                ))
+                CandideError::UnknownShapeUnit {
+                    name: name.to_string(),
+                    valid: valid.join(", "),
+                }
             })?;
             for &(v, d) in &unit.displacements {
                 let p = out.vertices.get_mut(v as usize).ok_or_else(|| {
-                    Error::Invalid(format!(
-                        "shape unit `{}` moves vertex {v}, which does not exist",
-                        unit.name
-                    ))
+                    CandideError::MissingVertex {
+                        unit: unit.name.clone(),
+                        vertex: v,
+                    }
                 })?;
                 *p += *value * d;
             }
@@ -150,29 +154,26 @@ pub fn parse_shape_spec(spec: &str) -> Result<Vec<(String, f32)>> {
         let (name, value) = item.rsplit_once('=').unwrap_or((&item, ""));
         let name = name.trim();
         if name.is_empty() {
-            return Err(Error::Invalid(format!(
-                "shape spec item `{}`: expected name=value",
-                item.trim()
-            )));
+            return Err(CandideError::ShapeSpecItem {
+                item: item.trim().to_string(),
+            }
+            .into());
         }
         let value: f32 = value
             .trim()
             .parse()
             .ok()
             .filter(|v: &f32| v.is_finite())
-            .ok_or_else(|| {
-                Error::Invalid(format!(
-                    "shape spec item `{}`: expected a finite number after `=`",
-                    item.trim()
-                ))
+            .ok_or_else(|| CandideError::ShapeSpecValue {
+                item: item.trim().to_string(),
             })?;
         out.push((name.to_string(), value));
     }
     if !pending.trim_matches([',', ' ']).is_empty() {
-        return Err(Error::Invalid(format!(
-            "shape spec item `{}`: expected name=value",
-            pending.trim_end_matches(',').trim()
-        )));
+        return Err(CandideError::ShapeSpecItem {
+            item: pending.trim_end_matches(',').trim().to_string(),
+        }
+        .into());
     }
     Ok(out)
 }

@@ -228,7 +228,7 @@ fn collapse_blanks(s: &str) -> String {
 }
 
 /// Reads `.wfm` text; `file` names the source in errors.
-pub fn read_wfm_str(text: &str, file: &Path) -> Result<CandideModel> {
+pub fn parse_wfm(text: &str, file: &Path) -> Result<CandideModel> {
     let err = |e: nom::Err<PErr<'_>>, default: &str| -> crate::error::Error {
         match e {
             nom::Err::Error(p) | nom::Err::Failure(p) => p.located(file, text, default).into(),
@@ -443,7 +443,14 @@ pub fn read_wfm_str(text: &str, file: &Path) -> Result<CandideModel> {
 /// Reads a `.wfm` file (UTF-8, size-bounded by [`crate::io::read_text`]).
 pub fn read_wfm_file(path: &Path) -> Result<CandideModel> {
     let text = crate::io::read_text(path)?;
-    read_wfm_str(&text, path)
+    parse_wfm(&text, path)
+}
+
+/// Reads a CANDIDE-3 model from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]); `source` names it in locations.
+pub fn read_wfm_from<R: std::io::BufRead>(reader: R, source: &Path) -> Result<CandideModel> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_wfm(&text, source)
 }
 
 #[cfg(test)]

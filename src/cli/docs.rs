@@ -60,7 +60,7 @@ struct ManReport {
 /// Writes one man page per command and subcommand.
 pub fn man(a: ManArgs) -> Result<u8> {
     if a.output.exists() && !a.output.is_dir() {
-        return Err(Error::Invalid(format!(
+        return Err(Error::Usage(format!(
             "{}: --output must be a directory (it is a file)",
             a.output.display()
         )));

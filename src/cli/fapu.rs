@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use fbakit::error::{Error, Result};
+use fbakit::error::Result;
 use fbakit::fdp::{read_feature_points, Fapu, FapuSource};
 use fbakit::spec::{FapuKind, FAPU_DIVISOR};
 use serde::Serialize;
@@ -56,10 +56,10 @@ pub fn run(args: FapuArgs) -> Result<u8> {
         None => {
             let file = read_feature_points(&args.file)?;
             if file.fapu.is_none() && file.points.needs_mesh() {
-                return Err(Error::Invalid(format!(
-                    "{}: the feature points are mesh-vertex indices without positions and the file has no FAPU distances; pass --mesh MESH with the neutral mesh they index",
-                    args.file.display()
-                )));
+                return Err(fbakit::fdp::FdpError::NeedsMesh {
+                    file: args.file.clone(),
+                }
+                .into());
             }
             file.fapu()?
         }

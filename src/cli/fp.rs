@@ -2,12 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use fbakit::error::{Error, Result};
+use fbakit::error::Result;
 use fbakit::fdp::landmarks::{
     feature_points_from_landmarks, read_landmark_ids, AbsentPoint, LandmarkIds, LandmarkScheme,
     PlacedPoint,
 };
-use fbakit::fdp::{Fapu, FapuDistances};
+use fbakit::fdp::{Fapu, FapuDistances, FdpError};
 use serde::Serialize;
 
 use super::{print_json, EXIT_OK};
@@ -107,11 +107,11 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
     };
     let face = fbakit::face::read(&args.mesh)?;
     let [only] = face.meshes.as_slice() else {
-        return Err(Error::Invalid(format!(
-            "{}: landmark ids index one mesh, but this face has {} meshes",
-            args.mesh.display(),
-            face.meshes.len()
-        )));
+        return Err(FdpError::LandmarksNeedOneMesh {
+            file: args.mesh.clone(),
+            meshes: face.meshes.len(),
+        }
+        .into());
     };
     let mesh = &only.mesh;
     let (ids, ids_name) = match &ids_path {
@@ -122,16 +122,16 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
         ),
     };
     if ids_path.is_none() && mesh.positions.len() < scheme.landmark_count() {
-        return Err(Error::Invalid(format!(
-            "{} has {} vertices; without landmark ids its vertex order is the landmark order, so it needs at least {}",
-            args.mesh.display(),
-            mesh.positions.len(),
-            scheme.landmark_count()
-        )));
+        return Err(FdpError::TooFewLandmarkVertices {
+            file: args.mesh.clone(),
+            vertices: mesh.positions.len(),
+            needed: scheme.landmark_count(),
+        }
+        .into());
     }
     ids.check(scheme.landmark_count(), mesh.positions.len(), &ids_name)?;
     let found = feature_points_from_landmarks(mesh, scheme, &ids.ids)
-        .map_err(|e| Error::Invalid(format!("{}: {e}", args.mesh.display())))?;
+        .map_err(|e| fbakit::face::FaceError::in_file(&args.mesh, e))?;
     let set = found.feature_point_set();
     let mut warnings = Vec::new();
     let fapu = match Fapu::from_feature_points(&set) {

@@ -407,7 +407,7 @@ pub fn print_text(text: &str) {
 /// Prints any serialisable value as pretty JSON on stdout.
 pub fn print_json<T: serde::Serialize>(value: &T) -> fbakit::error::Result<()> {
     let text = serde_json::to_string_pretty(value)
-        .map_err(|e| fbakit::error::Error::Invalid(format!("cannot encode JSON: {e}")))?;
+        .map_err(|e| fbakit::error::EncodeError::new("JSON", e))?;
     println!("{text}");
     Ok(())
 }

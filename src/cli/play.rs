@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use fbakit::error::{Error, Result};
-use fbakit::export::budget;
 use fbakit::export::gltf::export_face_with_units;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
+use fbakit::export::{budget, ExportError};
 use fbakit::format::OutputFormat;
 use fbakit::player::{PlayOptions, Player};
 use fbakit::render::RenderOptions;
@@ -267,10 +267,11 @@ pub fn run(a: PlayArgs) -> Result<u8> {
 
 /// Refuses an output estimated too large ([`budget::check`]), saying how to play less.
 pub fn check_budget(output: &Path, frames: &Range<usize>, bytes_per_frame: u64) -> Result<()> {
-    budget::check(output, frames, bytes_per_frame).map_err(|e| {
-        Error::Invalid(format!(
-            "{e}; play fewer with --frames a..b or a lower --fps"
-        ))
+    budget::check(output, frames, bytes_per_frame).map_err(|mut e| {
+        if let Error::Export(ExportError::OverBudget { advice, .. }) = &mut e {
+            *advice = "; play fewer with --frames a..b or a lower --fps".into();
+        }
+        e
     })
 }
 

@@ -154,10 +154,13 @@ pub fn write_video(
         VideoFormat::Mp4 => image / 16,
         _ => image,
     };
-    fbakit::export::budget::check(job.output, &span, per_frame).map_err(|e| {
-        Error::Invalid(format!(
-            "{e}; render fewer with a lower --fps or a shorter stream (`fbakit play --frames` cuts one)"
-        ))
+    fbakit::export::budget::check(job.output, &span, per_frame).map_err(|mut e| {
+        if let Error::Export(fbakit::export::ExportError::OverBudget { advice, .. }) = &mut e {
+            *advice = "; render fewer with a lower --fps or a shorter stream \
+                       (`fbakit play --frames` cuts one)"
+                .into();
+        }
+        e
     })?;
     let settings = VideoSettings {
         width: job.size.0,

@@ -93,7 +93,7 @@ struct SpeakReport {
 /// Runs `speak`.
 pub fn run(a: SpeakArgs) -> Result<u8> {
     if a.wav.as_ref() == Some(&a.output) {
-        return Err(Error::Invalid(
+        return Err(Error::Usage(
             "-o and --wav name the same file; give them different names".into(),
         ));
     }

@@ -63,7 +63,7 @@ pub fn run(a: ViewArgs) -> Result<u8> {
     inputs.extend(a.fp.as_deref());
     refuse_overwriting_input(&a.output, &inputs)?;
     if a.stream.is_none() && (a.fps.is_some() || a.frames.is_some()) {
-        return Err(Error::Invalid(
+        return Err(Error::Usage(
             "--fps and --frames need a STREAM to play".into(),
         ));
     }
@@ -83,7 +83,7 @@ pub fn run(a: ViewArgs) -> Result<u8> {
                 },
             )?;
             if player.frame_count() > fbakit::export::viewer::MAX_FRAMES {
-                return Err(Error::Invalid(format!(
+                return Err(Error::Usage(format!(
                     "{}: {} frames, more than the {} the viewer embeds; play fewer with \
                      --frames a..b or a lower --fps",
                     a.output.display(),

@@ -14,11 +14,14 @@
 //! points and its FAPU. Motions are sparse morph targets on that surface ([`SurfaceMotion`]).
 //! Rigid parts (eyes, teeth, tongue, head) move through transforms and are handled separately.
 
+mod error;
 pub mod eval;
 pub mod face;
 pub mod fmc;
 pub mod quality;
 pub mod rbf;
+
+pub use error::CloneError;
 
 use std::collections::BTreeMap;
 

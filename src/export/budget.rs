@@ -8,7 +8,7 @@
 use std::ops::Range;
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::FaceModel;
 
 /// Largest estimated output of one played stream: 2 GiB.
@@ -63,12 +63,15 @@ pub fn check(output: &Path, frames: &Range<usize>, bytes_per_frame: u64) -> Resu
     } else {
         return Ok(());
     };
-    Err(Error::Invalid(format!(
-        "{}: frames {}..{} are {n} frames, {over}",
-        output.display(),
-        frames.start,
-        frames.end
-    )))
+    Err(super::ExportError::OverBudget {
+        output: output.to_path_buf(),
+        start: frames.start,
+        end: frames.end,
+        frames: n,
+        over,
+        advice: String::new(),
+    }
+    .into())
 }
 
 #[cfg(test)]

@@ -41,10 +41,12 @@ use std::collections::BTreeMap;
 
 use glam::{Quat, Vec3};
 
-use crate::error::{Error, Result};
+use super::ExportError;
+use crate::error::Result;
 use crate::face::FaceModel;
 use crate::fat::eval::Activation;
 use crate::fat::morph::default_value;
+use crate::fat::FatError;
 use crate::fat::{interval_weights, TableKey, TransformField};
 use crate::gltf::{
     AnimationData, ChannelData, ChannelValues, GltfDocument, Interpolation, MaterialData, MeshData,
@@ -85,34 +87,34 @@ impl FaceMorphs {
         let mut meshes: Vec<Vec<MorphPiece>> = vec![Vec::new(); face.meshes.len()];
         for table in &face.fat.tables {
             if table.key.slot().is_none() {
-                return Err(Error::Invalid(format!(
-                    "{}: viseme 0 and the neutral expression cannot have tables",
-                    table.key
-                )));
+                return Err(FatError::NeutralTable { key: table.key }.into());
             }
             for m in &table.meshes {
-                let mi = face.mesh_index(&m.mesh).ok_or_else(|| {
-                    Error::Invalid(format!(
-                        "{}: FaceDefMesh refers to unknown mesh `{}`",
-                        table.key, m.mesh
-                    ))
-                })?;
+                let mi = face
+                    .mesh_index(&m.mesh)
+                    .ok_or_else(|| FatError::UnknownMesh {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
+                    })?;
                 let count = face.meshes[mi].mesh.vertex_count();
                 if let Some(bad) = m.coord_index.iter().find(|&&i| i as usize >= count) {
-                    return Err(Error::Invalid(format!(
-                        "{}: coordIndex {bad} is out of range for mesh `{}`",
-                        table.key, m.mesh
-                    )));
+                    return Err(ExportError::CoordIndexOutOfRange {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
+                        index: *bad,
+                    }
+                    .into());
                 }
                 let n = m.interval_count();
                 if n == 0 || m.displacements.len() != m.coord_index.len() * n {
-                    return Err(Error::Invalid(format!(
-                        "{}: mesh `{}` has {} displacements for {} vertices and {n} intervals",
-                        table.key,
-                        m.mesh,
-                        m.displacements.len(),
-                        m.coord_index.len()
-                    )));
+                    return Err(ExportError::DisplacementCount {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
+                        found: m.displacements.len(),
+                        vertices: m.coord_index.len(),
+                        intervals: n,
+                    }
+                    .into());
                 }
                 for j in 0..n {
                     let span = piece_span(table.key, &m.interval_borders, j);

@@ -15,12 +15,15 @@
 //! files lives here.
 
 pub mod budget;
+mod error;
 pub mod gltf;
 pub mod movie;
 pub mod obj_sequence;
 pub mod picture;
 pub mod video;
 pub mod viewer;
+
+pub use error::ExportError;
 
 use std::path::Path;
 

@@ -175,7 +175,7 @@ mod tests {
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/speech.fap"),
         )
         .unwrap();
-        let (mut stream, _) = crate::fap::read_fap_str(
+        let (mut stream, _) = crate::fap::parse_fap(
             &text,
             std::path::Path::new("speech.fap"),
             &crate::fap::ReadOptions::lenient(),

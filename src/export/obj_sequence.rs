@@ -116,7 +116,7 @@ impl ObjSequence {
     pub fn finish(self) -> Result<PathBuf> {
         let path = self.dir.path().join("frames.json");
         let text = serde_json::to_string_pretty(&self.index)
-            .map_err(|e| Error::Invalid(format!("cannot encode frames.json: {e}")))?;
+            .map_err(|e| crate::error::EncodeError::new("frames.json", e))?;
         crate::io::write_atomic(&self.dir.temp_path().join("frames.json"), text.as_bytes())
             .map_err(|e| named_output(e, &path))?;
         self.dir.commit()?;

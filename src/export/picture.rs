@@ -9,7 +9,7 @@
 use glam::Vec3;
 
 use crate::clone::face::{clone_face, CloneOptions, Method};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::parts::{split_mesh, FacePart};
 use crate::face::FaceModel;
 use crate::fap::FapStream;
@@ -75,8 +75,9 @@ impl FaceView {
             }
         }
         let meshes = render_meshes(&neutral, &parts);
-        let neutral_bounds = bounds(&meshes)
-            .ok_or_else(|| Error::Invalid(format!("face `{}` has no vertex to draw", face.name)))?;
+        let neutral_bounds = bounds(&meshes).ok_or_else(|| super::ExportError::NothingToDraw {
+            face: face.name.clone(),
+        })?;
         Ok(FaceView {
             parts,
             neutral_bounds,
@@ -334,9 +335,7 @@ pub(crate) fn cloning_grid_with(
     mut cloned: impl FnMut(usize, usize) -> Result<FaceModel>,
 ) -> Result<Image> {
     if faces.is_empty() {
-        return Err(Error::Invalid(
-            "the cloning grid needs at least one face".into(),
-        ));
+        return Err(super::ExportError::NoFaces.into());
     }
     let mut rows = Vec::with_capacity(faces.len());
     for (i, (src, src_face)) in faces.iter().enumerate() {

@@ -40,6 +40,7 @@ use std::thread::JoinHandle;
 
 use serde::Serialize;
 
+use super::ExportError;
 use crate::error::{Error, Result};
 use crate::format::OutputFormat;
 use crate::io::{AtomicDir, AtomicFile};
@@ -128,13 +129,10 @@ pub fn open_sink(
     settings: &VideoSettings,
 ) -> Result<Box<dyn FrameSink>> {
     if !(settings.fps.is_finite() && settings.fps > 0.0) {
-        return Err(Error::Invalid(format!(
-            "frame rate {} is not a finite positive number",
-            settings.fps
-        )));
+        return Err(ExportError::BadFrameRate { fps: settings.fps }.into());
     }
     if settings.width == 0 || settings.height == 0 {
-        return Err(Error::Invalid("video frames need a non-zero size".into()));
+        return Err(ExportError::ZeroSize.into());
     }
     if settings.audio.is_some() && format != VideoFormat::Mp4 {
         return Err(Error::Unsupported(
@@ -151,10 +149,13 @@ pub fn open_sink(
 /// Refuses a frame whose size differs from the sink's.
 fn check_size(frame: &Image, settings: &VideoSettings) -> Result<()> {
     if (frame.width, frame.height) != (settings.width, settings.height) {
-        return Err(Error::Invalid(format!(
-            "frame of {}x{} pixels in a {}x{} video",
-            frame.width, frame.height, settings.width, settings.height
-        )));
+        return Err(ExportError::FrameSize {
+            width: frame.width,
+            height: frame.height,
+            video_width: settings.width,
+            video_height: settings.height,
+        }
+        .into());
     }
     Ok(())
 }
@@ -244,10 +245,10 @@ impl Mp4Sink {
             // A missing or unreadable soundtrack is bad input, found before any rendering.
             std::fs::File::open(audio).map_err(|e| Error::io(audio, e))?;
             if audio.is_dir() {
-                return Err(Error::Invalid(format!(
-                    "{}: is a directory, not a sound file",
-                    audio.display()
-                )));
+                return Err(ExportError::AudioIsDirectory {
+                    path: audio.clone(),
+                }
+                .into());
             }
         }
         let out = AtomicFile::create(path, ".mp4")?;
@@ -330,7 +331,7 @@ impl FrameSink for Mp4Sink {
             self.rgb.extend_from_slice(&px[..3]);
         }
         let Some(stdin) = self.stdin.as_mut() else {
-            return Err(Error::Invalid(format!("{FFMPEG} is not running")));
+            return Err(ExportError::FfmpegNotRunning.into());
         };
         if let Err(e) = stdin.write_all(&self.rgb) {
             // A broken pipe means ffmpeg stopped; its own message says why.
@@ -349,7 +350,7 @@ impl FrameSink for Mp4Sink {
         let out = self
             .out
             .take()
-            .ok_or_else(|| Error::Invalid("the MP4 sink was already finished".into()))?;
+            .ok_or(ExportError::SinkFinished { sink: "MP4" })?;
         let path = out.path().to_path_buf();
         out.commit()?;
         let bytes = file_size(&path)?;
@@ -408,9 +409,10 @@ impl GifSink {
     /// Creates the temporary file and writes the GIF header.
     pub fn open(path: &Path, settings: &VideoSettings) -> Result<GifSink> {
         if settings.width > GIF_MAX_SIDE || settings.height > GIF_MAX_SIDE {
-            return Err(Error::Invalid(format!(
-                "a GIF is at most {GIF_MAX_SIDE} pixels on a side"
-            )));
+            return Err(ExportError::GifTooLarge {
+                limit: GIF_MAX_SIDE,
+            }
+            .into());
         }
         let mut out = AtomicFile::create(path, ".gif")?;
         let file = out.file().try_clone().map_err(|e| Error::output(path, e))?;
@@ -441,7 +443,7 @@ impl FrameSink for GifSink {
         let encoder = self
             .encoder
             .as_mut()
-            .ok_or_else(|| Error::Invalid("the GIF sink was already finished".into()))?;
+            .ok_or(ExportError::SinkFinished { sink: "GIF" })?;
         self.rgba.clear();
         self.rgba.extend_from_slice(&frame.rgba);
         let mut f = gif::Frame::from_rgba_speed(
@@ -462,7 +464,7 @@ impl FrameSink for GifSink {
         let out = self
             .out
             .take()
-            .ok_or_else(|| Error::Invalid("the GIF sink was already finished".into()))?;
+            .ok_or(ExportError::SinkFinished { sink: "GIF" })?;
         let path = out.path().to_path_buf();
         if let Some(encoder) = self.encoder.take() {
             // `into_inner` writes the trailer; the buffered writer is then flushed.
@@ -522,7 +524,7 @@ impl FrameSink for PngFolderSink {
         let dir = self
             .dir
             .as_ref()
-            .ok_or_else(|| Error::Invalid("the PNG sink was already finished".into()))?;
+            .ok_or(ExportError::SinkFinished { sink: "PNG" })?;
         let path = dir.temp_path().join(png_frame_name(self.frames));
         // Errors name the frame as it will be called, never the temporary directory.
         let named = || dir.path().join(png_frame_name(self.frames));
@@ -541,7 +543,7 @@ impl FrameSink for PngFolderSink {
         let dir = self
             .dir
             .take()
-            .ok_or_else(|| Error::Invalid("the PNG sink was already finished".into()))?;
+            .ok_or(ExportError::SinkFinished { sink: "PNG" })?;
         let path = dir.path().to_path_buf();
         dir.commit()?;
         Ok(VideoOutput {

@@ -34,7 +34,7 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::export::gltf::{export_face_with_units, FaceMorphs};
 use crate::face::FaceModel;
 use crate::fat::morph::default_value;
@@ -269,10 +269,11 @@ impl ViewerPage {
     pub fn new(face: &FaceModel, animation: Option<&ViewerAnimation<'_>>) -> Result<ViewerPage> {
         if let Some(a) = animation {
             if a.frames.len() > MAX_FRAMES {
-                return Err(Error::Invalid(format!(
-                    "the animation has {} frames; the viewer embeds at most {MAX_FRAMES}",
-                    a.frames.len()
-                )));
+                return Err(super::ExportError::TooManyViewerFrames {
+                    frames: a.frames.len(),
+                    limit: MAX_FRAMES,
+                }
+                .into());
             }
         }
         // The page places the camera, the feature points and the FAPU in the face's own
@@ -289,7 +290,7 @@ impl ViewerPage {
         }
         let glb = export.document.to_glb()?;
         let json = serde_json::to_string(&model)
-            .map_err(|e| Error::Invalid(format!("cannot encode the viewer data: {e}")))?;
+            .map_err(|e| crate::error::EncodeError::new("the viewer data", e))?;
         let html = assemble(&face.name, &json, &glb)?;
         Ok(ViewerPage {
             html,
@@ -356,10 +357,11 @@ impl ViewerModel {
             let slot = table.key.slot().unwrap_or(usize::MAX);
             for e in &table.transforms {
                 let Some(ti) = face.transform_index(&e.transform) else {
-                    return Err(Error::Invalid(format!(
-                        "{}: FaceDefTransform refers to unknown transform `{}`",
-                        table.key, e.transform
-                    )));
+                    return Err(crate::fat::FatError::UnknownTransform {
+                        key: table.key,
+                        transform: e.transform.clone(),
+                    }
+                    .into());
                 };
                 let axis = e.rotation_axis.try_normalize().unwrap_or(Vec3::Z);
                 let numbers = [
@@ -372,10 +374,11 @@ impl ViewerModel {
                     e.scale.z,
                 ];
                 if numbers.iter().any(|v| !v.is_finite()) {
-                    return Err(Error::Invalid(format!(
-                        "{}: FaceDefTransform of `{}` has a non-finite number",
-                        table.key, e.transform
-                    )));
+                    return Err(super::ExportError::NonFiniteTransform {
+                        key: table.key,
+                        transform: e.transform.clone(),
+                    }
+                    .into());
                 }
                 rigs.entry(ti).or_default().push((
                     slot,
@@ -458,9 +461,7 @@ fn finite(borders: &[f64], key: &TableKey) -> Result<()> {
     if borders.iter().all(|b| b.is_finite()) {
         Ok(())
     } else {
-        Err(Error::Invalid(format!(
-            "{key}: interval borders must be finite numbers"
-        )))
+        Err(super::ExportError::NonFiniteBorders { key: *key }.into())
     }
 }
 
@@ -676,9 +677,10 @@ fn assemble(title: &str, json: &str, glb: &[u8]) -> Result<String> {
     // Markers appear in the template in this order, each once (a unit test checks).
     for (marker, value) in parts {
         let Some(at) = rest.find(marker) else {
-            return Err(Error::Invalid(format!(
-                "viewer template has no {marker} marker"
-            )));
+            return Err(super::ExportError::TemplateMarker {
+                marker: marker.to_string(),
+            }
+            .into());
         };
         html.push_str(&rest[..at]);
         html.push_str(value);

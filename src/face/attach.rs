@@ -3,7 +3,7 @@
 
 use super::vrml::FeaturePointMatch;
 use super::FaceModel;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::vertex_index::FaceVertexIndex;
 use crate::fdp::FeaturePointSet;
 
@@ -40,11 +40,11 @@ pub fn attach_feature_points(
     }
     if !bad.is_empty() {
         let names: Vec<&str> = face.meshes.iter().map(|m| m.name.as_str()).collect();
-        return Err(Error::Invalid(format!(
-            "feature points bound to meshes the face does not have ({}); the face's meshes: {}",
-            bad.join(", "),
-            names.join(", ")
-        )));
+        return Err(super::FaceError::UnknownFeaturePointMeshes {
+            points: bad.join(", "),
+            meshes: names.join(", "),
+        }
+        .into());
     }
     face.feature_points = points;
     face.resolve_feature_points()?;
@@ -60,9 +60,7 @@ pub fn attach_feature_points(
         .collect();
     for (id, pos) in unbound {
         if !pos.is_finite() {
-            return Err(Error::Invalid(format!(
-                "feature point {id} has a non-finite position"
-            )));
+            return Err(super::FaceError::NonFiniteFeaturePoint { id }.into());
         }
         let Some((binding, found)) = index.bind(face, id, pos) else {
             continue;

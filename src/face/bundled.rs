@@ -87,15 +87,15 @@ impl BundledFace {
     pub fn read(self) -> Result<(FaceModel, FaceReadReport)> {
         let Some(fp_text) = self.feature_point_text() else {
             return super::read::read_bytes(
-                &format!("{}.wrl.gz", self.name()),
                 self.bytes(),
+                format!("{}.wrl.gz", self.name()),
                 &super::read::FaceReadOptions::default(),
             );
         };
         let glb = Path::new(self.sample_file());
         let rig = crate::rig::gltf_read::read_gltf_bytes(self.bytes(), glb)?;
         let fp_file = self.sample_feature_points().unwrap_or_default();
-        let points = crate::fdp::parse_feature_points(Path::new(fp_file), fp_text)?.points;
+        let points = crate::fdp::parse_feature_points(fp_text, Path::new(fp_file))?.points;
         let (mut face, _) = crate::rig::fat_build::face_from_rig(
             &rig,
             Some(points),

@@ -23,7 +23,7 @@
 use glam::Vec3;
 
 use crate::candide::CandideModel;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::FaceModel;
 use crate::fat::{FaceDefMesh, FaceDefTable, TableKey};
 use crate::fdp::{FeaturePointSet, VertexBinding};
@@ -70,9 +70,7 @@ pub fn candide_face_with_notes(
             if let Some(b) = p.binding.as_mut() {
                 b.mesh = Some(CANDIDE_MESH.into());
             } else if p.position.is_some() {
-                return Err(Error::Invalid(format!(
-                    "feature point {id} has a position but no CANDIDE vertex; the table must bind every point to vertices"
-                )));
+                return Err(super::FaceError::UnboundCandidePoint { id }.into());
             }
         }
     }
@@ -109,16 +107,18 @@ pub fn candide_face_with_notes(
         let mut displacements = Vec::with_capacity(unit.displacements.len());
         for &(v, d) in &unit.displacements {
             if v as usize >= n {
-                return Err(Error::Invalid(format!(
-                    "FAP unit {} moves vertex {v}, which does not exist",
-                    fap.number()
-                )));
+                return Err(super::FaceError::AnimationUnitVertex {
+                    fap: fap.number(),
+                    vertex: v,
+                }
+                .into());
             }
             if coord_index.contains(&v) {
-                return Err(Error::Invalid(format!(
-                    "FAP unit {} lists vertex {v} twice",
-                    fap.number()
-                )));
+                return Err(super::FaceError::AnimationUnitRepeat {
+                    fap: fap.number(),
+                    vertex: v,
+                }
+                .into());
             }
             coord_index.push(v);
             displacements.push((d.as_dvec3() * u).as_vec3());

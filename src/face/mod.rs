@@ -14,6 +14,7 @@
 pub mod attach;
 pub mod bundled;
 pub mod candide;
+mod error;
 pub mod format;
 mod from_rig;
 pub mod morphs;
@@ -29,6 +30,7 @@ pub mod vrml;
 pub mod write;
 
 pub use bundled::BundledFace;
+pub use error::FaceError;
 pub use format::FaceFormat;
 pub use pose::FacePose;
 pub use read::{read, read_bytes, read_with, FaceReadOptions};
@@ -40,7 +42,7 @@ use std::collections::HashMap;
 use glam::{Affine3A, Quat, Vec3};
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fat::eval::FatEvaluator;
 use crate::fat::Fat;
 use crate::fdp::{Fapu, FeaturePointSet};
@@ -286,22 +288,25 @@ impl FaceModel {
         let mut seen = HashMap::new();
         for m in &self.meshes {
             if seen.insert(m.name.as_str(), ()).is_some() {
-                return Err(Error::Invalid(format!("two meshes are named `{}`", m.name)));
+                return Err(FaceError::DuplicateMesh {
+                    name: m.name.clone(),
+                }
+                .into());
             }
         }
         let mut seen = HashMap::new();
         for (i, t) in self.transforms.iter().enumerate() {
             if seen.insert(t.name.as_str(), ()).is_some() {
-                return Err(Error::Invalid(format!(
-                    "two transforms are named `{}`",
-                    t.name
-                )));
+                return Err(FaceError::DuplicateTransform {
+                    name: t.name.clone(),
+                }
+                .into());
             }
             if t.parent.is_some_and(|p| p >= i) {
-                return Err(Error::Invalid(format!(
-                    "transform `{}` comes before its parent",
-                    t.name
-                )));
+                return Err(FaceError::TransformBeforeParent {
+                    name: t.name.clone(),
+                }
+                .into());
             }
         }
         if let Some(m) = self
@@ -309,10 +314,10 @@ impl FaceModel {
             .iter()
             .find(|m| m.transform.is_some_and(|t| t >= self.transforms.len()))
         {
-            return Err(Error::Invalid(format!(
-                "mesh `{}` refers to a missing transform",
-                m.name
-            )));
+            return Err(FaceError::MissingTransform {
+                mesh: m.name.clone(),
+            }
+            .into());
         }
         Ok(())
     }

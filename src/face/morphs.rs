@@ -32,8 +32,8 @@ use serde::Serialize;
 
 use super::attach::attach_feature_points;
 use super::write::merged_mesh;
-use super::FaceModel;
-use crate::error::{Error, Result};
+use super::{FaceError, FaceModel};
+use crate::error::{Error, Location, Result};
 use crate::fat::eval::Activation;
 use crate::fat::morph::{default_value, fat_from_morph_targets, MorphMesh, MorphTarget};
 use crate::fat::TableKey;
@@ -138,24 +138,24 @@ pub struct MorphSetReport {
 /// Reads a manifest: a JSON object mapping morph file stems to FAP values.
 pub fn read_manifest(path: &Path) -> Result<BTreeMap<String, f64>> {
     let text = crate::io::read_text(path)?;
-    let map: BTreeMap<String, serde_json::Value> = serde_json::from_str(&text).map_err(|e| {
-        Error::Invalid(format!(
-            "{}:{}:{}: expected a JSON object mapping morph names to FAP values ({e})",
-            path.display(),
-            e.line(),
-            e.column()
-        ))
-    })?;
+    let map: BTreeMap<String, serde_json::Value> =
+        serde_json::from_str(&text).map_err(|e| FaceError::ManifestSyntax {
+            location: Location {
+                file: path.to_path_buf(),
+                line: e.line(),
+                column: e.column(),
+            },
+            message: e.to_string(),
+        })?;
     map.into_iter()
         .map(|(k, v)| {
             let x = v
                 .as_f64()
                 .filter(|x| x.is_finite() && *x != 0.0)
-                .ok_or_else(|| {
-                    Error::Invalid(format!(
-                        "{}: `{k}`: {v} is not a finite, non-zero FAP value",
-                        path.display()
-                    ))
+                .ok_or_else(|| FaceError::ManifestValue {
+                    file: path.to_path_buf(),
+                    name: k.clone(),
+                    value: v.to_string(),
                 })?;
             Ok((k, x))
         })
@@ -192,11 +192,7 @@ pub fn face_from_morph_set(
     let mesh_name = face.meshes[0].name.clone();
     let tolerance = match options.tolerance {
         Some(t) if t.is_finite() && t >= 0.0 => t,
-        Some(t) => {
-            return Err(Error::Invalid(format!(
-                "tolerance {t} must be a finite number ≥ 0"
-            )))
-        }
+        Some(t) => return Err(FaceError::BadTolerance { tolerance: t }.into()),
         None => {
             let diag = neutral_mesh.bounds().map_or(1.0, |b| b.diagonal() as f64);
             DEFAULT_RELATIVE_TOLERANCE * diag
@@ -217,10 +213,11 @@ pub fn face_from_morph_set(
     for entry in entries {
         let entry = entry.map_err(|e| Error::io(dir, e))?;
         if files.len() + report.ignored.len() >= MAX_MORPH_FOLDER_ENTRIES {
-            return Err(Error::Invalid(format!(
-                "{}: more than {MAX_MORPH_FOLDER_ENTRIES} entries; not a morph folder",
-                dir.display()
-            )));
+            return Err(FaceError::TooManyMorphFiles {
+                dir: dir.to_path_buf(),
+                limit: MAX_MORPH_FOLDER_ENTRIES,
+            }
+            .into());
         }
         let path = entry.path();
         if !path.is_file() {
@@ -248,8 +245,10 @@ pub fn face_from_morph_set(
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let name = parse_morph_name(&stem)
-            .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
+        let name = parse_morph_name(&stem).map_err(|message| FaceError::BadMorphName {
+            file: path.clone(),
+            message,
+        })?;
         let (value, value_source) = match (name.value, manifest.get(&stem)) {
             (Some(v), _) => (v, ValueSource::FileName),
             (None, Some(&v)) => (v, ValueSource::Manifest),
@@ -259,12 +258,13 @@ pub fn face_from_morph_set(
             used_stems.push(stem.clone());
         }
         if let Some(other) = seen.insert((name.key, value.to_bits()), path.clone()) {
-            return Err(Error::Invalid(format!(
-                "{} and {} both show {} at value {value}",
-                other.display(),
-                path.display(),
-                name.key
-            )));
+            return Err(FaceError::DuplicateMorph {
+                first: other,
+                second: path.clone(),
+                key: name.key,
+                value,
+            }
+            .into());
         }
         let (obj, _) = read_obj_file(path)?;
         let target = morph_target(
@@ -275,7 +275,7 @@ pub fn face_from_morph_set(
             &obj.mesh,
             tolerance,
         )
-        .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
+        .map_err(|e| FaceError::in_file(path, e))?;
         report.morphs.push(MorphUsed {
             file: path.clone(),
             key: name.key,
@@ -286,14 +286,15 @@ pub fn face_from_morph_set(
         targets.push(target);
     }
     if let Some(unused) = manifest.keys().find(|k| !used_stems.contains(k)) {
-        return Err(Error::Invalid(format!(
-            "{}: `{unused}` names no morph file in {}",
-            options
+        return Err(FaceError::UnusedManifestEntry {
+            manifest: options
                 .manifest
                 .as_deref()
                 .map_or_else(String::new, |p| p.display().to_string()),
-            dir.display()
-        )));
+            name: unused.clone(),
+            dir: dir.to_path_buf(),
+        }
+        .into());
     }
     // Keys in the standard's order (FAPs, visemes, expressions), whatever the file order.
     targets.sort_by(|a, b| a.key.cmp(&b.key).then(a.value.total_cmp(&b.value)));
@@ -305,7 +306,7 @@ pub fn face_from_morph_set(
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         attach_feature_points(&mut face, file.points, &[&alias])
-            .map_err(|e| Error::Invalid(format!("{}: {e}", fp.display())))?;
+            .map_err(|e| FaceError::in_file(fp, e))?;
     }
     Ok((face, report))
 }
@@ -321,11 +322,11 @@ pub fn morph_target(
     tolerance: f64,
 ) -> Result<MorphTarget> {
     if morph.vertex_count() != neutral.vertex_count() {
-        return Err(Error::Invalid(format!(
-            "has {} vertices, the neutral has {} (a morph must have the neutral's topology)",
-            morph.vertex_count(),
-            neutral.vertex_count()
-        )));
+        return Err(FaceError::MorphVertexCount {
+            morph: morph.vertex_count(),
+            neutral: neutral.vertex_count(),
+        }
+        .into());
     }
     if morph.polygons != neutral.polygons {
         let at = morph
@@ -334,18 +335,15 @@ pub fn morph_target(
             .zip(neutral.polygons.iter())
             .position(|(a, b)| a != b)
             .unwrap_or(morph.polygons.len().min(neutral.polygons.len()));
-        return Err(Error::Invalid(format!(
-            "its polygons differ from the neutral's (first at polygon {}; {} vs {} polygons)",
-            at + 1,
-            morph.polygons.len(),
-            neutral.polygons.len()
-        )));
+        return Err(FaceError::MorphPolygons {
+            at: at + 1,
+            morph: morph.polygons.len(),
+            neutral: neutral.polygons.len(),
+        }
+        .into());
     }
     if let Some(i) = morph.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "vertex {} has a non-finite coordinate",
-            i + 1
-        )));
+        return Err(FaceError::MorphNonFinite { vertex: i + 1 }.into());
     }
     let mut vertices = Vec::new();
     let mut offsets = Vec::new();
@@ -421,9 +419,7 @@ pub fn write_morph_set(
 ) -> Result<Vec<WrittenMorph>> {
     if let Some(v) = value {
         if !v.is_finite() || v == 0.0 {
-            return Err(Error::Invalid(format!(
-                "--value {v}: must be a finite, non-zero FAP value"
-            )));
+            return Err(FaceError::BadMorphValue { value: v }.into());
         }
     }
     face.check_structure()?;
@@ -516,8 +512,13 @@ pub fn face_from_morph_meshes(
     let mut targets = Vec::with_capacity(morphs.len());
     for (key, value, m) in morphs {
         targets.push(
-            morph_target(*key, *value, name, &neutral, m, tolerance)
-                .map_err(|e| Error::Invalid(format!("morph {key} @ {value}: {e}")))?,
+            morph_target(*key, *value, name, &neutral, m, tolerance).map_err(|e| {
+                FaceError::Morph {
+                    key: *key,
+                    value: *value,
+                    source: Box::new(e),
+                }
+            })?,
         );
     }
     let mut face = FaceModel::single_mesh(name, neutral);

@@ -54,6 +54,15 @@ impl FaceReadOptions {
 
 /// Reads a face from a file, or a bundled face by name (`alma`, `bruno`) when no file of
 /// that name exists. See the module docs.
+///
+/// ```
+/// let alma = fbakit::face::read("alma")?;
+/// assert!(!alma.fat.tables.is_empty());
+/// // Errors are typed: a missing file is an I/O error on that path, exit code 2 in the CLI.
+/// let err = fbakit::face::read("no-such-face.wrl").unwrap_err();
+/// assert!(err.is_input_error());
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
 pub fn read(path: impl AsRef<Path>) -> Result<FaceModel> {
     read_with(path.as_ref(), &FaceReadOptions::default()).map(|(face, _)| face)
 }
@@ -75,13 +84,12 @@ pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, Face
         // A folder is a face only as an OBJ blendshape rig (a neutral plus shape OBJs); a
         // folder with a neutral is a rig, and its own errors (a shape of the wrong size) stand.
         if let Err(e) = crate::rig::obj_folder::find_neutral(path) {
-            return Err(Error::Invalid(format!(
-                "{}: is a directory and not a rig folder ({e}); expected a face file (.wrl, \
-                 .wrl.gz, .obj, .wfm, .glb, .gltf), a folder of rig shape OBJs or a bundled \
-                 face name ({})",
-                path.display(),
-                BundledFace::NAMES.join(", ")
-            )));
+            return Err(super::FaceError::NotAFaceFolder {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+                bundled: BundledFace::NAMES.join(", "),
+            }
+            .into());
         }
         let rig = crate::rig::obj_folder::read_obj_rig(path)?;
         return super::from_rig::rig_face(path, &rig, opts.feature_points.as_deref());
@@ -90,15 +98,15 @@ pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, Face
     read_bytes_at(path, &bytes, opts)
 }
 
-/// Reads a face held in memory; `name` stands for the file in messages and gives the face
-/// its name (`head.obj` → `head`), and its extension picks the format unless the content or
-/// [`FaceReadOptions::format`] does.
+/// Reads a face held in memory (data first, then its source name, as every reader); `source`
+/// stands for the file in messages and gives the face its name (`head.obj` → `head`), and its
+/// extension picks the format unless the content or [`FaceReadOptions::format`] does.
 pub fn read_bytes(
-    name: &str,
     bytes: &[u8],
+    source: impl AsRef<Path>,
     opts: &FaceReadOptions,
 ) -> Result<(FaceModel, FaceReadReport)> {
-    read_bytes_at(Path::new(name), bytes, opts)
+    read_bytes_at(source.as_ref(), bytes, opts)
 }
 
 fn read_bytes_at(
@@ -171,13 +179,13 @@ fn text_of(path: &Path, bytes: &[u8], expected: &str) -> Result<String> {
 }
 
 fn vrml_face(path: &Path, text: &str, name: &str) -> Result<(FaceModel, FaceReadReport)> {
-    let scene = crate::vrml::parse_vrml(path, text)?;
+    let scene = crate::vrml::parse_vrml(text, path)?;
     face_from_scene(scene, name)
 }
 
 fn obj_face(path: &Path, bytes: &[u8], name: &str) -> Result<(FaceModel, FaceReadReport)> {
     let text = text_of(path, bytes, "UTF-8 OBJ text")?;
-    let (obj, diagnostics) = crate::mesh::obj::read_obj_str(&text, path)?;
+    let (obj, diagnostics) = crate::mesh::obj::parse_obj(&text, path)?;
     let face = FaceModel::single_mesh(name, obj.mesh);
     let report = FaceReadReport {
         diagnostics,
@@ -195,15 +203,14 @@ fn candide(
     opts: &FaceReadOptions,
 ) -> Result<(FaceModel, FaceReadReport)> {
     let Some(fp) = &opts.feature_points else {
-        return Err(Error::Invalid(format!(
-            "{}: a CANDIDE-3 model needs its feature-point table to become a face; give it \
-             with --fp (e.g. feature-points.csv beside candide3.wfm)",
-            path.display()
-        )));
+        return Err(super::FaceError::CandideNeedsFeaturePoints {
+            path: path.to_path_buf(),
+        }
+        .into());
     };
     // CANDIDE files carry Latin-1 author names in comments; only ASCII matters to the model.
     let text = String::from_utf8_lossy(bytes);
-    let model = crate::candide::read_wfm_str(&text, path)?;
+    let model = crate::candide::parse_wfm(&text, path)?;
     let points = crate::fdp::read_feature_points(fp)?.points;
     let face = super::candide::candide_face(&model, &points, &[])?;
     Ok((face, FaceReadReport::default()))
@@ -220,7 +227,7 @@ fn attach_file(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     attach_feature_points(face, file.points, &[&alias])
-        .map_err(|e| Error::Invalid(format!("{}: {e}", fp.display())))
+        .map_err(|e| super::FaceError::in_file(fp, e).into())
 }
 
 #[cfg(test)]
@@ -251,9 +258,9 @@ mod tests {
                 }
         );
         let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-        let (face, _) = read_bytes("tri", obj.as_bytes(), &FaceReadOptions::default()).unwrap();
+        let (face, _) = read_bytes(obj.as_bytes(), "tri", &FaceReadOptions::default()).unwrap();
         assert_eq!(face.vertex_count(), 3);
-        let e = read_bytes("x", b"hello", &FaceReadOptions::default()).unwrap_err();
+        let e = read_bytes(b"hello", "x", &FaceReadOptions::default()).unwrap_err();
         assert!(e.to_string().contains("not a face file"), "{e}");
         let e = read(dir.path()).unwrap_err();
         assert!(e.to_string().contains("is a directory"), "{e}");
@@ -263,8 +270,8 @@ mod tests {
     #[test]
     fn candide_needs_its_table() {
         let e = read_bytes(
-            "c.wfm",
             b"# VERTEX LIST:\n0\n# FACE LIST:\n0\n",
+            "c.wfm",
             &FaceReadOptions::default(),
         )
         .unwrap_err();

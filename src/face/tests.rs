@@ -11,7 +11,7 @@ use crate::error::Severity;
 use crate::spec::FeaturePointId;
 
 fn read_str(text: &str) -> (FaceModel, super::vrml::FaceReadReport) {
-    let scene = crate::vrml::parse_vrml(Path::new("t.wrl"), text).expect("parses");
+    let scene = crate::vrml::parse_vrml(text, Path::new("t.wrl")).expect("parses");
     face_from_scene(scene, "t").expect("reads")
 }
 

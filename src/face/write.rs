@@ -9,7 +9,7 @@ use glam::{Affine3A, Vec3};
 
 use super::vrml::face_to_scene;
 use super::FaceModel;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::format::OutputFormat;
 use crate::io::gzip;
 use crate::mesh::obj::ObjScene;
@@ -64,8 +64,8 @@ pub fn merged_mesh(
     for (mi, fm) in face.meshes.iter().enumerate() {
         let m = &fm.mesh;
         let frame = mesh_frames.get(mi).copied().unwrap_or(Affine3A::IDENTITY);
-        let base = u32::try_from(out.positions.len())
-            .map_err(|_| Error::Invalid("too many vertices for one OBJ".into()))?;
+        let base =
+            u32::try_from(out.positions.len()).map_err(|_| super::FaceError::TooManyVertices)?;
         let uv_base = out.uvs.len() as u32;
         let n_base = out.normals.len() as u32;
         out.groups.push(FaceGroup {

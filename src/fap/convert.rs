@@ -4,9 +4,10 @@
 use std::path::Path;
 
 use super::model::FapStream;
-use super::parse::{read_fap_str, ReadMode, ReadOptions};
+use super::parse::{parse_fap, ReadMode, ReadOptions};
 use super::write::write_fap_file;
-use crate::error::{Diagnostic, Error, Location, ParseError, Result, Severity};
+use super::FapError;
+use crate::error::{Diagnostic, EncodeError, Error, Location, ParseError, Result, Severity};
 
 /// Whether `path` names a JSON file (extension `.json`, any case).
 pub fn is_json_path(path: &Path) -> bool {
@@ -17,10 +18,20 @@ pub fn is_json_path(path: &Path) -> bool {
 /// Reads a `.fap` or `.json` stream. JSON input is checked like `.fap` input: frame rate and
 /// frame order are errors; negative unidirectional values are errors in strict mode and
 /// unlocated warnings in lenient mode.
+///
+/// ```
+/// use fbakit::fap::{read_stream_file, ReadOptions};
+/// let (stream, warnings) = read_stream_file("samples/speech.fap".as_ref(), &ReadOptions::lenient())?;
+/// assert!(stream.frame_rate > 0.0);
+/// for w in &warnings {
+///     eprintln!("{w}"); // located: file:line:column: warning: ...
+/// }
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
 pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, Vec<Diagnostic>)> {
     let text = crate::io::read_text(path)?;
     if !is_json_path(path) {
-        return read_fap_str(&text, path, opts);
+        return parse_fap(&text, path, opts);
     }
     let stream: FapStream = serde_json::from_str(&text).map_err(|e| {
         Error::Parse(ParseError {
@@ -35,12 +46,12 @@ pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, V
     })?;
     let structural = stream.structural_problems();
     if let Some(p) = structural.first() {
-        return Err(Error::Invalid(format!("{}: {p}", path.display())));
+        return Err(content(path, p));
     }
     let values = stream.value_problems();
     if opts.mode == ReadMode::Strict {
         if let Some(p) = values.first() {
-            return Err(Error::Invalid(format!("{}: {p}", path.display())));
+            return Err(content(path, p));
         }
     }
     let warnings = values
@@ -54,6 +65,14 @@ pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, V
     Ok((stream, warnings))
 }
 
+fn content(path: &Path, problem: &str) -> Error {
+    FapError::Content {
+        file: path.to_path_buf(),
+        problem: problem.to_string(),
+    }
+    .into()
+}
+
 /// Writes `stream` atomically as JSON (pretty) or canonical `.fap`, by the extension of `path`.
 pub fn write_stream_file(path: &Path, stream: &FapStream) -> Result<()> {
     use crate::format::OutputFormat;
@@ -63,8 +82,7 @@ pub fn write_stream_file(path: &Path, stream: &FapStream) -> Result<()> {
         "a FAP stream",
     )?;
     if format == OutputFormat::Json {
-        let text = serde_json::to_string_pretty(stream)
-            .map_err(|e| Error::Invalid(format!("cannot encode JSON: {e}")))?;
+        let text = serde_json::to_string_pretty(stream).map_err(|e| EncodeError::new("JSON", e))?;
         crate::io::write_atomic(path, format!("{text}\n").as_bytes())
     } else {
         write_fap_file(path, stream)

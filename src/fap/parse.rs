@@ -57,7 +57,7 @@ pub enum ReadMode {
     Lenient,
 }
 
-/// Options of [`read_fap_str`] and [`read_fap_file`].
+/// Options of [`parse_fap`] and [`read_fap_file`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ReadOptions {
     /// Strict or lenient.
@@ -94,11 +94,34 @@ impl ReadOptions {
 /// Reads a `.fap` file (UTF-8, size-bounded) into a stream plus the warnings of lenient mode.
 pub fn read_fap_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, Vec<Diagnostic>)> {
     let text = crate::io::read_text(path)?;
-    read_fap_str(&text, path, opts)
+    parse_fap(&text, path, opts)
+}
+
+/// Reads a `.fap` stream from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]); `source` names it in locations.
+///
+/// ```
+/// use std::path::Path;
+/// let text = std::fs::read("samples/speech.fap").unwrap();
+/// let (stream, _warnings) = fbakit::fap::read_fap_from(
+///     &text[..],
+///     Path::new("speech.fap"),
+///     &fbakit::fap::ReadOptions::lenient(),
+/// )?;
+/// assert!(!stream.frames.is_empty());
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
+pub fn read_fap_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+    opts: &ReadOptions,
+) -> Result<(FapStream, Vec<Diagnostic>)> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_fap(&text, source, opts)
 }
 
 /// Reads `.fap` text; `file` names the source in locations.
-pub fn read_fap_str(
+pub fn parse_fap(
     text: &str,
     file: &Path,
     opts: &ReadOptions,
@@ -909,11 +932,11 @@ mod tests {
     }
 
     fn strict(text: &str) -> Result<(FapStream, Vec<Diagnostic>)> {
-        read_fap_str(text, Path::new(P), &ReadOptions::strict())
+        parse_fap(text, Path::new(P), &ReadOptions::strict())
     }
 
     fn lenient(text: &str) -> Result<(FapStream, Vec<Diagnostic>)> {
-        read_fap_str(text, Path::new(P), &ReadOptions::lenient())
+        parse_fap(text, Path::new(P), &ReadOptions::lenient())
     }
 
     fn err(text: &str) -> String {

@@ -11,7 +11,8 @@
 use glam::Vec3;
 
 use super::model::{ExpressionParams, FapFrame, FapMask, FapStream, VisemeParams, NUM_LOW_LEVEL};
-use crate::error::{Error, Result};
+use super::FapError;
+use crate::error::Result;
 use crate::fdp::Fapu;
 use crate::spec::{FapId, PositiveMotion};
 
@@ -143,15 +144,13 @@ pub const MAX_RESAMPLED_FRAMES: u64 = 10_000_000;
 /// frames.
 pub fn resample(stream: &FapStream, new_fps: f64) -> Result<FapStream> {
     if !(new_fps.is_finite() && new_fps > 0.0) {
-        return Err(Error::Invalid(format!(
-            "frame rate {new_fps} is not a finite positive number"
-        )));
+        return Err(FapError::BadFrameRate { rate: new_fps }.into());
     }
     if !(stream.frame_rate.is_finite() && stream.frame_rate > 0.0) {
-        return Err(Error::Invalid(format!(
-            "stream frame rate {} is not a finite positive number",
-            stream.frame_rate
-        )));
+        return Err(FapError::BadStreamFrameRate {
+            rate: stream.frame_rate,
+        }
+        .into());
     }
     let timeline = FapTimeline::new(stream);
     let mut out = FapStream {
@@ -166,9 +165,10 @@ pub fn resample(stream: &FapStream, new_fps: f64) -> Result<FapStream> {
     // Small tolerance so 3 s at 25 fps -> 50 fps ends exactly on frame 150.
     let last_out = (end_time * new_fps + 1e-9).floor();
     if last_out.is_nan() || last_out >= MAX_RESAMPLED_FRAMES as f64 {
-        return Err(Error::Invalid(format!(
-            "resampling would produce more than {MAX_RESAMPLED_FRAMES} frames"
-        )));
+        return Err(FapError::TooManyFrames {
+            limit: MAX_RESAMPLED_FRAMES,
+        }
+        .into());
     }
     let last_out = last_out as u64;
     out.frames.reserve(last_out as usize + 1);

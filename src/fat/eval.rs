@@ -6,8 +6,8 @@
 
 use glam::{Quat, Vec3};
 
-use super::{interval_weights, Fat, TableKey, TransformField, HIGH_LEVEL_FULL};
-use crate::error::{Error, Result};
+use super::{interval_weights, Fat, FatError, TableKey, TransformField, HIGH_LEVEL_FULL};
+use crate::error::Result;
 use crate::fap::DenseFrame;
 use crate::spec::{Expression, FapId, Viseme};
 
@@ -150,38 +150,35 @@ impl FatEvaluator {
         let mut tables = vec![CompiledTable::default(); TableKey::SLOTS];
         for table in &fat.tables {
             let Some(slot) = table.key.slot() else {
-                return Err(Error::Invalid(format!(
-                    "{}: viseme 0 and the neutral expression cannot have tables",
-                    table.key
-                )));
+                return Err(FatError::NeutralTable { key: table.key }.into());
             };
             for m in &table.meshes {
                 let mesh = meshes
                     .iter()
                     .position(|(name, _)| *name == m.mesh)
-                    .ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "{}: FaceDefMesh refers to unknown mesh `{}`",
-                            table.key, m.mesh
-                        ))
+                    .ok_or_else(|| FatError::UnknownMesh {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
                     })?;
                 let count = meshes[mesh].1;
                 if let Some(bad) = m.coord_index.iter().find(|&&i| i as usize >= count) {
-                    return Err(Error::Invalid(format!(
-                        "{}: coordIndex {bad} is out of range for mesh `{}` with {count} vertices",
-                        table.key, m.mesh
-                    )));
+                    return Err(FatError::CoordIndexOutOfRange {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
+                        index: *bad,
+                        vertex_count: count,
+                    }
+                    .into());
                 }
                 if m.displacements.len() != m.coord_index.len() * m.interval_count() {
-                    return Err(Error::Invalid(format!(
-                        "{}: mesh `{}` has {} displacements, expected {} (coordIndex {} × intervals {})",
-                        table.key,
-                        m.mesh,
-                        m.displacements.len(),
-                        m.coord_index.len() * m.interval_count(),
-                        m.coord_index.len(),
-                        m.interval_count()
-                    )));
+                    return Err(FatError::DisplacementCount {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
+                        found: m.displacements.len(),
+                        coord_index: m.coord_index.len(),
+                        intervals: m.interval_count(),
+                    }
+                    .into());
                 }
                 tables[slot].meshes.push(CompiledMesh {
                     mesh,
@@ -194,11 +191,9 @@ impl FatEvaluator {
                 let transform = transforms
                     .iter()
                     .position(|name| *name == t.transform)
-                    .ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "{}: FaceDefTransform refers to unknown transform `{}`",
-                            table.key, t.transform
-                        ))
+                    .ok_or_else(|| FatError::UnknownTransform {
+                        key: table.key,
+                        transform: t.transform.clone(),
                     })?;
                 tables[slot].transforms.push(CompiledTransform {
                     transform,

@@ -17,9 +17,12 @@
 //! `intensity2` (the two terms are added). A table whose only interval is `[0, 63]` therefore
 //! shows its full morph target at `P = 63`.
 
+mod error;
 pub mod eval;
 pub mod morph;
 pub mod validate;
+
+pub use error::FatError;
 
 use std::fmt;
 

@@ -10,8 +10,8 @@ use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
 use super::{interval_weights, FaceDefMesh, FaceDefTable, FaceDefTransform, Fat, TableKey};
-use super::{TransformField, HIGH_LEVEL_FULL};
-use crate::error::{Error, Result};
+use super::{FatError, TransformField, HIGH_LEVEL_FULL};
+use crate::error::Result;
 
 /// FAP value a low-level translation morph target represents when none is given (half of the
 /// face's FAP-unit distance, i.e. 512 units).
@@ -164,20 +164,21 @@ pub fn fat_from_morph_targets(targets: &[MorphTarget]) -> Result<Fat> {
     let mut keys: Vec<TableKey> = Vec::new();
     for t in targets {
         if !t.value.is_finite() || t.value == 0.0 {
-            return Err(Error::Invalid(format!(
-                "morph target {} has value {}; it must be finite and non-zero",
-                t.key, t.value
-            )));
+            return Err(FatError::BadMorphValue {
+                key: t.key,
+                value: t.value,
+            }
+            .into());
         }
         for m in &t.meshes {
             if m.vertices.len() != m.offsets.len() {
-                return Err(Error::Invalid(format!(
-                    "morph target {} mesh `{}`: {} vertices but {} offsets",
-                    t.key,
-                    m.mesh,
-                    m.vertices.len(),
-                    m.offsets.len()
-                )));
+                return Err(FatError::MorphLengths {
+                    key: t.key,
+                    mesh: m.mesh.clone(),
+                    vertices: m.vertices.len(),
+                    offsets: m.offsets.len(),
+                }
+                .into());
             }
         }
         if !keys.contains(&t.key) {
@@ -189,10 +190,11 @@ pub fn fat_from_morph_targets(targets: &[MorphTarget]) -> Result<Fat> {
         let mut group: Vec<&MorphTarget> = targets.iter().filter(|t| t.key == key).collect();
         group.sort_by(|a, b| a.value.total_cmp(&b.value));
         if let Some(w) = group.windows(2).find(|w| w[0].value == w[1].value) {
-            return Err(Error::Invalid(format!(
-                "two morph targets of {key} have the same value {}",
-                w[0].value
-            )));
+            return Err(FatError::DuplicateMorphValue {
+                key,
+                value: w[0].value,
+            }
+            .into());
         }
         let mut borders: Vec<f64> = group.iter().map(|t| t.value).collect();
         let zero_at = borders.partition_point(|&b| b < 0.0);

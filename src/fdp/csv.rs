@@ -12,7 +12,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::error::{Error, Location, ParseError, Result};
+use crate::error::{EncodeError, Error, Location, ParseError, Result};
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
 use crate::spec::FeaturePointId;
 
@@ -113,11 +113,11 @@ impl FeaturePointTable {
 /// Reads a feature-point CSV file.
 pub fn read_csv_file(path: &Path) -> Result<FeaturePointTable> {
     let text = crate::io::read_text(path)?;
-    parse_csv(path, &text)
+    parse_csv(&text, path)
 }
 
 /// Parses feature-point CSV text; `file` is used in error locations only.
-pub fn parse_csv(file: &Path, text: &str) -> Result<FeaturePointTable> {
+pub fn parse_csv(text: &str, file: &Path) -> Result<FeaturePointTable> {
     let mut reader = ::csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
@@ -241,7 +241,7 @@ pub fn parse_csv(file: &Path, text: &str) -> Result<FeaturePointTable> {
 /// Writes the table as CSV text (always with all four columns).
 pub fn to_csv_string(table: &FeaturePointTable) -> Result<String> {
     let mut w = ::csv::WriterBuilder::new().from_writer(Vec::new());
-    let enc = |e: ::csv::Error| Error::Invalid(format!("cannot encode CSV: {e}"));
+    let enc = |e: ::csv::Error| EncodeError::new("CSV", e);
     w.write_record(["fp", "vertices", "combine", "description"])
         .map_err(enc)?;
     for r in &table.rows {
@@ -254,10 +254,8 @@ pub fn to_csv_string(table: &FeaturePointTable) -> Result<String> {
         ])
         .map_err(enc)?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Invalid(format!("cannot encode CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::Invalid(format!("cannot encode CSV: {e}")))
+    let bytes = w.into_inner().map_err(|e| EncodeError::new("CSV", e))?;
+    String::from_utf8(bytes).map_err(|e| EncodeError::new("CSV", e).into())
 }
 
 /// Writes the table to `path` atomically.
@@ -271,7 +269,7 @@ mod tests {
     use proptest::prelude::*;
 
     fn parse(text: &str) -> Result<FeaturePointTable> {
-        parse_csv(Path::new("t.csv"), text)
+        parse_csv(text, Path::new("t.csv"))
     }
 
     #[test]

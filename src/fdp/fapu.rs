@@ -6,8 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
-use crate::fdp::FeaturePointSet;
+use crate::error::Result;
+use crate::fdp::{FdpError, FeaturePointSet};
 use crate::spec::{FapId, FapuKind, FeaturePointId, AU_RADIANS, FAPU_DIVISOR};
 
 /// The five neutral-face distances of one face, in model units (not yet divided by 1024).
@@ -34,7 +34,7 @@ pub struct Fapu {
 
 impl Fapu {
     /// Units from neutral-face distances. Every distance must be finite and positive.
-    pub fn from_distances(distances: FapuDistances) -> Result<Fapu, String> {
+    pub fn from_distances(distances: FapuDistances) -> Result<Fapu, FdpError> {
         let named = [
             ("IRISD0", distances.irisd0),
             ("ES0", distances.es0),
@@ -44,9 +44,7 @@ impl Fapu {
         ];
         for (name, d) in named {
             if !d.is_finite() || d <= 0.0 {
-                return Err(format!(
-                    "FAPU distance {name} is {d}; it must be a positive finite length"
-                ));
+                return Err(FdpError::BadFapuDistance { name, value: d });
             }
         }
         Ok(Fapu { distances })
@@ -63,14 +61,13 @@ impl Fapu {
     /// obtained (e.g. IRISD0 taken from the right eye because a left-eye lid point is missing).
     ///
     /// Every missing point (or point without a position) is listed in one
-    /// [`Error::Invalid`]; a zero or negative distance is an error naming the FAPU and its
+    /// [`FdpError::FapuPointsMissing`]; a zero or negative distance is an error naming the FAPU and its
     /// points (usually a mirrored model or a wrong axis convention).
     pub fn measure(points: &FeaturePointSet) -> Result<FapuMeasurement> {
-        let fp = |g, i| FeaturePointId::new(g, i).expect("standard label");
         let has = |id: FeaturePointId| points.position(id).is_some();
         let mut notes = Vec::new();
-        let (l_top, l_bottom) = (fp(3, 1), fp(3, 3));
-        let (r_top, r_bottom) = (fp(3, 2), fp(3, 4));
+        let (l_top, l_bottom) = (FeaturePointId::FP_3_1, FeaturePointId::FP_3_3);
+        let (r_top, r_bottom) = (FeaturePointId::FP_3_2, FeaturePointId::FP_3_4);
         let iris = if has(l_top) && has(l_bottom) {
             (l_top, l_bottom)
         } else if has(r_top) && has(r_bottom) {
@@ -90,10 +87,10 @@ impl Fapu {
         // (name, upper/left point, lower/right point, axis 0 = x, 1 = y)
         let defs = [
             ("IRISD0", iris.0, iris.1, 1),
-            ("ES0", fp(3, 5), fp(3, 6), 0),
-            ("ENS0", fp(3, 5), fp(9, 15), 1),
-            ("MNS0", fp(9, 15), fp(2, 2), 1),
-            ("MW0", fp(8, 3), fp(8, 4), 0),
+            ("ES0", FeaturePointId::FP_3_5, FeaturePointId::FP_3_6, 0),
+            ("ENS0", FeaturePointId::FP_3_5, FeaturePointId::FP_9_15, 1),
+            ("MNS0", FeaturePointId::FP_9_15, FeaturePointId::FP_2_2, 1),
+            ("MW0", FeaturePointId::FP_8_3, FeaturePointId::FP_8_4, 0),
         ];
         let mut missing: Vec<(FeaturePointId, Vec<&str>)> = Vec::new();
         for (name, a, b, _) in defs {
@@ -117,10 +114,11 @@ impl Fapu {
             } else {
                 ""
             };
-            return Err(Error::Invalid(format!(
-                "cannot compute the FAPUs: feature points without a position: {}{hint}",
-                list.join(", ")
-            )));
+            return Err(FdpError::FapuPointsMissing {
+                points: list.join(", "),
+                hint: hint.to_string(),
+            }
+            .into());
         }
         let mut values = [0.0f64; 5];
         let mut bad = Vec::new();
@@ -138,10 +136,10 @@ impl Fapu {
             values[k] = d;
         }
         if !bad.is_empty() {
-            return Err(Error::Invalid(format!(
-                "cannot compute the FAPUs: {} (MPEG-4 frame: +x = the face's left, +y = up)",
-                bad.join("; ")
-            )));
+            return Err(FdpError::FapuNotPositive {
+                details: bad.join("; "),
+            }
+            .into());
         }
         let distances = FapuDistances {
             irisd0: values[0],
@@ -150,7 +148,7 @@ impl Fapu {
             mns0: values[3],
             mw0: values[4],
         };
-        let fapu = Fapu::from_distances(distances).map_err(Error::Invalid)?;
+        let fapu = Fapu::from_distances(distances)?;
         Ok(FapuMeasurement { fapu, notes })
     }
 
@@ -233,7 +231,10 @@ mod tests {
     fn rejects_non_positive_or_non_finite() {
         let mut d = sample().distances;
         d.mw0 = 0.0;
-        assert!(Fapu::from_distances(d).unwrap_err().contains("MW0"));
+        assert!(Fapu::from_distances(d)
+            .unwrap_err()
+            .to_string()
+            .contains("MW0"));
         d.mw0 = f64::NAN;
         assert!(Fapu::from_distances(d).is_err());
         d.mw0 = -1.0;

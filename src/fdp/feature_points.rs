@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::spec::FeaturePointId;
 
 /// The mesh vertex (or vertices) a feature point sits on.
@@ -183,10 +183,10 @@ impl FeaturePointSet {
             } else {
                 String::new()
             };
-            return Err(Error::Invalid(format!(
-                "cannot place feature points on the mesh: {}{more}",
-                problems[..shown].join("; ")
-            )));
+            return Err(super::FdpError::Unplaceable {
+                problems: format!("{}{more}", problems[..shown].join("; ")),
+            }
+            .into());
         }
         let n = resolved.len();
         for (id, pos) in resolved {

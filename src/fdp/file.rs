@@ -65,7 +65,7 @@ impl FeaturePointFile {
     pub fn fapu(&self) -> Result<(FapuSource, FapuMeasurement)> {
         match self.fapu {
             Some(d) => {
-                let fapu = Fapu::from_distances(d).map_err(Error::Invalid)?;
+                let fapu = Fapu::from_distances(d)?;
                 Ok((
                     FapuSource::File,
                     FapuMeasurement {
@@ -114,13 +114,30 @@ pub fn detect_format(path: &Path, text: &str) -> Option<FeaturePointFormat> {
 }
 
 /// Reads a feature-point file, picking the format with [`detect_format`].
+///
+/// ```
+/// let file = fbakit::fdp::read_feature_points("samples/feature-points-example.xml".as_ref())?;
+/// assert!(file.points.iter().count() > 0);
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
 pub fn read_feature_points(path: &Path) -> Result<FeaturePointFile> {
     let text = crate::io::read_text(path)?;
-    parse_feature_points(path, &text)
+    parse_feature_points(&text, path)
+}
+
+/// Reads feature points of any supported format from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]); `source` names it and its extension picks the
+/// format.
+pub fn read_feature_points_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+) -> Result<FeaturePointFile> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_feature_points(&text, source)
 }
 
 /// Parses feature-point text of any supported format; `path` names it and picks the format.
-pub fn parse_feature_points(path: &Path, text: &str) -> Result<FeaturePointFile> {
+pub fn parse_feature_points(text: &str, path: &Path) -> Result<FeaturePointFile> {
     let format = detect_format(path, text).ok_or_else(|| {
         Error::Unsupported(format!(
             "{}: not a feature-point file (expected fbakit .xml with <featurePoints>, Xface .fdp with <xfdp>, or .csv with fp,vertices columns)",
@@ -129,7 +146,7 @@ pub fn parse_feature_points(path: &Path, text: &str) -> Result<FeaturePointFile>
     })?;
     Ok(match format {
         FeaturePointFormat::FbakitXml => {
-            let d = super::xml::parse_xml(path, text)?;
+            let d = super::xml::parse_xml(text, path)?;
             FeaturePointFile {
                 format,
                 points: d.points,
@@ -138,7 +155,7 @@ pub fn parse_feature_points(path: &Path, text: &str) -> Result<FeaturePointFile>
             }
         }
         FeaturePointFormat::XfaceFdp => {
-            let x = super::xface::parse_xface(path, text)?;
+            let x = super::xface::parse_xface(text, path)?;
             FeaturePointFile {
                 format,
                 points: x.to_set(),
@@ -147,7 +164,7 @@ pub fn parse_feature_points(path: &Path, text: &str) -> Result<FeaturePointFile>
             }
         }
         FeaturePointFormat::Csv => {
-            let t = super::csv::parse_csv(path, text)?;
+            let t = super::csv::parse_csv(text, path)?;
             FeaturePointFile {
                 format,
                 points: t.to_set(),
@@ -181,21 +198,21 @@ mod tests {
             Some(FeaturePointFormat::Csv)
         );
         assert_eq!(d("a.obj", "v 1 2 3\n"), None);
-        let e = parse_feature_points(Path::new("a.obj"), "v 1 2 3").unwrap_err();
+        let e = parse_feature_points("v 1 2 3", Path::new("a.obj")).unwrap_err();
         assert!(e.to_string().contains("not a feature-point file"), "{e}");
         assert!(e.is_input_error());
     }
 
     #[test]
     fn every_format_fills_the_common_fields() {
-        let f = parse_feature_points(Path::new("t.csv"), "fp,vertices\n2.1,3\n").unwrap();
+        let f = parse_feature_points("fp,vertices\n2.1,3\n", Path::new("t.csv")).unwrap();
         assert_eq!(
             (f.format, f.points.len(), f.fapu),
             (FeaturePointFormat::Csv, 1, None)
         );
         let f = parse_feature_points(
-            Path::new("t.xml"),
             "<featurePoints version=\"1\" units=\"mm\"><point id=\"2.1\" x=\"0\" y=\"0\" z=\"0\"/></featurePoints>",
+            Path::new("t.xml"),
         )
         .unwrap();
         assert_eq!(
@@ -205,8 +222,8 @@ mod tests {
             }
         );
         let f = parse_feature_points(
-            Path::new("t.fdp"),
             "<xfdp><head><fapu ENS0=\"1\" ES0=\"2\" IRISD0=\"3\" MNS0=\"4\" MW0=\"5\"/></head></xfdp>",
+            Path::new("t.fdp"),
         )
         .unwrap();
         assert_eq!(f.fapu.unwrap().mw0, 5.0);

@@ -7,16 +7,18 @@
 //! - [`landmarks`]: feature points from iBUG-68 / MediaPipe-468 landmarks plus points derived
 //!   from the mesh.
 
+mod error;
 pub mod fapu;
 pub mod feature_points;
 pub mod file;
 pub mod landmarks;
 
+pub use error::FdpError;
 pub use fapu::{Fapu, FapuDistances, FapuMeasurement};
 pub use feature_points::{FeaturePoint, FeaturePointSet, VertexBinding};
 pub use file::{
-    detect_format, parse_feature_points, read_feature_points, FapuSource, FeaturePointFile,
-    FeaturePointFormat, FormatExtras,
+    detect_format, parse_feature_points, read_feature_points, read_feature_points_from, FapuSource,
+    FeaturePointFile, FeaturePointFormat, FormatExtras,
 };
 pub mod csv;
 pub mod xface;

@@ -174,11 +174,11 @@ impl XfaceFdp {
 /// Reads an Xface `.fdp` file.
 pub fn read_xface_file(path: &Path) -> Result<XfaceFdp> {
     let text = crate::io::read_text(path)?;
-    parse_xface(path, &text)
+    parse_xface(&text, path)
 }
 
 /// Parses Xface `.fdp` text; `file` is used in error locations only.
-pub fn parse_xface(file: &Path, text: &str) -> Result<XfaceFdp> {
+pub fn parse_xface(text: &str, file: &Path) -> Result<XfaceFdp> {
     let mut cur = XmlCursor::new(file, text);
     let mut out: Option<XfaceFdp> = None;
     loop {
@@ -652,7 +652,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str) -> Result<XfaceFdp> {
-        parse_xface(Path::new("a.fdp"), text)
+        parse_xface(text, Path::new("a.fdp"))
     }
 
     const SMALL: &str = r#"<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
@@ -832,7 +832,7 @@ mod tests {
         ));
         for fdp in files {
             let text = write_xface_string(&fdp);
-            let back = parse_xface(Path::new("w.fdp"), &text).unwrap();
+            let back = parse_xface(&text, Path::new("w.fdp")).unwrap();
             assert_eq!(back, fdp);
         }
     }

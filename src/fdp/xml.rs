@@ -42,11 +42,11 @@ pub struct FeaturePointDocument {
 /// Reads an fbakit feature-point XML file.
 pub fn read_xml_file(path: &Path) -> Result<FeaturePointDocument> {
     let text = crate::io::read_text(path)?;
-    parse_xml(path, &text)
+    parse_xml(&text, path)
 }
 
 /// Parses fbakit feature-point XML text; `file` is used in error locations only.
-pub fn parse_xml(file: &Path, text: &str) -> Result<FeaturePointDocument> {
+pub fn parse_xml(text: &str, file: &Path) -> Result<FeaturePointDocument> {
     let mut cur = XmlCursor::new(file, text);
     let mut doc: Option<FeaturePointDocument> = None;
     let mut root_closed = false;
@@ -317,7 +317,7 @@ mod tests {
     use proptest::prelude::*;
 
     fn parse(text: &str) -> Result<FeaturePointDocument> {
-        parse_xml(Path::new("f.xml"), text)
+        parse_xml(text, Path::new("f.xml"))
     }
 
     fn err(text: &str) -> String {

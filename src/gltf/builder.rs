@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 /// Collects meshes, nodes and animations, then [builds](SceneBuilder::build) a glTF document.
 ///
 /// Every `add_*` method checks its input completely (finite numbers, counts, index ranges,
-/// references to earlier handles) and returns [`Error::Invalid`] naming the offending object.
+/// references to earlier handles) and returns [`super::GltfError::Scene`] naming the offending object.
 #[derive(Clone, Debug, Default)]
 pub struct SceneBuilder<'a> {
     scene_name: String,
@@ -26,7 +26,7 @@ pub struct SceneBuilder<'a> {
 }
 
 fn invalid(msg: String) -> Error {
-    Error::Invalid(msg)
+    super::GltfError::Scene(msg).into()
 }
 
 fn finite3(v: Vec3) -> bool {

@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use super::json::{Buffer, Root};
+use super::GltfError;
 use crate::error::{Error, Result};
 
 /// GLB magic `glTF`, little-endian.
@@ -51,8 +52,7 @@ impl GltfDocument {
             } else {
                 8 + bin_padded
             };
-        let total = u32::try_from(total)
-            .map_err(|_| Error::Invalid("glTF asset exceeds the 4 GiB GLB limit".into()))?;
+        let total = u32::try_from(total).map_err(|_| GltfError::AssetTooLarge)?;
         let mut out = Vec::with_capacity(total as usize);
         for word in [GLB_MAGIC, GLB_VERSION, total, json.len() as u32, CHUNK_JSON] {
             out.extend_from_slice(&word.to_le_bytes());
@@ -110,7 +110,7 @@ impl GltfDocument {
 }
 
 fn json_error(e: serde_json::Error) -> Error {
-    Error::Invalid(format!("cannot serialise glTF JSON: {e}"))
+    GltfError::Serialize(e.to_string()).into()
 }
 
 fn pad_to_4(bytes: &mut Vec<u8>, fill: u8) {
@@ -129,7 +129,12 @@ pub struct GlbChunks<'a> {
 /// Splits GLB bytes into chunks, checking magic, version, total length, chunk lengths (a
 /// multiple of 4, inside the file) and chunk order. Unknown chunks after `BIN` are skipped.
 pub fn parse_glb(bytes: &[u8]) -> Result<GlbChunks<'_>> {
-    let bad = |what: &str| Error::Invalid(format!("not a valid GLB file: {what}"));
+    let bad = |what: &str| -> Error {
+        GltfError::BadGlb {
+            what: what.to_string(),
+        }
+        .into()
+    };
     let word = |at: usize| -> Option<u32> {
         bytes
             .get(at..at.checked_add(4)?)

@@ -12,7 +12,7 @@ use super::{
     area_weighted_normals, AnimationData, ChannelValues, Interpolation, MeshData, MorphOffsets,
     MorphTargetData, NodeData,
 };
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 /// The document of a checked scene: every mesh is shown by a node, every reference is valid.
 pub(super) fn assemble(
@@ -50,8 +50,7 @@ pub(super) fn assemble(
     for a in animations {
         root.animations.push(animation_json(&mut out, a));
     }
-    let byte_length = u32::try_from(out.bin.len())
-        .map_err(|_| Error::Invalid("glTF buffer exceeds 4 GiB".to_string()))?;
+    let byte_length = u32::try_from(out.bin.len()).map_err(|_| super::GltfError::BufferTooLarge)?;
     if byte_length > 0 {
         root.buffers.push(json::Buffer {
             byte_length,

@@ -71,6 +71,7 @@
 mod builder;
 pub mod container;
 mod document;
+mod error;
 pub mod json;
 mod layout;
 mod normals;
@@ -78,6 +79,7 @@ mod scene_data;
 
 pub use builder::SceneBuilder;
 pub use container::{parse_glb, GlbChunks, GltfDocument};
+pub use error::GltfError;
 pub use normals::area_weighted_normals;
 pub use scene_data::{
     AnimationData, ChannelData, ChannelValues, Interpolation, MaterialData, MeshData, MeshId,

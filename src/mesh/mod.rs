@@ -16,6 +16,7 @@
 //! (FAT evaluation, ray casting, rendering) index straight into them.
 
 pub mod components;
+mod error;
 pub mod geometry;
 pub mod obj;
 pub mod orient;
@@ -26,6 +27,7 @@ pub(crate) mod text;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
+pub use error::MeshError;
 pub use geometry::{Aabb, MeshValidation};
 pub use spatial::{find_coincident_vertices, CoincidentVertices, VertexIndex};
 

@@ -24,7 +24,7 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 
 use super::text::{fail, integer, newline_or_eof, real, rest_of_line, unsigned, PErr, Res};
-use super::{FaceGroup, Mesh, Polygons};
+use super::{FaceGroup, Mesh, MeshError, Polygons};
 use crate::error::{Diagnostic, Error, Location, ParseError, Result, Severity};
 
 /// Warnings kept per file; the rest are counted in one last warning.
@@ -390,7 +390,7 @@ impl Builder {
 }
 
 /// Reads OBJ text. `file` names the source in errors and diagnostics and gives the mesh name.
-pub fn read_obj_str(text: &str, file: &Path) -> Result<(ObjScene, Vec<Diagnostic>)> {
+pub fn parse_obj(text: &str, file: &Path) -> Result<(ObjScene, Vec<Diagnostic>)> {
     let mut warnings: Vec<Diagnostic> = Vec::new();
     let mut suppressed = 0usize;
     let mut warn = |at: &str, message: String, warnings: &mut Vec<Diagnostic>| {
@@ -611,18 +611,28 @@ fn to_error(e: nom::Err<PErr<'_>>, file: &Path, text: &str, default: &str) -> Er
 /// Reads an OBJ file (UTF-8, size-bounded by [`crate::io::read_text`]).
 pub fn read_obj_file(path: &Path) -> Result<(ObjScene, Vec<Diagnostic>)> {
     let text = crate::io::read_text(path)?;
-    read_obj_str(&text, path)
+    parse_obj(&text, path)
+}
+
+/// Reads OBJ from `reader` (UTF-8, bounded by [`crate::io::DEFAULT_MAX_INPUT_BYTES`]);
+/// `source` names it in locations and warnings.
+pub fn read_obj_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+) -> Result<(ObjScene, Vec<Diagnostic>)> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_obj(&text, source)
 }
 
 /// Vertex positions (`v` statements) of OBJ text, in order; everything else is skipped.
 ///
 /// For files known to share another file's faces (blend-shape OBJs): several times faster
-/// than [`read_obj_str`] because faces are not parsed. The same numbers are accepted (3, 4 or
+/// than [`parse_obj`] because faces are not parsed. The same numbers are accepted (3, 4 or
 /// 6 finite numbers after `v`); errors name file, line and column. Text with `\` line
-/// continuations goes through [`read_obj_str`].
-pub fn read_obj_positions_str(text: &str, file: &Path) -> Result<Vec<Vec3>> {
+/// continuations goes through [`parse_obj`].
+pub fn parse_obj_positions(text: &str, file: &Path) -> Result<Vec<Vec3>> {
     if text.contains("\\\n") || text.contains("\\\r\n") {
-        return read_obj_str(text, file).map(|(s, _)| s.mesh.positions);
+        return parse_obj(text, file).map(|(s, _)| s.mesh.positions);
     }
     let body = text.strip_prefix('\u{feff}').unwrap_or(text);
     let base = text.len() - body.len();
@@ -680,15 +690,15 @@ pub fn read_obj_positions_str(text: &str, file: &Path) -> Result<Vec<Vec3>> {
     Ok(out)
 }
 
-/// [`read_obj_positions_str`] on a file (UTF-8, size-bounded by [`crate::io::read_text`]).
+/// [`parse_obj_positions`] on a file (UTF-8, size-bounded by [`crate::io::read_text`]).
 pub fn read_obj_positions_file(path: &Path) -> Result<Vec<Vec3>> {
     let text = crate::io::read_text(path)?;
-    read_obj_positions_str(&text, path)
+    parse_obj_positions(&text, path)
 }
 
 /// Writes `scene` as canonical OBJ text (see the module docs).
 ///
-/// Fails with [`Error::Invalid`] if the mesh is structurally invalid ([`Mesh::validate`]),
+/// Fails with a [`MeshError`] if the mesh is structurally invalid ([`Mesh::validate`]),
 /// holds non-finite numbers, or a name contains a line break — such a file could not be read
 /// back.
 pub fn write_obj_string(scene: &ObjScene) -> Result<String> {
@@ -704,19 +714,18 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
     let m = &scene.mesh;
     let v = m.validate();
     if !v.is_valid() {
-        return Err(Error::Invalid(format!(
-            "cannot write an invalid mesh as OBJ: {v:?}"
-        )));
+        return Err(MeshError::InvalidMesh {
+            details: format!("{v:?}"),
+        }
+        .into());
     }
     if m.polygons.iter().any(|p| p.len() < 3) {
-        return Err(Error::Invalid("OBJ faces need at least 3 corners".into()));
+        return Err(MeshError::DegenerateFace.into());
     }
     let finite2 = m.uvs.iter().all(|v| v.is_finite());
     let finite3 = m.normals.iter().chain(&m.colors).all(|v| v.is_finite());
     if !finite2 || !finite3 {
-        return Err(Error::Invalid(
-            "cannot write non-finite uvs, normals or colours".into(),
-        ));
+        return Err(MeshError::NonFiniteAttributes.into());
     }
     // A trailing `\` would read back as a line continuation.
     let bad_name = |s: &str| s.contains(['\n', '\r', '#']) || s.trim() != s || s.ends_with('\\');
@@ -729,10 +738,10 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
     });
     for n in names.chain(scene.material_libraries.iter().map(String::as_str)) {
         if bad_name(n) {
-            return Err(Error::Invalid(format!(
-                "name `{}` cannot be written to OBJ (line break, `#`, outer spaces or trailing `\\`)",
-                n.escape_debug()
-            )));
+            return Err(MeshError::UnwritableName {
+                name: n.escape_debug().to_string(),
+            }
+            .into());
         }
     }
     if m.groups
@@ -740,9 +749,7 @@ fn check_writable(scene: &ObjScene) -> Result<()> {
         .flat_map(|g| &g.groups)
         .any(|g| g.is_empty() || g.contains([' ', '\t']))
     {
-        return Err(Error::Invalid(
-            "OBJ group names cannot be empty or contain spaces".into(),
-        ));
+        return Err(MeshError::BadGroupName.into());
     }
     Ok(())
 }

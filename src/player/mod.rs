@@ -32,9 +32,12 @@
 
 use std::ops::Range;
 
+mod error;
+pub use error::PlayerError;
+
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::{FaceModel, FacePose};
 use crate::fap::{resample, FapStream, FapTimeline};
 use crate::fat::eval::{frame_activations, Activation, FatEvaluator, FatOutput, TransformDelta};
@@ -121,6 +124,24 @@ impl<'a> Player<'a> {
     /// Errors: the face's FAT refers to unknown meshes/transforms, the stream's frame rate
     /// (or `opts.fps`) is not finite and positive, resampling would be too long, or the
     /// requested frame range is empty or starts after the last frame.
+    ///
+    /// ```
+    /// use fbakit::error::Error;
+    /// use fbakit::player::{PlayOptions, Player, PlayerError};
+    /// let face = fbakit::face::read("alma")?;
+    /// let (stream, _) = fbakit::fap::read_stream_file(
+    ///     "samples/speech.fap".as_ref(),
+    ///     &fbakit::fap::ReadOptions::lenient(),
+    /// )?;
+    /// let mut player = Player::new(&face, &stream, PlayOptions::default())?;
+    /// let mut frame = player.new_frame();
+    /// while player.next_frame(&mut frame) {}
+    /// // A frame range past the end is a typed error callers can match.
+    /// let opts = PlayOptions { frames: Some(1_000_000..1_000_001), ..PlayOptions::default() };
+    /// let err = Player::new(&face, &stream, opts).err().unwrap();
+    /// assert!(matches!(err, Error::Player(PlayerError::EmptyFrameRange { .. })));
+    /// # Ok::<(), Error>(())
+    /// ```
     pub fn new(face: &'a FaceModel, stream: &FapStream, opts: PlayOptions) -> Result<Player<'a>> {
         face.check_structure()?;
         let evaluator = face.evaluator()?;
@@ -128,11 +149,11 @@ impl<'a> Player<'a> {
             && stream.frame_rate > 0.0
             && stream.frame_rate <= crate::fap::MAX_FRAME_RATE)
         {
-            return Err(Error::Invalid(format!(
-                "stream frame rate {} is not a number in (0, {}]",
-                stream.frame_rate,
-                crate::fap::MAX_FRAME_RATE
-            )));
+            return Err(PlayerError::StreamFrameRate {
+                rate: stream.frame_rate,
+                max: crate::fap::MAX_FRAME_RATE,
+            }
+            .into());
         }
         let (timeline, fps) = match opts.fps {
             Some(f) if f != stream.frame_rate => (FapTimeline::new(&resample(stream, f)?), f),
@@ -143,11 +164,9 @@ impl<'a> Player<'a> {
                 .ok()
                 .and_then(|n| n.checked_add(1))
                 .filter(|&n| n as u64 <= crate::fap::MAX_RESAMPLED_FRAMES)
-                .ok_or_else(|| {
-                    Error::Invalid(format!(
-                        "stream has frame number {n}, more than {} frames",
-                        crate::fap::MAX_RESAMPLED_FRAMES
-                    ))
+                .ok_or(PlayerError::FrameNumberTooLarge {
+                    frame: n,
+                    limit: crate::fap::MAX_RESAMPLED_FRAMES,
                 })?,
             None => 0,
         };
@@ -155,10 +174,12 @@ impl<'a> Player<'a> {
             None => 0..total,
             Some(r) => {
                 if r.start >= r.end || r.start >= total {
-                    return Err(Error::Invalid(format!(
-                        "frame range {}..{} selects nothing of the {total} frames",
-                        r.start, r.end
-                    )));
+                    return Err(PlayerError::EmptyFrameRange {
+                        start: r.start,
+                        end: r.end,
+                        total,
+                    }
+                    .into());
                 }
                 r.start..r.end.min(total)
             }
@@ -272,13 +293,13 @@ impl<'a> Player<'a> {
     pub fn animation(&self) -> Result<Vec<AnimationFrame>> {
         // The clip is built whole in memory: refuse absurd spans before allocating them.
         if self.range.len() > crate::export::budget::MAX_PLAYED_FRAMES {
-            return Err(Error::Invalid(format!(
-                "frames {}..{} are {} frames, more than the {} an animation holds",
-                self.range.start,
-                self.range.end,
-                self.range.len(),
-                crate::export::budget::MAX_PLAYED_FRAMES
-            )));
+            return Err(PlayerError::TooManyFrames {
+                start: self.range.start,
+                end: self.range.end,
+                count: self.range.len(),
+                limit: crate::export::budget::MAX_PLAYED_FRAMES,
+            }
+            .into());
         }
         let face = self.face;
         let transform_fat = Fat {

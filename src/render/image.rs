@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::colour::{linear_to_srgb8, srgb8_to_linear};
 use super::font;
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 /// Largest width or height of an image made by this module; larger requests are clamped so a
 /// bad argument cannot allocate without bound.
@@ -128,12 +128,12 @@ impl Image {
     /// Writes the image as a PNG file, atomically (the target is replaced only on success).
     pub fn write_png(&self, path: &Path) -> Result<()> {
         if self.rgba.len() != self.width as usize * self.height as usize * 4 {
-            return Err(Error::Invalid(format!(
-                "image of {}×{} has {} bytes of pixels",
-                self.width,
-                self.height,
-                self.rgba.len()
-            )));
+            return Err(super::RenderError::PixelCount {
+                width: self.width,
+                height: self.height,
+                bytes: self.rgba.len(),
+            }
+            .into());
         }
         crate::io::write_atomic_with(path, |w| self.encode_png(w))
     }

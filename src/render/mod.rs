@@ -26,6 +26,7 @@
 //! ```
 
 mod colour;
+mod error;
 pub mod font;
 mod image;
 mod raster;
@@ -38,6 +39,7 @@ pub use self::image::{
     contact_sheet, grid, Image, ImageStats, PixelRect, MAX_IMAGE_SIDE, THUMBNAIL_SIDE,
 };
 pub use colour::{linear_to_srgb, srgb_to_linear};
+pub use error::RenderError;
 pub use raster::render;
 
 use crate::mesh::Aabb;

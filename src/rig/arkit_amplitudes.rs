@@ -54,8 +54,8 @@ pub struct Amplitude {
 /// The bundled ARKit amplitudes (`specs/arkit-fap-amplitudes.csv`).
 pub fn arkit_amplitudes() -> Vec<Amplitude> {
     parse_amplitudes(
-        Path::new("specs/arkit-fap-amplitudes.csv"),
         ARKIT_AMPLITUDES_CSV,
+        Path::new("specs/arkit-fap-amplitudes.csv"),
     )
     .expect("the bundled amplitude table parses")
 }
@@ -182,7 +182,7 @@ pub fn amplitudes_csv(rows: &[Amplitude]) -> String {
 }
 
 /// Parses an amplitude table; `file` names it in errors (`file:line:column: expected ...`).
-pub fn parse_amplitudes(file: &Path, text: &str) -> Result<Vec<Amplitude>> {
+pub fn parse_amplitudes(text: &str, file: &Path) -> Result<Vec<Amplitude>> {
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
@@ -275,14 +275,14 @@ mod tests {
         assert!(rows
             .iter()
             .any(|r| r.shape == "jawOpen" && r.fap.name() == "open_jaw"));
-        let again = parse_amplitudes(Path::new("x.csv"), &amplitudes_csv(&rows)).unwrap();
+        let again = parse_amplitudes(&amplitudes_csv(&rows), Path::new("x.csv")).unwrap();
         assert_eq!(again.len(), rows.len());
     }
 
     #[test]
     fn bad_tables_are_located() {
         let e = |t: &str| {
-            parse_amplitudes(Path::new("a.csv"), t)
+            parse_amplitudes(t, Path::new("a.csv"))
                 .unwrap_err()
                 .to_string()
         };

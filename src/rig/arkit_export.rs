@@ -165,10 +165,10 @@ pub fn write_arkit_gltf(
     units: Option<crate::face::units::LengthUnit>,
 ) -> Result<(ArkitExportReport, Vec<String>)> {
     if face.fat.tables.is_empty() {
-        return Err(crate::error::Error::Invalid(format!(
-            "face `{}` has no FAT, so no ARKit shapes can be made from it",
-            face.name
-        )));
+        return Err(super::RigError::NoFat {
+            face: face.name.clone(),
+        }
+        .into());
     }
     let amplitudes = super::arkit_amplitudes::arkit_amplitudes();
     let (mut rig, report) = face_to_arkit_rig(face, &amplitudes)?;

@@ -43,7 +43,7 @@ use super::fap_map::ShapeLookup;
 use super::fat_build::RigFatReport;
 use super::weights_csv::{WeightCsv, MAX_FRAME_NUMBER};
 use super::Rig;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::{FaceModel, FacePose};
 use crate::fap::{FapFrame, FapStream, FapTimeline};
 use crate::fat::eval::{frame_activations, Activation, FatEvaluator, FatOutput};
@@ -148,10 +148,11 @@ impl<'a> ArkitBridge<'a> {
                 .zip(&rig.meshes)
                 .any(|(f, r)| f.mesh.vertex_count() != r.mesh.vertex_count())
         {
-            return Err(Error::Invalid(format!(
-                "face `{}` is not the face of rig `{}` (meshes differ)",
-                face.name, rig.name
-            )));
+            return Err(super::RigError::FaceNotOfRig {
+                face: face.name.clone(),
+                rig: rig.name.clone(),
+            }
+            .into());
         }
         let probes: Vec<(FeaturePointId, usize, u32)> = face
             .feature_points
@@ -159,10 +160,10 @@ impl<'a> ArkitBridge<'a> {
             .filter_map(|p| face.fp_vertex(p.id).map(|(m, v)| (p.id, m, v)))
             .collect();
         if probes.is_empty() {
-            return Err(Error::Invalid(format!(
-                "face `{}` has no feature points bound to vertices: nothing to compare (--fp)",
-                face.name
-            )));
+            return Err(super::RigError::NoBoundFeaturePoints {
+                face: face.name.clone(),
+            }
+            .into());
         }
         let mut evaluator = face.evaluator()?;
         let mut output = evaluator.output();
@@ -363,23 +364,26 @@ impl<'a> ArkitBridge<'a> {
         stream: &FapStream,
     ) -> Result<(Vec<Vec<f32>>, ToArkitReport)> {
         if !(stream.frame_rate.is_finite() && stream.frame_rate > 0.0) {
-            return Err(Error::Invalid(format!(
-                "stream `{}`: frame rate {} is not a finite positive number",
-                stream.name, stream.frame_rate
-            )));
+            return Err(super::RigError::StreamFrameRate {
+                stream: stream.name.clone(),
+                rate: stream.frame_rate,
+            }
+            .into());
         }
         let timeline = FapTimeline::new(stream);
         let Some(last) = timeline.last_number() else {
-            return Err(Error::Invalid(format!(
-                "stream `{}` has no frames",
-                stream.name
-            )));
+            return Err(super::RigError::EmptyStream {
+                stream: stream.name.clone(),
+            }
+            .into());
         };
         if last > MAX_FRAME_NUMBER {
-            return Err(Error::Invalid(format!(
-                "stream `{}`: last frame number {last} is beyond {MAX_FRAME_NUMBER}",
-                stream.name
-            )));
+            return Err(super::RigError::StreamTooLong {
+                stream: stream.name.clone(),
+                last,
+                limit: MAX_FRAME_NUMBER,
+            }
+            .into());
         }
         let face = self.face;
         let neutral = probe_positions(

@@ -91,7 +91,7 @@ pub fn normalise_shape_name(name: &str) -> String {
 impl FapMap {
     /// The built-in ARKit-52 preset (`specs/arkit-fap-map.csv`).
     pub fn arkit() -> FapMap {
-        let mut m = parse_fap_map(Path::new("specs/arkit-fap-map.csv"), ARKIT_MAP_CSV)
+        let mut m = parse_fap_map(ARKIT_MAP_CSV, Path::new("specs/arkit-fap-map.csv"))
             .expect("the bundled ARKit map parses");
         m.source = "arkit".into();
         m.strict = false;
@@ -123,18 +123,18 @@ impl FapMap {
                         .map(|t| t.shape.as_str())
                         .filter(|s| names.find(s).is_none())
                         .collect();
-                    return Err(Error::Invalid(format!(
-                        "{}:{}: unknown shape{} {} (rig `{}` has no such blend shape)",
-                        file.display(),
-                        row.line,
-                        if missing.len() == 1 { "" } else { "s" },
-                        missing
+                    return Err(super::RigError::UnknownShapes {
+                        file: file.to_path_buf(),
+                        line: row.line,
+                        plural: missing.len() != 1,
+                        shapes: missing
                             .iter()
                             .map(|s| format!("`{s}`"))
                             .collect::<Vec<_>>()
                             .join(", "),
-                        rig.name
-                    )));
+                        rig: rig.name.clone(),
+                    }
+                    .into());
                 }
             }
         }
@@ -177,11 +177,11 @@ impl ShapeLookup {
 /// Reads a mapping table file (bounded read; strict: unknown shapes are errors).
 pub fn read_fap_map(path: &Path) -> Result<FapMap> {
     let text = crate::io::read_text(path)?;
-    parse_fap_map(path, &text)
+    parse_fap_map(&text, path)
 }
 
 /// Parses a mapping table; `file` names it in errors (`file:line:column: expected ...`).
-pub fn parse_fap_map(file: &Path, text: &str) -> Result<FapMap> {
+pub fn parse_fap_map(text: &str, file: &Path) -> Result<FapMap> {
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
@@ -380,15 +380,15 @@ mod tests {
     fn bad_tables_are_located() {
         let p = Path::new("m.csv");
         let e = parse_fap_map(
-            p,
             "fap,positive,negative,reasoning\nopen_jaw,jawOpen,,ok\nwink,x,,\n",
+            p,
         )
         .unwrap_err()
         .to_string();
         assert!(e.starts_with("m.csv:3:1: expected a low-level FAP"), "{e}");
         let e = parse_fap_map(
-            p,
             "fap,positive,negative,reasoning\nopen_jaw,jawOpen,jawClose,no\n",
+            p,
         )
         .unwrap_err()
         .to_string();
@@ -396,11 +396,11 @@ mod tests {
             e.starts_with("m.csv:2:18: expected no negative shapes"),
             "{e}"
         );
-        let e = parse_fap_map(p, "fap,positive,negative,reasoning\n3,a,,\nopen_jaw,b,,\n")
+        let e = parse_fap_map("fap,positive,negative,reasoning\n3,a,,\nopen_jaw,b,,\n", p)
             .unwrap_err()
             .to_string();
         assert!(e.contains("m.csv:3:1") && e.contains("line 2"), "{e}");
-        let e = parse_fap_map(p, "name,shape\n").unwrap_err().to_string();
+        let e = parse_fap_map("name,shape\n", p).unwrap_err().to_string();
         assert!(e.contains("m.csv:1:1: expected the header"), "{e}");
     }
 }

@@ -23,7 +23,7 @@ use ::gltf::mesh::{Mode, Semantic};
 use ::gltf::{Accessor, Document, Gltf};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
-use super::{BlendShape, Rig, RigMesh, ShapeDelta, MAX_RIG_SHAPES, MAX_RIG_VERTICES};
+use super::{BlendShape, Rig, RigError, RigMesh, ShapeDelta, MAX_RIG_SHAPES, MAX_RIG_VERTICES};
 use crate::error::{Error, Result};
 use crate::mesh::{FaceGroup, Mesh, Polygons};
 
@@ -113,11 +113,11 @@ fn check_glb_header(bytes: &[u8], file: &Path) -> Result<()> {
         .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
     {
         if len < 12 {
-            return Err(Error::Invalid(format!(
-                "{}: not a readable glTF file: the GLB header gives a length of {len} bytes, \
-                 less than the header itself",
-                file.display()
-            )));
+            return Err(RigError::GlbTooShort {
+                file: file.to_path_buf(),
+                length: len,
+            }
+            .into());
         }
     }
     Ok(())
@@ -152,7 +152,12 @@ fn check_attribute_indices(doc: &Document, file: &Path) -> Result<()> {
 
 /// An error at JSON path `at` of `file`.
 fn located(file: &Path, at: &str, what: impl std::fmt::Display) -> Error {
-    Error::Invalid(format!("{}: {at}: {what}", file.display()))
+    RigError::GltfContent {
+        file: file.to_path_buf(),
+        at: at.to_string(),
+        what: what.to_string(),
+    }
+    .into()
 }
 
 /// The `gltf` crate's validation, less two findings that valid files trigger: accessors
@@ -192,22 +197,26 @@ fn gltf_error(file: &Path, e: ::gltf::Error) -> Error {
                 .map(|(p, e)| format!("{p}: {e}"))
                 .collect();
             let more = list.len().saturating_sub(5);
-            Error::Invalid(format!(
-                "{}: invalid glTF: {}{}",
-                file.display(),
-                shown.join("; "),
-                if more > 0 {
-                    format!(" (and {more} more)")
-                } else {
-                    String::new()
-                }
-            ))
+            RigError::InvalidGltf {
+                file: file.to_path_buf(),
+                findings: format!(
+                    "{}{}",
+                    shown.join("; "),
+                    if more > 0 {
+                        format!(" (and {more} more)")
+                    } else {
+                        String::new()
+                    }
+                ),
+            }
+            .into()
         }
         ::gltf::Error::Io(io) => Error::io(file, io),
-        other => Error::Invalid(format!(
-            "{}: not a readable glTF file: {other}",
-            file.display()
-        )),
+        other => RigError::UnreadableGltf {
+            file: file.to_path_buf(),
+            message: other.to_string(),
+        }
+        .into(),
     }
 }
 

@@ -26,6 +26,7 @@ pub mod arkit_export;
 pub mod arkit_names;
 pub mod arkit_weights;
 pub mod bounded_ls;
+mod error;
 pub mod fap_map;
 pub mod fat_build;
 pub mod gltf_read;
@@ -33,6 +34,8 @@ pub mod gltf_write;
 pub mod obj_folder;
 pub mod trim;
 pub mod weights_csv;
+
+pub use error::RigError;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -135,40 +138,45 @@ impl Rig {
         let mut names = HashMap::new();
         for m in &self.meshes {
             if names.insert(m.name.as_str(), ()).is_some() {
-                return Err(Error::Invalid(format!(
-                    "rig `{}`: two meshes are named `{}`",
-                    self.name, m.name
-                )));
+                return Err(RigError::DuplicateMesh {
+                    rig: self.name.clone(),
+                    mesh: m.name.clone(),
+                }
+                .into());
             }
         }
         let mut names = HashMap::new();
         for s in &self.shapes {
             if s.name.is_empty() {
-                return Err(Error::Invalid(format!(
-                    "rig `{}`: a shape has no name",
-                    self.name
-                )));
+                return Err(RigError::UnnamedShape {
+                    rig: self.name.clone(),
+                }
+                .into());
             }
             if names.insert(s.name.as_str(), ()).is_some() {
-                return Err(Error::Invalid(format!(
-                    "rig `{}`: two shapes are named `{}`",
-                    self.name, s.name
-                )));
+                return Err(RigError::DuplicateShape {
+                    rig: self.name.clone(),
+                    shape: s.name.clone(),
+                }
+                .into());
             }
             if !s.default_weight.is_finite() {
-                return Err(Error::Invalid(format!(
-                    "rig `{}`: shape `{}` has a non-finite default weight",
-                    self.name, s.name
-                )));
+                return Err(RigError::NonFiniteWeight {
+                    rig: self.name.clone(),
+                    shape: s.name.clone(),
+                }
+                .into());
             }
             for d in &s.deltas {
-                let who = || format!("rig `{}`: shape `{}`", self.name, s.name);
+                let rig = || self.name.clone();
+                let shape = || s.name.clone();
                 let Some(m) = self.meshes.get(d.mesh) else {
-                    return Err(Error::Invalid(format!(
-                        "{}: unknown mesh {}",
-                        who(),
-                        d.mesh
-                    )));
+                    return Err(RigError::ShapeUnknownMesh {
+                        rig: rig(),
+                        shape: shape(),
+                        mesh: d.mesh,
+                    }
+                    .into());
                 };
                 if d.vertices.len() != d.offsets.len()
                     || d.vertices.windows(2).any(|w| w[0] >= w[1])
@@ -176,18 +184,20 @@ impl Rig {
                         .last()
                         .is_some_and(|&v| v as usize >= m.mesh.vertex_count())
                 {
-                    return Err(Error::Invalid(format!(
-                        "{}: bad vertex list on mesh `{}`",
-                        who(),
-                        m.name
-                    )));
+                    return Err(RigError::BadVertexList {
+                        rig: rig(),
+                        shape: shape(),
+                        mesh: m.name.clone(),
+                    }
+                    .into());
                 }
                 if !d.offsets.iter().all(|o| o.is_finite()) {
-                    return Err(Error::Invalid(format!(
-                        "{}: non-finite offset on mesh `{}`",
-                        who(),
-                        m.name
-                    )));
+                    return Err(RigError::NonFiniteOffset {
+                        rig: rig(),
+                        shape: shape(),
+                        mesh: m.name.clone(),
+                    }
+                    .into());
                 }
             }
         }
@@ -197,10 +207,10 @@ impl Rig {
     /// Fails unless the rig has at least one shape (`file` names the source in the message).
     pub fn require_shapes(&self, file: &Path) -> Result<()> {
         if self.shapes.is_empty() {
-            return Err(Error::Invalid(format!(
-                "{}: no morph targets (blend shapes): not a rig",
-                file.display()
-            )));
+            return Err(RigError::NoShapes {
+                file: file.to_path_buf(),
+            }
+            .into());
         }
         Ok(())
     }

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use super::{sparse_delta, BlendShape, Rig, RigMesh, MAX_RIG_SHAPES};
+use super::{sparse_delta, BlendShape, Rig, RigError, RigMesh, MAX_RIG_SHAPES};
 use crate::error::{Error, Result};
 use crate::mesh::obj::{read_obj_file, read_obj_positions_file};
 
@@ -51,19 +51,20 @@ pub fn find_neutral(dir: &Path) -> Result<PathBuf> {
         .collect();
     match candidates.as_slice() {
         [one] => Ok(one.clone()),
-        [] => Err(Error::Invalid(format!(
-            "{}: no neutral OBJ (expected one of {} or a single *neutral*.obj)",
-            dir.display(),
-            NEUTRAL_NAMES.join(", ")
-        ))),
-        many => Err(Error::Invalid(format!(
-            "{}: several candidate neutrals ({}); name one neutral.obj",
-            dir.display(),
-            many.iter()
+        [] => Err(RigError::NoNeutral {
+            dir: dir.to_path_buf(),
+            expected: NEUTRAL_NAMES.join(", "),
+        }
+        .into()),
+        many => Err(RigError::SeveralNeutrals {
+            dir: dir.to_path_buf(),
+            candidates: many
+                .iter()
                 .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
                 .collect::<Vec<_>>()
-                .join(", ")
-        ))),
+                .join(", "),
+        }
+        .into()),
     }
 }
 
@@ -77,10 +78,11 @@ fn obj_files(dir: &Path) -> Result<Vec<PathBuf>> {
             .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
         if is_obj && path.is_file() {
             if out.len() > MAX_RIG_SHAPES {
-                return Err(Error::Invalid(format!(
-                    "{}: more than {MAX_RIG_SHAPES} OBJ files; not a rig folder",
-                    dir.display()
-                )));
+                return Err(RigError::TooManyShapes {
+                    dir: dir.to_path_buf(),
+                    limit: MAX_RIG_SHAPES,
+                }
+                .into());
             }
             out.push(path);
         }
@@ -104,12 +106,13 @@ pub fn read_obj_rig_with(neutral: &Path, shapes_dir: &Path) -> Result<Rig> {
         .map(|path| {
             let positions = read_obj_positions_file(path)?;
             if positions.len() != n {
-                return Err(Error::Invalid(format!(
-                    "{}: has {} vertices but the neutral {} has {n}; a shape must be the full neutral mesh",
-                    path.display(),
-                    positions.len(),
-                    neutral.display()
-                )));
+                return Err(RigError::ShapeVertexCount {
+                    file: path.clone(),
+                    vertices: positions.len(),
+                    neutral: neutral.to_path_buf(),
+                    expected: n,
+                }
+                .into());
             }
             let name = path
                 .file_stem()

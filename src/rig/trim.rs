@@ -3,7 +3,7 @@
 //! wants a lighter rig (a face without its eyelashes, only the speech shapes).
 
 use super::{Rig, ShapeDelta};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::mesh::{FaceGroup, Mesh, Polygons};
 
 impl Rig {
@@ -14,21 +14,22 @@ impl Rig {
     /// dropped. Returns the new index of every old vertex.
     pub fn retain_vertices(&mut self, mesh: usize, keep: &[bool]) -> Result<Vec<Option<u32>>> {
         let Some(rig_mesh) = self.meshes.get_mut(mesh) else {
-            return Err(Error::Invalid(format!(
-                "rig {}: no mesh {mesh} (it has {})",
-                self.name,
-                self.meshes.len()
-            )));
+            return Err(super::RigError::NoSuchMesh {
+                rig: self.name.clone(),
+                mesh,
+                count: self.meshes.len(),
+            }
+            .into());
         };
         let old = &rig_mesh.mesh;
         if keep.len() != old.vertex_count() {
-            return Err(Error::Invalid(format!(
-                "rig {}: mesh {} has {} vertices, the keep mask {}",
-                self.name,
-                rig_mesh.name,
-                old.vertex_count(),
-                keep.len()
-            )));
+            return Err(super::RigError::KeepMaskLength {
+                rig: self.name.clone(),
+                mesh: rig_mesh.name.clone(),
+                vertices: old.vertex_count(),
+                mask: keep.len(),
+            }
+            .into());
         }
         let mut remap = vec![None; keep.len()];
         let mut next = 0u32;

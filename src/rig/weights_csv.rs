@@ -84,7 +84,7 @@ pub struct WeightCsv {
 /// Reads a weight CSV file (bounded read); see [`parse_weights_csv`].
 pub fn read_weights_csv(path: &Path, fps: Option<f64>) -> Result<WeightCsv> {
     let text = crate::io::read_text(path)?;
-    parse_weights_csv(path, &text, fps)
+    parse_weights_csv(&text, path, fps)
 }
 
 /// One comma-separated field: its text (trimmed, quotes removed) and byte offset.
@@ -149,16 +149,17 @@ fn parse_timecode(s: &str) -> Option<Stamp> {
 
 /// Parses a weight CSV; `file` names it in errors, `fps` overrides the detected frame rate
 /// (and is the timecode rate when the capture never crosses a second). See the module docs.
-pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<WeightCsv> {
+pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<WeightCsv> {
     let err = |offset: usize, expected: String| -> crate::error::Error {
         ParseError::at_offset(file, text, offset, expected).into()
     };
     if let Some(f) = fps {
         if !(f.is_finite() && f > 0.0 && f <= 1000.0) {
-            return Err(crate::error::Error::Invalid(format!(
-                "{}: frame rate {f} is not between 0 and 1000",
-                file.display()
-            )));
+            return Err(super::RigError::CsvFrameRate {
+                file: file.to_path_buf(),
+                fps: f,
+            }
+            .into());
         }
     }
     let body_start = if text.starts_with('\u{feff}') { 3 } else { 0 };
@@ -334,11 +335,8 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
             let t: Vec<f64> = stamps.iter().map(|(s, _)| s.seconds).collect();
             let rate = match fps {
                 Some(f) => f,
-                None => rate_from_times(&t).ok_or_else(|| {
-                    crate::error::Error::Invalid(format!(
-                        "{}: cannot detect the frame rate (fewer than two distinct times); give --fps",
-                        file.display()
-                    ))
+                None => rate_from_times(&t).ok_or_else(|| super::RigError::UndetectableRate {
+                    file: file.to_path_buf(),
                 })?,
             };
             (t, rate, fps.is_none())
@@ -352,11 +350,8 @@ pub fn parse_weights_csv(file: &Path, text: &str, fps: Option<f64>) -> Result<We
                     .fold(0.0, f64::max)
                     + 1.0
             } else {
-                fps.ok_or_else(|| {
-                    crate::error::Error::Invalid(format!(
-                        "{}: the timecodes never cross a second, so their frame rate cannot be detected; give --fps",
-                        file.display()
-                    ))
+                fps.ok_or_else(|| super::RigError::UndetectableTimecodeRate {
+                    file: file.to_path_buf(),
                 })?
             };
             let t: Vec<f64> = stamps
@@ -505,7 +500,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str, fps: Option<f64>) -> Result<WeightCsv> {
-        parse_weights_csv(Path::new("w.csv"), text, fps)
+        parse_weights_csv(text, Path::new("w.csv"), fps)
     }
 
     fn message(text: &str) -> String {

@@ -20,7 +20,8 @@ use serde::Serialize;
 use super::articulation::{articulation, ARTICULATION_FAPS};
 use super::espeak::TimedPhoneme;
 use super::phonemes::{PhonemeVisemeTable, VisemeTarget};
-use crate::error::{Error, Result};
+use super::SpeechError;
+use crate::error::Result;
 use crate::fap::{FapFrame, FapStream, VisemeParams};
 use crate::spec::{FapId, Viseme};
 
@@ -196,21 +197,19 @@ pub fn speech_animation(
     opts: &SpeechOptions,
 ) -> Result<SpeechAnimation> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
-        return Err(Error::Invalid(format!(
-            "frame rate {} is not between 0 and 1000",
-            opts.fps
-        )));
+        return Err(SpeechError::BadFrameRate { fps: opts.fps }.into());
     }
     if !(duration.is_finite() && duration >= 0.0) {
-        return Err(Error::Invalid(format!("speech duration {duration} s")));
+        return Err(SpeechError::BadDuration { duration }.into());
     }
     let (keys, unmapped) = viseme_keys(phonemes, duration, PhonemeVisemeTable::standard());
     let count = ((duration * opts.fps).round() as u64).max(1);
     if count > crate::fap::MAX_RESAMPLED_FRAMES {
-        return Err(Error::Invalid(format!(
-            "{count} frames of speech is more than {}",
-            crate::fap::MAX_RESAMPLED_FRAMES
-        )));
+        return Err(SpeechError::TooManyFrames {
+            count,
+            limit: crate::fap::MAX_RESAMPLED_FRAMES,
+        }
+        .into());
     }
     let mut stream = FapStream::new(opts.name.clone(), opts.fps);
     stream.frames.reserve(count as usize);

@@ -14,6 +14,7 @@
 use std::ffi::{c_char, c_int, c_short, c_uint, c_void, CString};
 use std::sync::{Mutex, OnceLock};
 
+use super::SpeechError;
 use crate::error::{Error, Result};
 
 /// Longest text accepted, in bytes (a few minutes of speech).
@@ -226,26 +227,24 @@ pub fn espeak_available() -> bool {
 /// library missing ([`Error::MissingTool`]) or failing.
 pub fn speak(text: &str, voice: &str) -> Result<Utterance> {
     if text.trim().is_empty() {
-        return Err(Error::Invalid("nothing to say: the text is empty".into()));
+        return Err(SpeechError::EmptyText.into());
     }
     if text.len() > MAX_TEXT_BYTES {
-        return Err(Error::Invalid(format!(
-            "the text has {} bytes, more than the {MAX_TEXT_BYTES} accepted",
-            text.len()
-        )));
+        return Err(SpeechError::TextTooLong {
+            bytes: text.len(),
+            limit: MAX_TEXT_BYTES,
+        }
+        .into());
     }
-    let c_text =
-        CString::new(text).map_err(|_| Error::Invalid("the text contains a NUL byte".into()))?;
-    let c_voice = CString::new(voice)
-        .map_err(|_| Error::Invalid("the voice name contains a NUL byte".into()))?;
+    let c_text = CString::new(text).map_err(|_| SpeechError::NulInText)?;
+    let c_voice = CString::new(voice).map_err(|_| SpeechError::NulInVoice)?;
     let engine = ENGINE.get_or_init(load).as_ref().map_err(|e| missing(e))?;
-    let engine = engine
-        .lock()
-        .map_err(|_| Error::Invalid("espeak-ng failed earlier in this process".into()))?;
+    let engine = engine.lock().map_err(|_| SpeechError::EngineFailed)?;
     if unsafe { (engine.set_voice)(c_voice.as_ptr()) } != EE_OK {
-        return Err(Error::Invalid(format!(
-            "espeak-ng has no voice `{voice}` (`espeak-ng --voices` lists them)"
-        )));
+        return Err(SpeechError::UnknownVoice {
+            voice: voice.to_string(),
+        }
+        .into());
     }
     *COLLECTOR.lock().map_err(|_| poisoned())? = Some(Collector::default());
     let bytes = c_text.as_bytes_with_nul();
@@ -265,14 +264,10 @@ pub fn speak(text: &str, voice: &str) -> Result<Utterance> {
     let collected = COLLECTOR.lock().map_err(|_| poisoned())?.take();
     let collected = collected.unwrap_or_default();
     if status != EE_OK {
-        return Err(Error::Invalid(format!(
-            "espeak-ng could not synthesise the text (error {status})"
-        )));
+        return Err(SpeechError::SynthesisFailed { status }.into());
     }
     if collected.samples.len() >= MAX_SAMPLES {
-        return Err(Error::Invalid(
-            "the speech is longer than 10 minutes; split the text".into(),
-        ));
+        return Err(SpeechError::TooLong.into());
     }
     let sample_rate = engine.sample_rate;
     let duration = collected.samples.len() as f64 / f64::from(sample_rate);
@@ -284,7 +279,7 @@ pub fn speak(text: &str, voice: &str) -> Result<Utterance> {
 }
 
 fn poisoned() -> Error {
-    Error::Invalid("espeak-ng failed earlier in this process".into())
+    SpeechError::EngineFailed.into()
 }
 
 /// Phoneme events (milliseconds, mnemonic) as intervals: each ends where the next starts,

@@ -27,11 +27,13 @@
 
 pub mod animation;
 pub mod articulation;
+mod error;
 pub mod espeak;
 pub mod phonemes;
 pub mod wav;
 
 pub use animation::{speech_animation, MouthFaps, SpeechAnimation, SpeechOptions, VisemeKey};
+pub use error::SpeechError;
 pub use espeak::{espeak_available, speak, TimedPhoneme, Utterance};
 pub use phonemes::{PhonemeVisemeTable, VisemeTarget};
 

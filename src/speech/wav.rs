@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::espeak::Utterance;
-use crate::error::{Error, Result};
+use crate::error::{EncodeError, Error, Result};
 
 /// The WAV bytes of `utterance`.
 pub fn wav_bytes(utterance: &Utterance) -> Result<Vec<u8>> {
@@ -14,7 +14,7 @@ pub fn wav_bytes(utterance: &Utterance) -> Result<Vec<u8>> {
         sample_format: hound::SampleFormat::Int,
     };
     let mut cursor = std::io::Cursor::new(Vec::with_capacity(44 + 2 * utterance.samples.len()));
-    let encode = |e: hound::Error| Error::Invalid(format!("cannot encode WAV: {e}"));
+    let encode = |e: hound::Error| -> Error { EncodeError::new("WAV", e).into() };
     let mut w = hound::WavWriter::new(&mut cursor, spec).map_err(encode)?;
     for &s in &utterance.samples {
         w.write_sample(s).map_err(encode)?;

@@ -26,10 +26,10 @@
 //! use std::path::Path;
 //! use fbakit::vrml::{parse_vrml, write_vrml_string};
 //! let text = "#VRML V2.0 utf8\nDEF C Coordinate { point [ 0 0 0, 1 0 0 ] }";
-//! let scene = parse_vrml(Path::new("<input>"), text).unwrap();
+//! let scene = parse_vrml(text, Path::new("<input>")).unwrap();
 //! let c = scene.find_def("C").unwrap();
 //! assert_eq!(scene.get_mfvec3f(c, "point").unwrap().len(), 2);
-//! assert_eq!(parse_vrml(Path::new("<input>"), &write_vrml_string(&scene)).unwrap(), scene);
+//! assert_eq!(parse_vrml(&write_vrml_string(&scene), Path::new("<input>")).unwrap(), scene);
 //! ```
 
 pub mod fields;
@@ -54,10 +54,17 @@ use crate::error::{ParseError, Result};
 /// Reads and parses a VRML97 file (bounded read, UTF-8 checked with a located error).
 pub fn read_vrml_file(path: &Path) -> Result<Scene> {
     let text = crate::io::read_text(path)?;
-    Ok(parse_vrml(path, &text)?)
+    Ok(parse_vrml(&text, path)?)
 }
 
-/// Parses in-memory text named `<input>` in errors.
+/// Reads a VRML97 scene from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]); `source` names it in locations.
+pub fn read_vrml_from<R: std::io::BufRead>(reader: R, source: &Path) -> Result<Scene> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    Ok(parse_vrml(&text, source)?)
+}
+
+/// [`parse_vrml`] for text without a file, named `<input>` in errors.
 pub fn parse_vrml_str(text: &str) -> Result<Scene, ParseError> {
-    parse_vrml(Path::new("<input>"), text)
+    parse_vrml(text, Path::new("<input>"))
 }

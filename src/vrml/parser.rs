@@ -30,7 +30,7 @@ pub const HEADER: &str = "#VRML V2.0 utf8";
 type Res<'a, T> = Result<(&'a str, T), Box<ParseError>>;
 
 /// Parses VRML97 text; `file` names it in error messages.
-pub fn parse_vrml(file: &Path, text: &str) -> Result<Scene, ParseError> {
+pub fn parse_vrml(text: &str, file: &Path) -> Result<Scene, ParseError> {
     let mut p = Parser {
         file,
         text,

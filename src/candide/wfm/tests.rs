@@ -104,7 +104,7 @@ fn line_combinators() {
 
 #[test]
 fn reads_every_section() {
-    let m = read_wfm_str(SMALL, p()).unwrap();
+    let m = parse_wfm(SMALL, p()).unwrap();
     assert_eq!(m.header, ["Tiny test model", "second header line"]);
     assert_eq!(m.vertices.len(), 4);
     assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
@@ -140,18 +140,18 @@ fn reads_every_section() {
 #[test]
 fn trailing_sections_are_optional() {
     let cut = SMALL.find("# ANIMATION UNITS LIST:").unwrap();
-    let m = read_wfm_str(&SMALL[..cut], p()).unwrap();
+    let m = parse_wfm(&SMALL[..cut], p()).unwrap();
     assert_eq!((m.vertices.len(), m.triangles.len()), (4, 2));
     assert!(m.animation_units.is_empty() && m.global_motion.is_none());
     assert_eq!(m.to_mesh().face_count(), 2);
     // The last line may lack its line ending; counts still fit.
-    let m = read_wfm_str("# h\n# VERTEX LIST:\n1\n0 0 0\n# FACE LIST:\n1\n0 0 0", p()).unwrap();
+    let m = parse_wfm("# h\n# VERTEX LIST:\n1\n0 0 0\n# FACE LIST:\n1\n0 0 0", p()).unwrap();
     assert_eq!(m.vertices, vec![Vec3::ZERO]);
     assert_eq!(m.triangles, vec![[0, 0, 0]]);
 }
 
 fn err(text: &str) -> String {
-    read_wfm_str(text, p()).unwrap_err().to_string()
+    parse_wfm(text, p()).unwrap_err().to_string()
 }
 
 #[test]

@@ -5,7 +5,8 @@ use glam::{DMat3, DVec3, Vec3};
 use serde::Serialize;
 
 use super::CloneOptions;
-use crate::error::{Error, Result};
+use crate::clone::CloneError;
+use crate::error::Result;
 use crate::face::FaceModel;
 
 /// A similarity `p ↦ s·R·p + t`.
@@ -58,9 +59,7 @@ impl Similarity {
     pub fn fit(from: &[DVec3], to: &[DVec3]) -> Result<Similarity> {
         let n = from.len().min(to.len());
         if n < 3 {
-            return Err(Error::Invalid(format!(
-                "aligning the faces needs at least 3 shared feature points, found {n}"
-            )));
+            return Err(CloneError::TooFewSharedPoints { found: n }.into());
         }
         let mf = from[..n].iter().sum::<DVec3>() / n as f64;
         let mt = to[..n].iter().sum::<DVec3>() / n as f64;
@@ -77,14 +76,12 @@ impl Similarity {
         var_f /= n as f64;
         let svd = cov.svd(true, true);
         let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-            return Err(Error::Invalid("feature point alignment: SVD failed".into()));
+            return Err(CloneError::SvdFailed.into());
         };
         let mut sv = svd.singular_values;
         // Rank check: collinear points leave the rotation undetermined.
         if var_f <= 0.0 || sv.iter().filter(|&&x| x > 1e-12 * sv.max()).count() < 2 {
-            return Err(Error::Invalid(
-                "feature point alignment: the shared feature points are collinear".into(),
-            ));
+            return Err(CloneError::CollinearPoints.into());
         }
         let mut d = nalgebra::Matrix3::<f64>::identity();
         if (u * vt).determinant() < 0.0 {
@@ -107,9 +104,7 @@ impl Similarity {
         let rotation = glam::DQuat::from_mat3(&rm).normalize();
         let translation = mt - rotation * mf * scale;
         if !scale.is_finite() || scale <= 0.0 || !translation.is_finite() {
-            return Err(Error::Invalid(
-                "feature point alignment gave a degenerate similarity".into(),
-            ));
+            return Err(CloneError::DegenerateSimilarity.into());
         }
         Ok(Similarity {
             scale,

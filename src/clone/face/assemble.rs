@@ -6,8 +6,9 @@ use std::collections::HashMap;
 use super::motions::back_to_meshes;
 use super::rigid::RigidPlan;
 use super::{CloneReport, FaceParts, Similarity, SkinSurface};
+use crate::clone::CloneError;
 use crate::clone::SurfaceMotion;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::FaceModel;
 use crate::fat::morph::{fat_from_morph_targets, MorphMesh, MorphTarget};
 use crate::fat::{Fat, TableKey};
@@ -82,10 +83,11 @@ fn check_finite(fat: &Fat) -> Result<()> {
             if m.displacements.iter().any(|d| !d.is_finite())
                 || m.interval_borders.iter().any(|b| !b.is_finite())
             {
-                return Err(Error::Invalid(format!(
-                    "cloning produced a non-finite displacement for {} on mesh `{}`",
-                    t.key, m.mesh
-                )));
+                return Err(CloneError::NonFiniteDisplacement {
+                    key: t.key,
+                    mesh: m.mesh.clone(),
+                }
+                .into());
             }
         }
         for x in &t.transforms {
@@ -94,10 +96,11 @@ fn check_finite(fat: &Fat) -> Result<()> {
                 || !x.scale.is_finite()
                 || !x.translation.is_finite()
             {
-                return Err(Error::Invalid(format!(
-                    "cloning produced a non-finite transform entry for {} on `{}`",
-                    t.key, x.transform
-                )));
+                return Err(CloneError::NonFiniteTransform {
+                    key: t.key,
+                    transform: x.transform.clone(),
+                }
+                .into());
             }
         }
     }

@@ -7,8 +7,9 @@ use glam::Vec3;
 
 use super::parts::{face_diagonal, fp_mesh_vertex};
 use super::Similarity;
+use crate::clone::CloneError;
 use crate::clone::CloneSurface;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::face::{FaceFrames, FaceModel};
 use crate::fdp::{Fapu, FeaturePoint, FeaturePointSet};
 use crate::mesh::find_coincident_vertices;
@@ -57,10 +58,11 @@ pub fn build_skin_surface(
     let diag = face_diagonal(face, &frames);
     let (positions, triangles, starts) = concatenate_skin(face, &frames, skin, frame);
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "face `{}`: skin vertex {i} has a non-finite position",
-            face.name
-        )));
+        return Err(CloneError::NonFiniteSkin {
+            face: face.name.clone(),
+            vertex: i,
+        }
+        .into());
     }
     let (fp_positions, fapu) = framed_feature_points(face, frame)?;
     // Weld, keeping the closed mouth apart.
@@ -140,8 +142,10 @@ fn framed_feature_points(
             fp_set.insert(FeaturePoint::at(fp.id, q));
         }
     }
-    let fapu = Fapu::from_feature_points(&fp_set)
-        .map_err(|e| Error::Invalid(format!("face `{}`: {e}", face.name)))?;
+    let fapu = Fapu::from_feature_points(&fp_set).map_err(|e| CloneError::Fapu {
+        face: face.name.clone(),
+        source: Box::new(e),
+    })?;
     Ok((fp_positions, fapu))
 }
 
@@ -208,14 +212,11 @@ impl Box3 {
 /// The box around the closed mouth's lip line: between the lip corners (8.3, 8.4) widened by
 /// 0.1 MW0, ±0.35 MNS0 about the lip line, from half an MW0 behind the corners forward.
 fn mouth_box(fps: &BTreeMap<FeaturePointId, Vec3>, fapu: &Fapu) -> Option<Box3> {
-    let get = |s: &str| {
-        fps.get(&s.parse::<FeaturePointId>().expect("label"))
-            .copied()
-    };
-    let (l, r) = (get("8.3")?, get("8.4")?);
+    let get = |id: FeaturePointId| fps.get(&id).copied();
+    let (l, r) = (get(FeaturePointId::FP_8_3)?, get(FeaturePointId::FP_8_4)?);
     let mw = fapu.distances.mw0 as f32;
     let mns = fapu.distances.mns0 as f32;
-    let lip_y = match (get("2.2"), get("2.3")) {
+    let lip_y = match (get(FeaturePointId::FP_2_2), get(FeaturePointId::FP_2_3)) {
         (Some(a), Some(b)) => (a.y + b.y) / 2.0,
         _ => (l.y + r.y) / 2.0,
     };

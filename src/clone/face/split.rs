@@ -65,14 +65,10 @@ struct Landmarks {
 
 impl Landmarks {
     fn of(face: &FaceModel) -> Option<Landmarks> {
-        let p = |s: &str| {
-            s.parse::<FeaturePointId>()
-                .ok()
-                .and_then(|id| face.feature_points.position(id))
-        };
+        let p = |id: FeaturePointId| face.feature_points.position(id);
         let d = face.fapu().ok()?.distances;
-        let (l, r) = (p("3.5")?, p("3.6")?);
-        let (u, lo) = (p("2.2")?, p("2.3")?);
+        let (l, r) = (p(FeaturePointId::FP_3_5)?, p(FeaturePointId::FP_3_6)?);
+        let (u, lo) = (p(FeaturePointId::FP_2_2)?, p(FeaturePointId::FP_2_3)?);
         Some(Landmarks {
             pupils: [(Part::LeftEye, l), (Part::RightEye, r)],
             lip_y: (u.y + lo.y) / 2.0,
@@ -131,9 +127,7 @@ pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
     // Meshes holding a skin feature point (2.1: the chin) are the candidates.
-    let Some(chin) = "2.1".parse::<FeaturePointId>().ok() else {
-        return (face.clone(), Vec::new());
-    };
+    let chin = FeaturePointId::FP_2_1;
     let Some((mi, _)) = fp_mesh_vertex(face, &frames, chin, diag * 1e-4) else {
         return (face.clone(), Vec::new());
     };

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use super::write::{add, set_field, use_of};
 use super::write_geometry::vec3s;
-use crate::error::{Error, Result};
-use crate::face::FaceModel;
+use crate::error::Result;
+use crate::face::{FaceError, FaceModel};
 use crate::fat::{FaceDefMesh, FaceDefTransform, TableKey};
 use crate::vrml::{FieldValue, Node, NodeId, NodeRef, Scene};
 
@@ -46,21 +46,22 @@ pub(super) fn table_nodes(
             .push(("highLevelSelect".into(), FieldValue::SFInt32(select as i32)));
         let mut mesh_refs = Vec::new();
         for m in &table.meshes {
-            let target = *mesh_node_of.get(m.mesh.as_str()).ok_or_else(|| {
-                Error::Invalid(format!(
-                    "{}: FAT refers to unknown mesh `{}`",
-                    table.key, m.mesh
-                ))
-            })?;
+            let target =
+                *mesh_node_of
+                    .get(m.mesh.as_str())
+                    .ok_or_else(|| FaceError::FatMeshNotInScene {
+                        key: table.key,
+                        mesh: m.mesh.clone(),
+                    })?;
             mesh_refs.push(def_mesh_node(m, target, table.key)?);
         }
         let mut transform_refs = Vec::new();
         for t in &table.transforms {
             let target = *transform_node_of.get(t.transform.as_str()).ok_or_else(|| {
-                Error::Invalid(format!(
-                    "{}: FAT refers to unknown transform `{}`",
-                    table.key, t.transform
-                ))
+                FaceError::FatTransformNotInScene {
+                    key: table.key,
+                    transform: t.transform.clone(),
+                }
             })?;
             transform_refs.push(def_transform_node(t, target));
         }
@@ -164,9 +165,7 @@ pub(super) fn attach_tables(scene: &mut Scene, fdp: NodeId, tables: Vec<DefTable
 /// error.
 fn border_i32(b: f64, key: TableKey) -> Result<i32> {
     if b.fract() != 0.0 || !b.is_finite() || b.abs() > i32::MAX as f64 {
-        return Err(Error::Invalid(format!(
-            "{key}: interval border {b} is not an integer (intervalBorders is MFInt32)"
-        )));
+        return Err(FaceError::NonIntegerBorder { key, border: b }.into());
     }
     Ok(b as i32)
 }

@@ -4,8 +4,8 @@
 use glam::{Quat, Vec3};
 
 use super::write::{add, set_field};
-use crate::error::{Error, Result};
-use crate::face::{FaceMesh, FaceModel, FaceTransform};
+use crate::error::Result;
+use crate::face::{FaceError, FaceMesh, FaceModel, FaceTransform};
 use crate::mesh::{Mesh, Polygons, SurfaceFlags};
 use crate::vrml::{FieldValue, Node, NodeId, NodeRef, Scene};
 
@@ -103,20 +103,18 @@ pub(super) fn patch_geometry(scene: &mut Scene, face: &FaceModel) -> Result<Geom
     let mut transform_nodes: Vec<NodeId> = Vec::with_capacity(face.transforms.len());
     for t in &face.transforms {
         let id = find_def_of_type(scene, &t.name, "Transform").ok_or_else(|| {
-            Error::Invalid(format!(
-                "transform `{}` is not in the face's scene; clear `scene` to write a new one",
-                t.name
-            ))
+            FaceError::TransformNotInScene {
+                name: t.name.clone(),
+            }
         })?;
         write_transform_fields(&mut scene.nodes[id.0], t);
         transform_nodes.push(id);
     }
     for m in &face.meshes {
         let id = find_def_of_type(scene, &m.name, "IndexedFaceSet").ok_or_else(|| {
-            Error::Invalid(format!(
-                "mesh `{}` is not in the face's scene; clear `scene` to write a new one",
-                m.name
-            ))
+            FaceError::MeshNotInScene {
+                name: m.name.clone(),
+            }
         })?;
         write_mesh_fields(scene, id, &m.mesh);
         mesh_nodes.push(id);

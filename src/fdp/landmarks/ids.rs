@@ -14,6 +14,7 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::error::{Error, Location, ParseError, Result};
+use crate::fdp::FdpError;
 
 /// The ICT-FaceKit key holding the 68 iBUG landmark vertex ids.
 pub const ICT_LANDMARK_KEY: &str = "idx_to_landmark_verts";
@@ -45,24 +46,33 @@ impl LandmarkIds {
     /// names the place of the offending id. `what` names the source in the count message.
     pub fn check(&self, expected: usize, vertex_count: usize, what: &str) -> Result<()> {
         if self.ids.len() != expected {
-            return Err(Error::Invalid(format!(
-                "{what}: expected {expected} landmark vertex ids, found {}",
-                self.ids.len()
-            )));
+            return Err(FdpError::LandmarkCount {
+                what: what.to_string(),
+                expected,
+                found: self.ids.len(),
+            }
+            .into());
         }
         let mut first_at: std::collections::HashMap<u32, usize> = Default::default();
         for (i, &v) in self.ids.iter().enumerate() {
             if v as usize >= vertex_count {
-                return Err(Error::Invalid(format!(
-                    "{}: landmark {i} is vertex {v}, beyond the mesh's {vertex_count} vertices",
-                    self.places[i]
-                )));
+                return Err(FdpError::LandmarkBeyondMesh {
+                    place: self.places[i].clone(),
+                    landmark: i,
+                    vertex: v,
+                    vertex_count,
+                }
+                .into());
             }
             if let Some(&j) = first_at.get(&v) {
-                return Err(Error::Invalid(format!(
-                    "{}: landmark {i} repeats vertex {v} of landmark {j} ({})",
-                    self.places[i], self.places[j]
-                )));
+                return Err(FdpError::LandmarkRepeated {
+                    place: self.places[i].clone(),
+                    landmark: i,
+                    vertex: v,
+                    first: j,
+                    first_place: self.places[j].clone(),
+                }
+                .into());
             }
             first_at.insert(v, i);
         }
@@ -73,11 +83,11 @@ impl LandmarkIds {
 /// Reads a landmark id file (layout chosen by content: JSON when it starts with `{` or `[`).
 pub fn read_landmark_ids(path: &Path) -> Result<LandmarkIds> {
     let text = crate::io::read_text(path)?;
-    parse_landmark_ids(path, &text)
+    parse_landmark_ids(&text, path)
 }
 
 /// Parses landmark ids; `file` names the text in messages.
-pub fn parse_landmark_ids(file: &Path, text: &str) -> Result<LandmarkIds> {
+pub fn parse_landmark_ids(text: &str, file: &Path) -> Result<LandmarkIds> {
     let trimmed = text.trim_start_matches('\u{feff}').trim_start();
     if trimmed.starts_with('{') || trimmed.starts_with('[') {
         parse_json(file, text)
@@ -103,23 +113,23 @@ fn parse_json(file: &Path, text: &str) -> Result<LandmarkIds> {
         Value::Object(map) => match map.get(ICT_LANDMARK_KEY) {
             Some(Value::Array(a)) => (a, ICT_LANDMARK_KEY.to_string()),
             Some(_) => {
-                return Err(Error::Invalid(format!(
-                    "{}: {ICT_LANDMARK_KEY}: expected an array of vertex indices",
-                    file.display()
-                )))
+                return Err(FdpError::LandmarkKeyNotArray {
+                    file: file.to_path_buf(),
+                }
+                .into())
             }
             None => {
-                return Err(Error::Invalid(format!(
-                    "{}: expected a JSON array of vertex indices or an object with the key `{ICT_LANDMARK_KEY}`",
-                    file.display()
-                )))
+                return Err(FdpError::NotLandmarkJson {
+                    file: file.to_path_buf(),
+                }
+                .into())
             }
         },
         _ => {
-            return Err(Error::Invalid(format!(
-                "{}: expected a JSON array of vertex indices or an object with the key `{ICT_LANDMARK_KEY}`",
-                file.display()
-            )))
+            return Err(FdpError::NotLandmarkJson {
+                file: file.to_path_buf(),
+            }
+            .into())
         }
     };
     let mut ids = Vec::with_capacity(array.len().min(100_000));
@@ -129,10 +139,11 @@ fn parse_json(file: &Path, text: &str) -> Result<LandmarkIds> {
         match v.as_u64().and_then(|n| u32::try_from(n).ok()) {
             Some(n) => ids.push(n),
             None => {
-                return Err(Error::Invalid(format!(
-                    "{place}: expected a vertex index (an integer from 0 to {}), found {v}",
-                    u32::MAX
-                )))
+                return Err(FdpError::BadVertexIndex {
+                    place,
+                    found: v.to_string(),
+                }
+                .into())
             }
         }
         places.push(place);
@@ -193,7 +204,7 @@ mod tests {
     use super::*;
 
     fn parse(name: &str, text: &str) -> Result<LandmarkIds> {
-        parse_landmark_ids(Path::new(name), text)
+        parse_landmark_ids(text, Path::new(name))
     }
 
     #[test]

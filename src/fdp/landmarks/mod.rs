@@ -23,9 +23,9 @@ use std::sync::OnceLock;
 use glam::Vec3;
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fdp::csv::{Combine, FeaturePointRow, FeaturePointTable};
-use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
+use crate::fdp::{FdpError, FeaturePoint, FeaturePointSet, VertexBinding};
 use crate::mesh::Mesh;
 use crate::spec::FeaturePointId;
 
@@ -202,7 +202,7 @@ impl LandmarkFeaturePoints {
 /// Places the scheme's feature points on `mesh` given the mesh vertex of every landmark
 /// (`landmarks[i]` is landmark `i`).
 ///
-/// Errors (all [`Error::Invalid`], i.e. bad input): wrong landmark count, ids out of range or
+/// Errors (all [`FdpError`], i.e. bad input): wrong landmark count, ids out of range or
 /// repeated (use [`LandmarkIds::check`] first for messages naming the file and place), a
 /// non-finite vertex position, or landmarks that do not make a face frame (coincident or
 /// mirrored).
@@ -217,12 +217,14 @@ pub fn feature_points_from_landmarks(
         scheme.name(),
     )?;
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "mesh `{}`: vertex {i} has a non-finite position {}",
-            mesh.name, mesh.positions[i]
-        )));
+        return Err(FdpError::NonFiniteVertex {
+            mesh: mesh.name.clone(),
+            vertex: i,
+            position: mesh.positions[i].to_string(),
+        }
+        .into());
     }
-    derive::place(mesh, scheme, landmarks).map_err(Error::Invalid)
+    derive::place(mesh, scheme, landmarks).map_err(|e| FdpError::LandmarkFrame(e).into())
 }
 
 #[cfg(test)]

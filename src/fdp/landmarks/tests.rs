@@ -214,6 +214,6 @@ fn table_carries_the_provenance() {
     assert_eq!(row.description.as_deref(), Some("landmark iBUG 31"));
     // The CSV round-trips to the same bindings.
     let text = crate::fdp::csv::to_csv_string(&table).unwrap();
-    let back = crate::fdp::csv::parse_csv(std::path::Path::new("t.csv"), &text).unwrap();
+    let back = crate::fdp::csv::parse_csv(&text, std::path::Path::new("t.csv")).unwrap();
     assert_eq!(back, table);
 }

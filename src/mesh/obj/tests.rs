@@ -2,13 +2,11 @@ use super::*;
 use proptest::prelude::*;
 
 fn read(text: &str) -> (ObjScene, Vec<Diagnostic>) {
-    read_obj_str(text, Path::new("t.obj")).unwrap()
+    parse_obj(text, Path::new("t.obj")).unwrap()
 }
 
 fn read_err(text: &str) -> String {
-    read_obj_str(text, Path::new("t.obj"))
-        .unwrap_err()
-        .to_string()
+    parse_obj(text, Path::new("t.obj")).unwrap_err().to_string()
 }
 
 #[test]
@@ -411,7 +409,7 @@ proptest! {
     fn write_then_read_is_identity(scene in arb_scene()) {
         prop_assert!(scene.mesh.validate().is_valid());
         let text = write_obj_string(&scene).unwrap();
-        let (again, warnings) = read_obj_str(&text, Path::new("t.obj")).unwrap();
+        let (again, warnings) = parse_obj(&text, Path::new("t.obj")).unwrap();
         prop_assert!(warnings.is_empty(), "{:?}", warnings);
         prop_assert_eq!(again, scene, "{}", text);
     }

@@ -1,0 +1,33 @@
+//! glTF container and scene problems.
+
+/// A glTF problem. Every variant is bad input (exit code 2): a scene the builder rejects
+/// comes from the caller's data, a bad GLB from the file read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum GltfError {
+    /// The binary buffer is larger than glTF's 32-bit lengths allow.
+    #[error("glTF buffer exceeds 4 GiB")]
+    BufferTooLarge,
+    /// The whole `.glb` would be larger than its 32-bit length field allows.
+    #[error("glTF asset exceeds the 4 GiB GLB limit")]
+    AssetTooLarge,
+    /// The JSON chunk could not be serialised.
+    #[error("cannot serialise glTF JSON: {0}")]
+    Serialize(String),
+    /// A `.glb` file's header or chunks are malformed.
+    #[error("not a valid GLB file: {what}")]
+    BadGlb {
+        /// What is wrong.
+        what: String,
+    },
+    /// The [`crate::gltf::SceneBuilder`] rejected an object; the message names it
+    /// (`mesh `face`: non-finite UV`).
+    #[error("{0}")]
+    Scene(String),
+}
+
+impl GltfError {
+    /// Always true: every glTF problem is bad input.
+    pub fn is_input_error(&self) -> bool {
+        true
+    }
+}
