@@ -353,6 +353,39 @@ mod tests {
     use super::*;
 
     #[test]
+    fn layer_errors_convert_keep_their_message_and_classify_as_input() {
+        let e: Error = crate::face::FaceError::DuplicateMesh {
+            name: "skin".into(),
+        }
+        .into();
+        assert_eq!(e.to_string(), "two meshes are named `skin`");
+        assert!(e.is_input_error());
+        assert!(matches!(
+            e,
+            Error::Face(crate::face::FaceError::DuplicateMesh { ref name }) if name == "skin"
+        ));
+        let e: Error = crate::format::OutputPathError::WouldOverwriteInput {
+            path: "a.wrl".into(),
+        }
+        .into();
+        assert_eq!(
+            e.to_string(),
+            "a.wrl: refusing to write over the input file; choose another output path"
+        );
+        assert!(e.is_input_error());
+        // A wrapped error keeps the file prefix the old `Invalid(format!(..))` had.
+        let inner: Error = crate::fdp::FdpError::FapuNotPositive {
+            details: "ES0 = 0".into(),
+        }
+        .into();
+        let e: Error = crate::face::FaceError::in_file("fp.csv", inner).into();
+        assert!(e
+            .to_string()
+            .starts_with("fp.csv: cannot compute the FAPUs: ES0 = 0"));
+        assert!(!Error::MissingTool("ffmpeg".into()).is_input_error());
+    }
+
+    #[test]
     fn control_characters_are_escaped() {
         assert!(matches!(
             escape_control("plain\ttext\n"),

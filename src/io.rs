@@ -397,6 +397,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn read_text_from_is_bounded_and_located() {
+        let src = Path::new("pipe.fap");
+        assert_eq!(read_text_from(&b"abc"[..], src, 3).unwrap(), "abc");
+        let e = read_text_from(&b"abcd"[..], src, 3).unwrap_err();
+        assert!(
+            matches!(&e, Error::Io { source, .. } if source.kind() == std::io::ErrorKind::FileTooLarge)
+        );
+        assert!(e.to_string().starts_with("pipe.fap: "), "{e}");
+        let e = read_text_from(&b"ok\n\xff"[..], src, 100).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("pipe.fap:2:1: expected UTF-8 text"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn atomic_write_replaces_and_failed_write_leaves_nothing() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("out.txt");
