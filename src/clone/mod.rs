@@ -16,6 +16,7 @@
 
 pub mod eval;
 pub mod face;
+pub mod fit;
 pub mod fmc;
 pub mod quality;
 pub mod rbf;

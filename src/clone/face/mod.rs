@@ -131,6 +131,7 @@ pub use rigid::install_center;
 pub use skin_surface::{build_skin_surface, SkinSurface};
 pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 
+use super::fit::clone_fit;
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
 use super::{CloneSurface, SurfaceCloneResult, SurfaceMotion};
@@ -155,6 +156,7 @@ pub fn clone_surface(
     match method {
         Method::Fmc => clone_fmc(source, motions, target, &opts.fmc),
         Method::Rbf => clone_rbf(source, motions, target, &opts.rbf),
+        Method::Fit => clone_fit(source, motions, target, &opts.fit),
     }
 }
 
