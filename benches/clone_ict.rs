@@ -1,6 +1,7 @@
 //! Cloning between real heads: ICT head A (rig FAT, 14 FAPs) onto the reshaped head B of the
-//! ground truth (tests/support/ict_truth.rs), both methods, and alma onto the bundled
-//! one-mesh `ict` (parts split out). The ICT cases are skipped when
+//! ground truth (tests/support/ict_truth.rs), every method, alma onto the bundled
+//! one-mesh `ict` (parts split out), and a dense CANDIDE-3 (subdivided twice, with its FAT)
+//! onto the bundled `ict` (skipped when `../shared/data/candide3` is absent). The ICT cases are skipped when
 //! `../shared/data/ict-facekit` is absent. Quality figures are printed once per case.
 
 #[path = "../tests/support/ict_truth.rs"]
@@ -26,7 +27,7 @@ fn heads() -> Option<&'static (FaceModel, FaceModel, FaceModel)> {
         let (nose, chin) = ict_truth::anchors(&a);
         let truth = ict_truth::head_b(&a, |p| ict_truth::reshape(p, nose, chin));
         let target = strip_fat(&truth);
-        for method in [Method::Fmc, Method::Rbf] {
+        for method in [Method::Fmc, Method::Rbf, Method::Fit] {
             let out = clone_face(&a, &target, &opts(method)).expect("clone");
             let r = ground_truth_error(&out.face, &truth).expect("truth");
             let mut all: Vec<f64> = r.keys.iter().map(|k| k.all).collect();
@@ -50,13 +51,13 @@ fn opts(method: Method) -> CloneOptions {
     }
 }
 
-#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+#[divan::bench(args = [Method::Fmc, Method::Rbf, Method::Fit], sample_count = 5)]
 fn ict_a_to_b(method: Method) {
     let Some((a, _, b)) = heads() else { return };
     divan::black_box(clone_face(a, b, &opts(method)).expect("clone"));
 }
 
-#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+#[divan::bench(args = [Method::Fmc, Method::Rbf, Method::Fit], sample_count = 5)]
 fn alma_to_bundled_ict(method: Method) {
     static F: OnceLock<(FaceModel, FaceModel)> = OnceLock::new();
     let (alma, ict) = F.get_or_init(|| {
@@ -66,4 +67,37 @@ fn alma_to_bundled_ict(method: Method) {
         )
     });
     divan::black_box(clone_face(alma, ict, &opts(method)).expect("clone"));
+}
+
+/// CANDIDE-3 with its FAT, subdivided twice, and the bundled `ict` without its FAT.
+fn candide_and_ict() -> Option<&'static (FaceModel, FaceModel)> {
+    static F: OnceLock<Option<(FaceModel, FaceModel)>> = OnceLock::new();
+    F.get_or_init(|| {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/candide3");
+        let opts = fbakit::face::FaceReadOptions {
+            feature_points: Some(dir.join("feature-points.csv")),
+            format: None,
+        };
+        let (face, _) = fbakit::face::read_with(&dir.join("candide3.wfm"), &opts).ok()?;
+        let dense = ict_truth::subdivide(&ict_truth::subdivide(&face));
+        let ict = strip_fat(&fbakit::face::read("ict").expect("ict"));
+        eprintln!(
+            "dense candide: {} vertices",
+            dense
+                .meshes
+                .iter()
+                .map(|m| m.mesh.positions.len())
+                .sum::<usize>()
+        );
+        Some((dense, ict))
+    })
+    .as_ref()
+}
+
+#[divan::bench(args = [Method::Fmc, Method::Rbf, Method::Fit], sample_count = 5)]
+fn dense_candide_to_bundled_ict(method: Method) {
+    let Some((candide, ict)) = candide_and_ict() else {
+        return;
+    };
+    divan::black_box(clone_face(candide, ict, &opts(method)).expect("clone"));
 }

@@ -52,6 +52,7 @@ use glam::Vec3;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::{Error, Result};
+use crate::mesh::spatial::find_coincident_vertices;
 use regions::{classify, triangle_masks};
 use register::{register, Moving};
 use surface::{adjacency, QuerySurface};
@@ -116,6 +117,28 @@ fn check_surface(s: &CloneSurface, side: &str) -> Result<()> {
     Ok(())
 }
 
+/// Which vertices some triangle uses.
+fn used_vertices(s: &CloneSurface) -> Vec<bool> {
+    let mut used = vec![false; s.positions.len()];
+    for &v in s.triangles.iter().flatten() {
+        if let Some(u) = used.get_mut(v as usize) {
+            *u = true;
+        }
+    }
+    used
+}
+
+/// Vertices coinciding with another one (within 1e-6 of the face scale) outside the slits.
+fn loose_duplicates(s: &CloneSurface, sides: &[regions::Side]) -> usize {
+    let eps = face_scale(s) * 1e-6;
+    find_coincident_vertices(&s.positions, eps)
+        .clusters
+        .iter()
+        .flatten()
+        .filter(|&&v| sides.get(v as usize) == Some(&regions::Side::Other))
+        .count()
+}
+
 /// A length of the face: ES0, else a tenth of the bounding-box diagonal.
 fn face_scale(s: &CloneSurface) -> f32 {
     let es0 = s.fapu.distances.es0 as f32;
@@ -153,8 +176,10 @@ pub fn clone_fit(
     let mut warnings = Vec::new();
     // 1. Sides.
     let clock = Instant::now();
-    let (s_sides, s_slits) = classify(source);
-    let (t_sides, t_slits) = classify(target);
+    let adj = adjacency(source.positions.len(), &source.triangles);
+    let t_adj = adjacency(target.positions.len(), &target.triangles);
+    let (s_sides, s_slits) = classify(source, &adj);
+    let (t_sides, t_slits) = classify(target, &t_adj);
     for (n, side) in [(s_slits, "source"), (t_slits, "target")] {
         if n < 3 {
             warnings.push(format!(
@@ -163,15 +188,33 @@ pub fn clone_fit(
             ));
         }
     }
+    // Landmarks: feature points that are surface vertices (on a triangle) of both faces.
+    let (s_used, t_used) = (used_vertices(source), used_vertices(target));
+    let mut off_mesh = 0;
     let landmarks: Vec<(u32, Vec3)> = source
         .fp_vertices
         .iter()
         .filter_map(|(id, &sv)| {
             let tv = *target.fp_vertices.get(id)?;
-            let p = *target.positions.get(tv as usize)?;
-            ((sv as usize) < source.positions.len()).then_some((sv, p))
+            let on = |used: &[bool], v: u32| used.get(v as usize).copied().unwrap_or(false);
+            if !on(&s_used, sv) || !on(&t_used, tv) {
+                off_mesh += 1;
+                return None;
+            }
+            Some((sv, target.positions[tv as usize]))
         })
         .collect();
+    if off_mesh > 0 {
+        warnings.push(format!(
+            "fit: {off_mesh} feature points are not on any triangle of the source or target              surface; they are not used as landmarks"
+        ));
+    }
+    let loose = loose_duplicates(target, &t_sides);
+    if loose > 0 {
+        warnings.push(format!(
+            "fit: {loose} target vertices duplicate another vertex away from the mouth and              eyes (an unwelded seam); each side is mapped on its own"
+        ));
+    }
     if landmarks.len() < 8 {
         warnings.push(format!(
             "fit: only {} feature points are vertices of both surfaces; the registration \
@@ -184,7 +227,6 @@ pub fn clone_fit(
     // 2. Registration of the source onto the target.
     let clock = Instant::now();
     let scale = face_scale(source);
-    let adj = adjacency(source.positions.len(), &source.triangles);
     let fixed = QuerySurface::new(
         &target.positions,
         &target.triangles,
@@ -221,6 +263,13 @@ pub fn clone_fit(
     );
     let unmatched = corr.iter().filter(|c| c.is_none()).count();
     stats.insert("fit_unmatched".into(), unmatched as f64);
+    if unmatched > 0 {
+        warnings.push(format!(
+            "fit: {unmatched} of {} target vertices lie beyond the source surface and stay \
+             still",
+            target.positions.len()
+        ));
+    }
     timings.push("correspond", clock.elapsed().as_secs_f64());
     // 4. Transfer.
     let clock = Instant::now();

@@ -151,20 +151,27 @@ fn slits(s: &CloneSurface) -> Vec<Slit> {
     out
 }
 
-/// Every vertex's side, and how many slits were found (0 to 3).
-pub(crate) fn classify(s: &CloneSurface) -> (Vec<Side>, usize) {
+/// Every vertex's side, and how many slits were found (0 to 3). A vertex is judged by the
+/// mean of its neighbours (`adj`), not by itself: on a closed mouth or eye the upper and
+/// lower vertices of the slit coincide, and only their neighbours tell them apart.
+pub(crate) fn classify(s: &CloneSurface, adj: &[Vec<u32>]) -> (Vec<Side>, usize) {
     let slits = slits(s);
-    let sides = s
-        .positions
-        .iter()
-        .map(|&p| {
-            slits
-                .iter()
-                .map(|sl| sl.side(p))
-                .find(|&sd| sd != Side::Other)
-                .unwrap_or(Side::Other)
-        })
-        .collect();
+    let sides =
+        s.positions
+            .iter()
+            .enumerate()
+            .map(|(v, &p)| {
+                let ring = adj.get(v).filter(|r| !r.is_empty()).map(|r| {
+                    r.iter().map(|&w| s.positions[w as usize]).sum::<Vec3>() / r.len() as f32
+                });
+                let q = Vec3::new(p.x, ring.map_or(p.y, |c| c.y), p.z);
+                slits
+                    .iter()
+                    .map(|sl| sl.side(q))
+                    .find(|&sd| sd != Side::Other)
+                    .unwrap_or(Side::Other)
+            })
+            .collect();
     (sides, slits.len())
 }
 

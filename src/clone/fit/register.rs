@@ -98,6 +98,7 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
     }
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let limit = opts.max_distance as f32 * m.scale;
+    let snap = super::correspond::SNAP * m.scale;
     let (mut matched, mut mean_gap) = (0.0, 0.0);
     for &alpha in &opts.stiffness {
         for _ in 0..opts.iterations.max(1) {
@@ -107,11 +108,18 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
                 .into_par_iter()
                 .map(|i| {
                     let nrm = normals[i];
-                    let filter = Filter {
-                        bit: query_bit(m.sides[i]),
-                        normal: (nrm != Vec3::ZERO).then_some((nrm, cos)),
+                    let bit = query_bit(m.sides[i]);
+                    let plain = fixed.closest(x[i], Filter { bit, normal: None })?;
+                    // On the surface already: a match, whatever a crease's normals say.
+                    let h = if plain.point.distance(x[i]) <= snap || nrm == Vec3::ZERO {
+                        plain
+                    } else {
+                        let filter = Filter {
+                            bit,
+                            normal: Some((nrm, cos)),
+                        };
+                        fixed.closest(x[i], filter)?
                     };
-                    let h = fixed.closest(x[i], filter)?;
                     if fixed.on_border(&h) {
                         return None;
                     }
