@@ -195,9 +195,7 @@ pub fn subdivide(face: &FaceModel) -> FaceModel {
             let n = face.meshes[mi].mesh.positions.len();
             let mut rates = vec![vec![Vec3::ZERO; k]; n];
             for (slot, &v) in dm.coord_index.iter().enumerate() {
-                for j in 0..k {
-                    rates[v as usize][j] = dm.displacements[slot * k + j];
-                }
+                rates[v as usize].copy_from_slice(&dm.displacements[slot * k..(slot + 1) * k]);
             }
             for r in &recipes[mi] {
                 let mean: Vec<Vec3> = (0..k)

@@ -191,7 +191,7 @@ pub(crate) fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     let (d20, d21) = (ep.dot(e0), ep.dot(e1));
     let denom = d00 * d11 - d01 * d01;
     let scale = d00.max(d11);
-    if !(denom > 1e-12 * scale * scale) {
+    if denom.is_nan() || denom <= 1e-12 * scale * scale {
         let d = [p.distance(a), p.distance(b), p.distance(c)];
         let k = (0..3).min_by(|&i, &j| d[i].total_cmp(&d[j])).unwrap_or(0);
         let mut w = [0.0; 3];
@@ -202,7 +202,7 @@ pub(crate) fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     let w = (d00 * d21 - d01 * d20) / denom;
     let out = [(1.0 - v - w).max(0.0), v.max(0.0), w.max(0.0)];
     let s: f64 = out.iter().sum();
-    if !(s > 0.0) {
+    if s.is_nan() || s <= 0.0 {
         return [1.0, 0.0, 0.0];
     }
     out.map(|x| (x / s) as f32)

@@ -33,12 +33,6 @@ fn candide_self_clone_is_exact() {
             face.surface.triangles.iter().flatten().copied().collect();
         for (v, (x, y)) in dense.iter().zip(&got).enumerate() {
             if used.contains(&(v as u32)) {
-                if x.distance(*y) > worst {
-                    eprintln!(
-                        "{:?} v{v} {} want {x} got {y}",
-                        a.key, face.surface.positions[v]
-                    );
-                }
                 worst = worst.max(x.distance(*y));
             }
         }
@@ -69,11 +63,7 @@ fn grid_face(n: usize, bump: f32) -> CloneSurface {
     for j in 0..n {
         for i in 0..n {
             // Exactly mirrored coordinates (−1 + 2i/(n−1) is not, in floats).
-            let x = if 2 * i <= n - 1 {
-                at(i)
-            } else {
-                -at(n - 1 - i)
-            };
+            let x = if 2 * i < n { at(i) } else { -at(n - 1 - i) };
             let y = at(j);
             let z = 0.6 * (-(x * x + y * y)).exp()
                 + bump * (-(x * x) * 4.0 - (y + 0.2).powi(2) * 9.0).exp();
