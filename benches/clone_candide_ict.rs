@@ -32,7 +32,7 @@ fn faces() -> Option<&'static (FaceModel, FaceModel)> {
         let candide = candide_face(&model, &fp, &[]).expect("candide face");
         let dense = subdivide_face(&candide, Scheme::Loop, 3).expect("subdivide");
         let ict = fbakit::face::read("ict").expect("bundled ict");
-        for method in [Method::Fmc, Method::Rbf] {
+        for method in [Method::Fmc, Method::Rbf, Method::Fit] {
             let out = clone_face(&dense, &ict, &opts(method)).expect("clone");
             let steps: Vec<String> = out
                 .report
@@ -51,7 +51,7 @@ fn faces() -> Option<&'static (FaceModel, FaceModel)> {
             );
         }
         if let Some(peak) = peak_rss_mb() {
-            eprintln!("peak memory so far (faces read, both clones run): {peak:.0} MB");
+            eprintln!("peak memory so far (faces read, one clone per method run): {peak:.0} MB");
         }
         Some((dense, ict))
     })
@@ -73,7 +73,7 @@ fn opts(method: Method) -> CloneOptions {
     }
 }
 
-#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+#[divan::bench(args = [Method::Fmc, Method::Rbf, Method::Fit], sample_count = 5)]
 fn dense_candide_to_ict(method: Method) {
     let Some((source, target)) = faces() else {
         return;

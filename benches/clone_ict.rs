@@ -1,7 +1,7 @@
 //! Cloning between real heads: ICT head A (rig FAT, 14 FAPs) onto the reshaped head B of the
-//! ground truth (tests/support/ict_truth.rs), both methods, and alma onto the bundled
-//! one-mesh `ict` (parts split out). The ICT cases are skipped when
-//! `../shared/data/ict-facekit` is absent. Quality figures are printed once per case.
+//! ground truth (tests/support/ict_truth.rs), every method, alma onto the bundled
+//! one-mesh `ict` (parts split out); dense CANDIDE-3 onto `ict` is `clone_candide_ict`. The
+//! ICT cases are skipped when `../shared/data/ict-facekit` is absent. Quality figures are printed once per case.
 
 #[path = "../tests/support/ict_truth.rs"]
 mod ict_truth;
@@ -26,7 +26,7 @@ fn heads() -> Option<&'static (FaceModel, FaceModel, FaceModel)> {
         let (nose, chin) = ict_truth::anchors(&a);
         let truth = ict_truth::head_b(&a, |p| ict_truth::reshape(p, nose, chin));
         let target = strip_fat(&truth);
-        for method in [Method::Fmc, Method::Rbf] {
+        for method in [Method::Fmc, Method::Rbf, Method::Fit] {
             let out = clone_face(&a, &target, &opts(method)).expect("clone");
             let r = ground_truth_error(&out.face, &truth).expect("truth");
             let mut all: Vec<f64> = r.keys.iter().map(|k| k.all).collect();
@@ -50,13 +50,13 @@ fn opts(method: Method) -> CloneOptions {
     }
 }
 
-#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+#[divan::bench(args = [Method::Fmc, Method::Rbf, Method::Fit], sample_count = 5)]
 fn ict_a_to_b(method: Method) {
     let Some((a, _, b)) = heads() else { return };
     divan::black_box(clone_face(a, b, &opts(method)).expect("clone"));
 }
 
-#[divan::bench(args = [Method::Fmc, Method::Rbf], sample_count = 5)]
+#[divan::bench(args = [Method::Fmc, Method::Rbf, Method::Fit], sample_count = 5)]
 fn alma_to_bundled_ict(method: Method) {
     static F: OnceLock<(FaceModel, FaceModel)> = OnceLock::new();
     let (alma, ict) = F.get_or_init(|| {

@@ -294,7 +294,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
 
     let other = match opts.method {
         Method::Fmc => Method::Rbf,
-        Method::Rbf => Method::Fmc,
+        Method::Rbf | Method::Fit => Method::Fmc,
     };
     let (main_quality, outcome) = measure(&alma, &target, &truth, opts.method, &mut clock)?;
     let mut quality = vec![main_quality];

@@ -137,6 +137,22 @@ fn alma_to_bruno_against_ground_truth_and_compliance() {
 }
 
 #[test]
+fn fit_self_clone_and_alma_to_bruno() {
+    let (a, b) = faces();
+    let own = self_clone_error(a, Method::Fit).unwrap();
+    assert!(own < 0.001, "fit self-clone {own} %");
+    let fit = clone_face(a, b, &opts(Method::Fit)).unwrap();
+    let gt = ground_truth_error(&fit.face, b).unwrap();
+    eprintln!(
+        "fit alma -> bruno: ground truth all {:.2} %, skin {:.2} %",
+        gt.mean_all, gt.mean_skin
+    );
+    assert!(gt.mean_all < 34.0, "fit ground truth {} %", gt.mean_all);
+    let c = compliance(&fit.face).unwrap();
+    assert!(c.worst < 0.05, "fit compliance worst {}", c.worst);
+}
+
+#[test]
 fn rbf_paper_mode_is_less_compliant() {
     let (a, b) = faces();
     let paper = CloneOptions {

@@ -1,5 +1,6 @@
 //! Real-head ground truth (tests/support/ict_truth.rs): head A (ICT neutral + its rig FAT,
-//! 14 FAPs) cloned onto head B (A smoothly reshaped, and B×10 + offset) with both methods,
+//! 14 FAPs) cloned onto head B (A smoothly reshaped, B×10 + offset, and B subdivided once)
+//! with every method,
 //! against B's true FAT, per FAP. Skipped with a note when `../shared/data/ict-facekit` is
 //! absent.
 
@@ -18,13 +19,14 @@ use glam::Vec3;
 
 struct Case {
     truth: FaceModel,
-    /// fmc, rbf.
+    /// fmc, rbf, fit.
     clones: Vec<(Method, CloneOutcome, f64)>,
 }
 
-/// Cases `b` and `b10` (B×10 + offset), built and cloned once per test binary.
-fn cases() -> Option<&'static [Case; 2]> {
-    static C: OnceLock<Option<[Case; 2]>> = OnceLock::new();
+/// Cases `b`, `b10` (B×10 + offset) and `b_sub` (B subdivided once), built and cloned once
+/// per test binary.
+fn cases() -> Option<&'static [Case; 3]> {
+    static C: OnceLock<Option<[Case; 3]>> = OnceLock::new();
     C.get_or_init(|| {
         let dir = ict_truth::ict_dir()?;
         let a = ict_truth::head_a(&dir);
@@ -34,7 +36,7 @@ fn cases() -> Option<&'static [Case; 2]> {
         let b10 = ict_truth::head_b(&a, |p| ict_truth::reshape(p, nose, chin) * 10.0 + offset);
         let run = |truth: FaceModel| {
             let target = strip_fat(&truth);
-            let clones = [Method::Fmc, Method::Rbf]
+            let clones = [Method::Fmc, Method::Rbf, Method::Fit]
                 .into_iter()
                 .map(|m| {
                     let opts = CloneOptions {
@@ -48,7 +50,8 @@ fn cases() -> Option<&'static [Case; 2]> {
                 .collect();
             Case { truth, clones }
         };
-        Some([run(b), run(b10)])
+        let b_sub = ict_truth::subdivide(&b);
+        Some([run(b), run(b10), run(b_sub)])
     })
     .as_ref()
 }
@@ -107,6 +110,7 @@ fn both_cloners_against_the_real_head_truth() {
             let (med_max, worst_max) = match m {
                 Method::Fmc => (10.0, 25.0),
                 Method::Rbf => (90.0, 160.0),
+                Method::Fit => (4.0, 25.0),
             };
             assert!(med <= med_max, "{m:?} case {ci}: median {med}");
             assert!(worst.all < worst_max, "{m:?} case {ci}: {worst:?}");

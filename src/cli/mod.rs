@@ -35,7 +35,7 @@ mod show;
 mod speak;
 mod view;
 
-/// A cloning method on the command line (`--method fmc|rbf`). `clone`, `eval self-clone`,
+/// A cloning method on the command line (`--method fmc|rbf|fit`). `clone`, `eval self-clone`,
 /// `grid` and `demo` share one default, [`MethodArg::default`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum MethodArg {
@@ -43,6 +43,8 @@ pub enum MethodArg {
     Fmc,
     /// RBF cloning (Fratarcangeli & Schaerf 2005).
     Rbf,
+    /// Dense correspondence by non-rigid registration (fbakit's `fit`).
+    Fit,
 }
 
 impl Default for MethodArg {
@@ -51,6 +53,7 @@ impl Default for MethodArg {
         match fbakit::clone::face::Method::default() {
             fbakit::clone::face::Method::Fmc => MethodArg::Fmc,
             fbakit::clone::face::Method::Rbf => MethodArg::Rbf,
+            fbakit::clone::face::Method::Fit => MethodArg::Fit,
         }
     }
 }
@@ -66,6 +69,7 @@ impl From<MethodArg> for fbakit::clone::face::Method {
         match m {
             MethodArg::Fmc => fbakit::clone::face::Method::Fmc,
             MethodArg::Rbf => fbakit::clone::face::Method::Rbf,
+            MethodArg::Fit => fbakit::clone::face::Method::Fit,
         }
     }
 }

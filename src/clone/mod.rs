@@ -1,13 +1,18 @@
 //! Facial motion cloning: copying a source face's animation (its FAT, seen as morph targets)
 //! onto a target face that is only a mesh with feature points.
 //!
-//! Two methods share one interface:
+//! Three methods share one interface:
 //! - [`fmc`]: Pandzic 2003, "Facial Motion Cloning" — FAPU regional normalisation, cylindrical
 //!   projection into a 2D alignment space, feature-point-driven alignment, barycentric motion
 //!   mapping with an anti-aliasing filter and upper/lower lip separation.
 //! - [`rbf`]: Fratarcangeli & Schaerf 2005, "Fast Facial Motion Cloning in MPEG-4" — eye and
 //!   inner-lip contour extraction, a Hardy multiquadric RBF volume morph refined iteratively by
 //!   ray casting, and barycentric mapping of target vertices into the deformed source.
+//! - [`fit`]: fbakit's own — a landmark-guided non-rigid registration of the source's neutral
+//!   onto the target's (non-rigid ICP with a bending-regularised displacement field, sparse
+//!   Cholesky by faer), lips and eyelids kept apart, every target vertex located on the
+//!   registered source and each motion carried over by barycentric interpolation and scaled
+//!   by the target / source FAPU of the FAP's unit.
 //!
 //! Both work on a [`CloneSurface`]: the deformable skin of a face in the MPEG-4 face frame
 //! (meshes already placed by their transforms, concatenated into one vertex array), its feature
@@ -17,6 +22,7 @@
 mod error;
 pub mod eval;
 pub mod face;
+pub mod fit;
 pub mod fmc;
 pub mod quality;
 pub mod rbf;

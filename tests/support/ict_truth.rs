@@ -131,3 +131,88 @@ pub fn anchors(a: &FaceModel) -> (Vec3, Vec3) {
 pub fn fap(n: u8) -> FapId {
     FapId::new(n).unwrap()
 }
+
+/// `face` with every polygon of every mesh split once at its edge midpoints (triangles into
+/// four triangles, other polygons into one quad per corner around their centre). New
+/// vertices' positions and FAT rates are the means of the vertices they lie between, so a
+/// true FAT stays exactly true (the rig is linear). Original vertices keep their indices, so
+/// feature points stay bound. (Unlike `fbakit::face::subdivide`, which triangulates first,
+/// quads stay quads here: the subdivided ICT target is a quad mesh like the original.)
+pub fn subdivide(face: &FaceModel) -> FaceModel {
+    use std::collections::HashMap;
+    let mut out = face.clone();
+    out.name = format!("{}_sub", face.name);
+    // Per mesh: the new vertices as lists of the old vertices they average.
+    let mut recipes: Vec<Vec<Vec<u32>>> = Vec::new();
+    for m in &mut out.meshes {
+        let mesh = &mut m.mesh;
+        let n = mesh.positions.len() as u32;
+        let mut extra: Vec<Vec<u32>> = Vec::new();
+        let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut polys: Vec<Vec<u32>> = Vec::new();
+        let mut mid = |a: u32, b: u32, extra: &mut Vec<Vec<u32>>| -> u32 {
+            *edges.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                extra.push(vec![a, b]);
+                n + extra.len() as u32 - 1
+            })
+        };
+        for poly in mesh.polygons.iter() {
+            let k = poly.len();
+            let mids: Vec<u32> = (0..k)
+                .map(|i| mid(poly[i], poly[(i + 1) % k], &mut extra))
+                .collect();
+            if k == 3 {
+                polys.push(vec![poly[0], mids[0], mids[2]]);
+                polys.push(vec![mids[0], poly[1], mids[1]]);
+                polys.push(vec![mids[2], mids[1], poly[2]]);
+                polys.push(vec![mids[0], mids[1], mids[2]]);
+            } else {
+                extra.push(poly.to_vec());
+                let c = n + extra.len() as u32 - 1;
+                for i in 0..k {
+                    polys.push(vec![poly[i], mids[i], c, mids[(i + k - 1) % k]]);
+                }
+            }
+        }
+        for r in &extra {
+            let p = r.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / r.len() as f32;
+            mesh.positions.push(p);
+        }
+        mesh.polygons = fbakit::mesh::Polygons::from_lists(&polys);
+        mesh.colors.clear();
+        mesh.uvs.clear();
+        mesh.uv_polygons = None;
+        mesh.normals.clear();
+        mesh.normal_polygons = None;
+        mesh.groups.clear();
+        recipes.push(extra);
+    }
+    for t in &mut out.fat.tables {
+        for dm in &mut t.meshes {
+            let Some(mi) = face.mesh_index(&dm.mesh) else {
+                continue;
+            };
+            let k = dm.interval_count().max(1);
+            let n = face.meshes[mi].mesh.positions.len();
+            let mut rates = vec![vec![Vec3::ZERO; k]; n];
+            for (slot, &v) in dm.coord_index.iter().enumerate() {
+                rates[v as usize].copy_from_slice(&dm.displacements[slot * k..(slot + 1) * k]);
+            }
+            for r in &recipes[mi] {
+                let mean: Vec<Vec3> = (0..k)
+                    .map(|j| r.iter().map(|&v| rates[v as usize][j]).sum::<Vec3>() / r.len() as f32)
+                    .collect();
+                rates.push(mean);
+            }
+            dm.coord_index.clear();
+            dm.displacements.clear();
+            for (v, r) in rates.iter().enumerate() {
+                if r.iter().any(|d| *d != Vec3::ZERO) {
+                    dm.coord_index.push(v as u32);
+                    dm.displacements.extend_from_slice(r);
+                }
+            }
+        }
+    }
+    out
+}

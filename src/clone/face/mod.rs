@@ -1,5 +1,6 @@
 //! Cloning a whole face: the source's FAT onto a target [`FaceModel`], skin by a surface method
-//! ([`super::fmc`] or [`super::rbf`]) and rigid parts by transforms, after Pandžić 2003.
+//! ([`super::fmc`], [`super::rbf`] or [`super::fit`]) and rigid parts by transforms, after
+//! Pandžić 2003.
 //!
 //! # Steps (report timings use these names)
 //!
@@ -33,7 +34,8 @@
 //! 4. **`motions`** — every table of the source FAT becomes one morph target per non-zero
 //!    interval border ([`fat_to_morph_targets`]); skin displacements are turned into the face
 //!    frame with each mesh's world 3×3 (a welded vertex takes the mean of its duplicates).
-//! 5. The surface method's own steps (`fmc:*` or `rbf:*`).
+//! 5. The surface method's own steps (`fmc:*`, `rbf:*` or `fit:*`). `fit` scales each FAP by
+//!    the target / source FAPU ratio of its unit itself, so step 6's rescale is not needed.
 //! 6. **`rescale`** (RBF only, [`CloneOptions::rbf_fapu_rescale`]) — the RBF method carries a
 //!    motion through the Jacobian of its volume morph, not through FAPU ratios, so a FAP's
 //!    feature point does not move by `value × FAPU × direction` on the target. With the
@@ -131,6 +133,7 @@ pub use rigid::install_center;
 pub use skin_surface::{build_skin_surface, SkinSurface};
 pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 
+use super::fit::clone_fit;
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
 use super::{CloneSurface, SurfaceCloneResult, SurfaceMotion};
@@ -155,6 +158,7 @@ pub fn clone_surface(
     match method {
         Method::Fmc => clone_fmc(source, motions, target, &opts.fmc),
         Method::Rbf => clone_rbf(source, motions, target, &opts.rbf),
+        Method::Fit => clone_fit(source, motions, target, &opts.fit),
     }
 }
 

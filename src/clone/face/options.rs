@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 
+use crate::clone::fit::FitOptions;
 use crate::clone::fmc::{FmcOptions, NormalisationMode, OverlapRule};
 use crate::clone::rbf::RbfOptions;
 
@@ -17,14 +18,17 @@ pub enum Method {
     Fmc,
     /// Fratarcangeli & Schaerf 2005 ([`crate::clone::rbf`]).
     Rbf,
+    /// Dense correspondence by non-rigid registration ([`crate::clone::fit`]).
+    Fit,
 }
 
 impl Method {
-    /// `fmc` or `rbf`.
+    /// `fmc`, `rbf` or `fit`.
     pub fn name(self) -> &'static str {
         match self {
             Method::Fmc => "fmc",
             Method::Rbf => "rbf",
+            Method::Fit => "fit",
         }
     }
 }
@@ -38,6 +42,8 @@ pub struct CloneOptions {
     pub fmc: FmcOptions,
     /// RBF settings.
     pub rbf: RbfOptions,
+    /// Fit settings.
+    pub fit: FitOptions,
     /// RBF only: rescale each low-level translation FAP's motion so its feature point moves
     /// FAPU-compliantly (module docs, step 6). Default on; off is the paper's behaviour.
     pub rbf_fapu_rescale: bool,
@@ -54,6 +60,7 @@ impl Default for CloneOptions {
             method: Method::default(),
             fmc: face_fmc_options(),
             rbf: RbfOptions::default(),
+            fit: FitOptions::default(),
             rbf_fapu_rescale: true,
             align: true,
             align_snap_degrees: 3.0,

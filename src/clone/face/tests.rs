@@ -181,7 +181,7 @@ fn rotated_scaled_target_clones_like_the_plain_one() {
         rotation: glam::DQuat::from_axis_angle(DVec3::new(0.2, 1.0, 0.1).normalize(), 0.9),
         translation: DVec3::new(100.0, -20.0, 7.0),
     };
-    for method in [Method::Fmc, Method::Rbf] {
+    for method in [Method::Fmc, Method::Rbf, Method::Fit] {
         // No rotation snap: the plain target's small spurious tilt would be dropped while the
         // turned one keeps it, and this test is about the fit's equivariance.
         let opts = CloneOptions {
@@ -218,6 +218,8 @@ fn rotated_scaled_target_clones_like_the_plain_one() {
         match method {
             Method::Fmc => assert!(worst < 1e-3 * scale * 3.0, "{worst} vs {scale}"),
             Method::Rbf => assert!(diff < 0.1 * sum, "{diff} vs {sum}"),
+            // Fit: closest points move with float noise, nothing chooses discretely.
+            Method::Fit => assert!(diff < 0.01 * sum, "{diff} vs {sum}"),
         }
         eprintln!("{method:?}: worst {worst} of {scale}, sum {diff} of {sum}");
     }

@@ -1,0 +1,287 @@
+//! `fit`: facial motion cloning by dense correspondence — a landmark-guided non-rigid
+//! registration of the source's neutral surface onto the target's, every target vertex
+//! located on the registered source, and each motion carried over by barycentric
+//! interpolation and scaled to the target's FAP units.
+//!
+//! # The math
+//!
+//! 1. **Sides** ([`regions`](self) — `regions.rs`): vertices near the mouth and eye slits are
+//!    labelled upper or lower from the feature points (lip corners and inner-lip points,
+//!    eye corners and lid points). Every closest-point query below is restricted to its side:
+//!    an upper-lip vertex never lands on the lower lip, an upper lid never on the lower lid,
+//!    so a closed mouth or eye does not weld.
+//! 2. **Registration** (`register.rs`, `system.rs`): the source's displacement field `u`
+//!    minimises, per step,
+//!    `Σ w_i‖p_i+u_i−c_i‖² + βΣ_l‖p_l+u_l−L_l‖² + α(‖Lu‖² + μ‖∇u‖²) + ε‖u‖²` —
+//!    closest target points `c_i` (side-restricted; rejected on the target's border, with
+//!    normals more than 60° apart, or far off), the target's feature points `L_l` at the
+//!    source's feature-point vertices, and a bending term (uniform Laplacian `L`) whose
+//!    weight `α` goes from stiff to soft ([`FitOptions::stiffness`]), after Amberg et al.
+//!    2007 ("Optimal Step Nonrigid ICP Algorithms for Surface Registration"). Each step is one
+//!    sparse SPD system `(α(LᵀL+μL_g) + W + βB + εI) u = W(c−p) + βB(L−p)` in three
+//!    right-hand sides, solved by a sparse Cholesky factorisation (faer) whose pattern and
+//!    symbolic analysis are built once.
+//! 3. **Correspondence** (`correspond.rs`): every target vertex takes its closest point on
+//!    the registered source (same side, compatible normal): a source triangle and barycentric
+//!    weights. Target vertices far from the source (beyond what the source covers) fade out.
+//! 4. **Transfer** (`transfer.rs`): each motion's source displacements, interpolated at
+//!    those weights, times the target / source FAPU ratio of the FAP's unit — so the same FAP
+//!    value moves the target by its own FAPU (compliance), and no vertex exceeds the largest
+//!    source displacement of the FAP in FAPU. Motions run in parallel (rayon).
+//!
+//! The source is registered onto the target, not the other way: the source's motion field
+//! is what must be sampled, and the target vertices then sample it where the registered
+//! source lies under them. A surface cloned onto itself registers to itself (every closest
+//! point is the vertex itself) and reproduces its motions exactly.
+//!
+//! Whole faces: [`crate::clone::face`] with [`Method::Fit`](crate::clone::face::Method::Fit);
+//! the FAPU ratio is applied here, so the pipeline's RBF rescale does not run, and the
+//! pipeline's guard checks the result like every method's.
+
+mod correspond;
+mod regions;
+mod register;
+mod surface;
+mod system;
+mod transfer;
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use glam::Vec3;
+
+use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
+use crate::error::{Error, Result};
+use crate::mesh::spatial::find_coincident_vertices;
+use regions::{classify, triangle_masks};
+use register::{register, Moving};
+use surface::{adjacency, QuerySurface};
+
+/// Settings of [`clone_fit`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Bending weights `α` of the registration, stiff to soft (each value runs
+    /// [`iterations`](Self::iterations) closest-point updates). Default
+    /// `[100, 30, 10, 3, 1]`.
+    pub stiffness: Vec<f64>,
+    /// Closest-point updates per stiffness value. Default 2.
+    pub iterations: usize,
+    /// Weight `β` of the feature-point landmarks against one closest-point match. Default 10.
+    pub landmark_weight: f64,
+    /// Membrane weight `μ` relative to bending. Default 0.01.
+    pub membrane: f64,
+    /// Closest points whose surface normals differ by more than this many degrees are
+    /// rejected. Default 60.
+    pub normal_degrees: f64,
+    /// Registration matches farther than this many ES0 are rejected. Default 0.25.
+    pub max_distance: f64,
+    /// A target vertex farther than `.0` × ES0 from the registered source takes less of its
+    /// motion, none beyond `.1` × ES0. Default `(0.05, 0.25)`.
+    pub fade: (f64, f64),
+    /// Scale each low-level translation FAP by the target / source FAPU ratio of its unit.
+    /// Default on.
+    pub fapu_scale: bool,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            stiffness: vec![100.0, 30.0, 10.0, 3.0, 1.0],
+            iterations: 2,
+            landmark_weight: 10.0,
+            membrane: 0.01,
+            normal_degrees: 60.0,
+            max_distance: 0.25,
+            fade: (0.05, 0.25),
+            fapu_scale: true,
+        }
+    }
+}
+
+/// Checks a surface's numbers and indices.
+fn check_surface(s: &CloneSurface, side: &str) -> Result<()> {
+    if s.positions.is_empty() || s.triangles.is_empty() {
+        return Err(Error::Invalid(format!("fit: the {side} surface is empty")));
+    }
+    if s.positions.iter().any(|p| !p.is_finite()) {
+        return Err(Error::Invalid(format!(
+            "fit: the {side} surface has a non-finite position"
+        )));
+    }
+    let n = s.positions.len();
+    if s.triangles.iter().flatten().any(|&v| v as usize >= n) {
+        return Err(Error::Invalid(format!(
+            "fit: the {side} surface has a triangle index out of range"
+        )));
+    }
+    Ok(())
+}
+
+/// Which vertices some triangle uses.
+fn used_vertices(s: &CloneSurface) -> Vec<bool> {
+    let mut used = vec![false; s.positions.len()];
+    for &v in s.triangles.iter().flatten() {
+        if let Some(u) = used.get_mut(v as usize) {
+            *u = true;
+        }
+    }
+    used
+}
+
+/// Vertices coinciding with another one (within 1e-6 of the face scale) outside the slits.
+fn loose_duplicates(s: &CloneSurface, sides: &[regions::Side]) -> usize {
+    let eps = face_scale(s) * 1e-6;
+    find_coincident_vertices(&s.positions, eps)
+        .clusters
+        .iter()
+        .flatten()
+        .filter(|&&v| sides.get(v as usize) == Some(&regions::Side::Other))
+        .count()
+}
+
+/// A length of the face: ES0, else a tenth of the bounding-box diagonal.
+fn face_scale(s: &CloneSurface) -> f32 {
+    let es0 = s.fapu.distances.es0 as f32;
+    if es0.is_finite() && es0 > 0.0 {
+        return es0;
+    }
+    let (lo, hi) = s.positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let d = 0.1 * lo.distance(hi);
+    if d.is_finite() && d > 0.0 {
+        d
+    } else {
+        1.0
+    }
+}
+
+/// Clones `motions` of `source` onto `target` (module docs). The result has one motion per
+/// source motion, in the same order, on the target's vertices.
+///
+/// Errors: an empty surface, non-finite positions, out-of-range triangle indices, or a
+/// failing linear solve. Feature points missing on either side (fewer landmarks, slits not
+/// found) are warnings.
+pub fn clone_fit(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    target: &CloneSurface,
+    opts: &FitOptions,
+) -> Result<SurfaceCloneResult> {
+    check_surface(source, "source")?;
+    check_surface(target, "target")?;
+    let mut timings = StepTimings::default();
+    let mut stats = BTreeMap::new();
+    let mut warnings = Vec::new();
+    // 1. Sides.
+    let clock = Instant::now();
+    let adj = adjacency(source.positions.len(), &source.triangles);
+    let t_adj = adjacency(target.positions.len(), &target.triangles);
+    let (s_sides, s_slits) = classify(source, &adj);
+    let (t_sides, t_slits) = classify(target, &t_adj);
+    for (n, side) in [(s_slits, "source"), (t_slits, "target")] {
+        if n < 3 {
+            warnings.push(format!(
+                "fit: only {n} of the 3 slits (mouth, eyes) found on the {side}'s feature \
+                 points; lips or lids there may be matched across"
+            ));
+        }
+    }
+    // Landmarks: feature points that are surface vertices (on a triangle) of both faces.
+    let (s_used, t_used) = (used_vertices(source), used_vertices(target));
+    let mut off_mesh = 0;
+    let landmarks: Vec<(u32, Vec3)> = source
+        .fp_vertices
+        .iter()
+        .filter_map(|(id, &sv)| {
+            let tv = *target.fp_vertices.get(id)?;
+            let on = |used: &[bool], v: u32| used.get(v as usize).copied().unwrap_or(false);
+            if !on(&s_used, sv) || !on(&t_used, tv) {
+                off_mesh += 1;
+                return None;
+            }
+            Some((sv, target.positions[tv as usize]))
+        })
+        .collect();
+    if off_mesh > 0 {
+        warnings.push(format!(
+            "fit: {off_mesh} feature points are not on any triangle of the source or target              surface; they are not used as landmarks"
+        ));
+    }
+    let loose = loose_duplicates(target, &t_sides);
+    if loose > 0 {
+        warnings.push(format!(
+            "fit: {loose} target vertices duplicate another vertex away from the mouth and              eyes (an unwelded seam); each side is mapped on its own"
+        ));
+    }
+    if landmarks.len() < 8 {
+        warnings.push(format!(
+            "fit: only {} feature points are vertices of both surfaces; the registration \
+             relies on closest points",
+            landmarks.len()
+        ));
+    }
+    stats.insert("fit_landmarks".into(), landmarks.len() as f64);
+    timings.push("sides", clock.elapsed().as_secs_f64());
+    // 2. Registration of the source onto the target.
+    let clock = Instant::now();
+    let scale = face_scale(source);
+    let fixed = QuerySurface::new(
+        &target.positions,
+        &target.triangles,
+        triangle_masks(&t_sides, &target.triangles),
+    );
+    let moving = Moving {
+        positions: &source.positions,
+        triangles: &source.triangles,
+        adjacency: &adj,
+        sides: &s_sides,
+        landmarks: &landmarks,
+        scale,
+    };
+    let reg = register(&moving, &fixed, opts)?;
+    stats.insert("fit_solves".into(), reg.solves as f64);
+    stats.insert("fit_matched".into(), reg.matched);
+    stats.insert("fit_gap_es0".into(), reg.mean_gap);
+    timings.push("register", clock.elapsed().as_secs_f64());
+    // 3. Correspondence.
+    let clock = Instant::now();
+    let registered = QuerySurface::new(
+        &reg.positions,
+        &source.triangles,
+        triangle_masks(&s_sides, &source.triangles),
+    );
+    let corr = correspond::correspond(
+        &target.positions,
+        &target.triangles,
+        &t_sides,
+        &registered,
+        &source.triangles,
+        scale,
+        opts,
+    );
+    let unmatched = corr.iter().filter(|c| c.is_none()).count();
+    stats.insert("fit_unmatched".into(), unmatched as f64);
+    if unmatched > 0 {
+        warnings.push(format!(
+            "fit: {unmatched} of {} target vertices lie beyond the source surface and stay \
+             still",
+            target.positions.len()
+        ));
+    }
+    timings.push("correspond", clock.elapsed().as_secs_f64());
+    // 4. Transfer.
+    let clock = Instant::now();
+    let out = transfer::transfer(source, motions, target, &corr, opts.fapu_scale);
+    timings.push("transfer", clock.elapsed().as_secs_f64());
+    Ok(SurfaceCloneResult {
+        motions: out,
+        timings,
+        stats,
+        warnings,
+    })
+}
+
+#[cfg(test)]
+mod tests;

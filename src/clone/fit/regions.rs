@@ -1,0 +1,201 @@
+//! Upper and lower sides of the mouth and the eyes, so a closed mouth or eye does not weld
+//! when points are matched between surfaces.
+//!
+//! Each slit (the mouth, each eye) has a split line through its corners and the midpoints of
+//! its upper and lower feature points (xy in the face frame, piecewise linear in x). A vertex
+//! strictly between the corners in x, not too far above or below the line and not too deep
+//! behind the corners is [`Side::Upper`] above the line and [`Side::Lower`] below it; every
+//! other vertex is [`Side::Other`]. The labels come from the feature points alone, so both
+//! faces of a clone are cut the same anatomical way whatever their meshing.
+//!
+//! Queries from an upper vertex see only upper and other triangles, from a lower vertex only
+//! lower and other ones; triangles with both an upper and a lower vertex (across the slit)
+//! are seen by other vertices only.
+
+use glam::{Vec2, Vec3};
+
+use crate::clone::CloneSurface;
+use crate::spec::FeaturePointId;
+
+/// A vertex's side of the mouth or eye slit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Side {
+    /// Not near a slit.
+    Other,
+    /// Upper lip or upper eyelid.
+    Upper,
+    /// Lower lip or lower eyelid.
+    Lower,
+}
+
+/// Which query sides may see a triangle: bit 0 upper, bit 1 lower, bit 2 other.
+pub(crate) type TriMask = u8;
+
+/// A triangle seen by every query.
+pub(crate) const SEEN_BY_ALL: TriMask = 0b111;
+
+/// One slit: the split line (sorted by x) and the box around it.
+struct Slit {
+    line: Vec<Vec2>,
+    up: f32,
+    down: f32,
+    zmin: f32,
+}
+
+impl Slit {
+    /// The split line's y at `x`, if `x` lies strictly between the corners.
+    fn y_at(&self, x: f32) -> Option<f32> {
+        let (first, last) = (self.line.first()?, self.line.last()?);
+        if !(x > first.x && x < last.x) {
+            return None;
+        }
+        self.line.windows(2).find_map(|w| {
+            let (a, b) = (w[0], w[1]);
+            if x < a.x || x > b.x {
+                return None;
+            }
+            let t = if b.x > a.x {
+                (x - a.x) / (b.x - a.x)
+            } else {
+                0.5
+            };
+            Some(a.y + (b.y - a.y) * t)
+        })
+    }
+
+    fn side(&self, p: Vec3) -> Side {
+        if p.z < self.zmin {
+            return Side::Other;
+        }
+        let Some(y) = self.y_at(p.x) else {
+            return Side::Other;
+        };
+        if p.y >= y && p.y <= y + self.up {
+            Side::Upper
+        } else if p.y < y && p.y >= y - self.down {
+            Side::Lower
+        } else {
+            Side::Other
+        }
+    }
+}
+
+fn fp(s: &CloneSurface, group: u8, index: u8) -> Option<Vec3> {
+    s.fp(FeaturePointId::new(group, index)?)
+}
+
+/// First available of several feature points.
+fn first(s: &CloneSurface, ids: &[(u8, u8)]) -> Option<Vec3> {
+    ids.iter().find_map(|&(g, i)| fp(s, g, i))
+}
+
+/// A slit from its two corners and pairs of (upper, lower) points across it.
+fn slit(corners: [Vec3; 2], pairs: &[(Vec3, Vec3)], up: f32, down: f32, depth: f32) -> Slit {
+    let mut line: Vec<Vec2> = corners.iter().map(|c| c.truncate()).collect();
+    let (lo, hi) = (
+        corners[0].x.min(corners[1].x),
+        corners[0].x.max(corners[1].x),
+    );
+    for (u, l) in pairs {
+        let m = (*u + *l) * 0.5;
+        if m.x > lo && m.x < hi {
+            line.push(m.truncate());
+        }
+    }
+    line.sort_by(|a, b| a.x.total_cmp(&b.x));
+    line.dedup_by(|a, b| a.x == b.x);
+    let zmin = corners[0].z.min(corners[1].z) - depth;
+    Slit {
+        line,
+        up,
+        down,
+        zmin,
+    }
+}
+
+/// The mouth and eye slits a surface's feature points define.
+fn slits(s: &CloneSurface) -> Vec<Slit> {
+    let d = &s.fapu.distances;
+    let (mns0, es0, mw0) = (d.mns0 as f32, d.es0 as f32, d.mw0 as f32);
+    let mut out = Vec::new();
+    if !(mns0 > 0.0 && es0 > 0.0 && mw0 > 0.0) {
+        return out;
+    }
+    // Mouth: inner corners if known, else outer ones.
+    let lc = first(s, &[(2, 4), (8, 3)]);
+    let rc = first(s, &[(2, 5), (8, 4)]);
+    if let (Some(lc), Some(rc)) = (lc, rc) {
+        let pairs: Vec<(Vec3, Vec3)> = [((2, 2), (2, 3)), ((2, 6), (2, 8)), ((2, 7), (2, 9))]
+            .iter()
+            .filter_map(|&((a, b), (c, e))| Some((fp(s, a, b)?, fp(s, c, e)?)))
+            .collect();
+        if !pairs.is_empty() {
+            out.push(slit([lc, rc], &pairs, 0.9 * mns0, 1.3 * mns0, 0.5 * mw0));
+        }
+    }
+    // Eyes: (outer corner, inner corner, upper lid, lower lid) per side.
+    for (outer, inner, top, bottom) in [
+        ((3, 7), (3, 11), (3, 1), (3, 3)),
+        ((3, 8), (3, 12), (3, 2), (3, 4)),
+    ] {
+        let pts = (
+            fp(s, outer.0, outer.1),
+            fp(s, inner.0, inner.1),
+            fp(s, top.0, top.1),
+            fp(s, bottom.0, bottom.1),
+        );
+        if let (Some(o), Some(i), Some(t), Some(b)) = pts {
+            out.push(slit([o, i], &[(t, b)], 0.3 * es0, 0.3 * es0, 0.25 * es0));
+        }
+    }
+    out
+}
+
+/// Every vertex's side, and how many slits were found (0 to 3). A vertex is judged by the
+/// mean of its neighbours (`adj`), not by itself: on a closed mouth or eye the upper and
+/// lower vertices of the slit coincide, and only their neighbours tell them apart.
+pub(crate) fn classify(s: &CloneSurface, adj: &[Vec<u32>]) -> (Vec<Side>, usize) {
+    let slits = slits(s);
+    let sides =
+        s.positions
+            .iter()
+            .enumerate()
+            .map(|(v, &p)| {
+                let ring = adj.get(v).filter(|r| !r.is_empty()).map(|r| {
+                    r.iter().map(|&w| s.positions[w as usize]).sum::<Vec3>() / r.len() as f32
+                });
+                let q = Vec3::new(p.x, ring.map_or(p.y, |c| c.y), p.z);
+                slits
+                    .iter()
+                    .map(|sl| sl.side(q))
+                    .find(|&sd| sd != Side::Other)
+                    .unwrap_or(Side::Other)
+            })
+            .collect();
+    (sides, slits.len())
+}
+
+/// Triangle masks from vertex sides (module docs).
+pub(crate) fn triangle_masks(sides: &[Side], triangles: &[[u32; 3]]) -> Vec<TriMask> {
+    triangles
+        .iter()
+        .map(|t| {
+            let has = |w: Side| t.iter().any(|&v| sides.get(v as usize) == Some(&w));
+            match (has(Side::Upper), has(Side::Lower)) {
+                (true, true) => 0b100,
+                (true, false) => 0b101,
+                (false, true) => 0b110,
+                (false, false) => SEEN_BY_ALL,
+            }
+        })
+        .collect()
+}
+
+/// The mask bit a query from a vertex of side `s` needs.
+pub(crate) fn query_bit(s: Side) -> TriMask {
+    match s {
+        Side::Upper => 0b001,
+        Side::Lower => 0b010,
+        Side::Other => 0b100,
+    }
+}

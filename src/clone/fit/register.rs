@@ -1,0 +1,167 @@
+//! Landmark-guided non-rigid registration of one surface onto another (after the
+//! optimal-step non-rigid ICP of Amberg, Romdhani & Vetter 2007, with a displacement field
+//! instead of per-vertex affine maps).
+//!
+//! Unknown: a displacement `u_i` per vertex of the moving surface (positions `p_i`). Each
+//! step minimises
+//!
+//! ```text
+//! E(u) = Σ_i w_i ‖p_i + u_i − c_i‖² + β Σ_l ‖p_l + u_l − L_l‖² + α (‖L u‖² + μ ‖∇u‖²) + ε ‖u‖²
+//! ```
+//!
+//! where `c_i` is the closest allowed point of the fixed surface to the current `p_i + u_i`
+//! (`w_i` = 1, or 0 when rejected: no allowed triangle, a hit on the fixed surface's border,
+//! normals more than [`FitOptions::normal_degrees`] apart, or farther than the distance
+//! limit), `L_l` the fixed surface's feature point for each shared feature-point vertex,
+//! `L` the uniform Laplacian (bending: affine-like fields are cheap, so the surface may
+//! stretch between landmarks) and `∇` the graph gradient (a little membrane keeps the system
+//! definite along open borders). The normal equations
+//! `(α(LᵀL + μL_g) + W + βB + εI) u = W(c − p) + βB(L − p)` are one sparse SPD system for
+//! the three coordinates ([`super::system`]). The stiffness `α` runs from stiff to soft
+//! ([`FitOptions::stiffness`]), with [`FitOptions::iterations`] closest-point updates per
+//! value. Closest points are restricted by slit side ([`super::regions`]), so lips and lids
+//! never pull across a closed mouth or eye.
+
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::regions::{query_bit, Side};
+use super::surface::{Filter, QuerySurface};
+use super::system::SmoothSystem;
+use super::FitOptions;
+use crate::error::Result;
+use crate::mesh::geometry::vertex_normals;
+
+/// Damping that keeps pieces without any data or landmark where they are.
+const DAMPING: f64 = 1e-6;
+
+/// A moving surface and what to pull it to.
+pub(crate) struct Moving<'a> {
+    /// Neutral positions.
+    pub positions: &'a [Vec3],
+    /// Triangles.
+    pub triangles: &'a [[u32; 3]],
+    /// Vertex adjacency.
+    pub adjacency: &'a [Vec<u32>],
+    /// Slit side of each vertex.
+    pub sides: &'a [Side],
+    /// `(vertex, landmark position on the fixed surface)`.
+    pub landmarks: &'a [(u32, Vec3)],
+    /// A length of the face (ES0), for the distance limits.
+    pub scale: f32,
+}
+
+/// The registered surface.
+pub(crate) struct Registered {
+    /// Moved positions (same order and topology as the moving surface).
+    pub positions: Vec<Vec3>,
+    /// Linear solves run.
+    pub solves: usize,
+    /// Share of vertices with an accepted closest point in the last step.
+    pub matched: f64,
+    /// Mean distance to the accepted closest points in the last step, in ES0.
+    pub mean_gap: f64,
+}
+
+/// Registers `m` onto `fixed` (module docs).
+pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> Result<Registered> {
+    let n = m.positions.len();
+    let p: Vec<DVec3> = m.positions.iter().map(|v| v.as_dvec3()).collect();
+    let system = SmoothSystem::new(m.adjacency, opts.membrane)?;
+    let beta = opts.landmark_weight;
+    let mut lm_diag = vec![0.0; n];
+    let mut lm_rhs = vec![DVec3::ZERO; n];
+    for &(v, l) in m.landmarks {
+        if let Some(pv) = p.get(v as usize) {
+            lm_diag[v as usize] += beta;
+            lm_rhs[v as usize] += beta * (l.as_dvec3() - *pv);
+        }
+    }
+    let mut u = vec![DVec3::ZERO; n];
+    let mut solves = 0;
+    let solve = |alpha: f64, w: &[f64], c: &[DVec3], u: &mut Vec<DVec3>| -> Result<()> {
+        let diag: Vec<f64> = (0..n).map(|i| w[i] + lm_diag[i] + DAMPING).collect();
+        let rhs: Vec<[f64; 3]> = (0..n)
+            .map(|i| (w[i] * (c[i] - p[i]) + lm_rhs[i]).to_array())
+            .collect();
+        let sol = system.solve(alpha, &diag, &rhs)?;
+        for (ui, s) in u.iter_mut().zip(sol) {
+            *ui = DVec3::from_array(s);
+        }
+        Ok(())
+    };
+    let stiff = opts.stiffness.first().copied().unwrap_or(1.0);
+    if !m.landmarks.is_empty() {
+        // Landmarks alone first: a smooth warp that brings the surfaces close.
+        solve(stiff, &vec![0.0; n], &vec![DVec3::ZERO; n], &mut u)?;
+        solves += 1;
+    }
+    let cos = (opts.normal_degrees.to_radians()).cos() as f32;
+    let limit = opts.max_distance as f32 * m.scale;
+    let snap = super::correspond::SNAP * m.scale;
+    let (mut matched, mut mean_gap) = (0.0, 0.0);
+    for &alpha in &opts.stiffness {
+        for _ in 0..opts.iterations.max(1) {
+            let x: Vec<Vec3> = p.iter().zip(&u).map(|(a, b)| (*a + *b).as_vec3()).collect();
+            let normals = vertex_normals(&x, m.triangles);
+            let hits: Vec<Option<(Vec3, f32)>> = (0..n)
+                .into_par_iter()
+                .map(|i| {
+                    let nrm = normals[i];
+                    let bit = query_bit(m.sides[i]);
+                    let plain = fixed.closest(x[i], Filter { bit, normal: None })?;
+                    // On the surface already: a match, whatever a crease's normals say.
+                    let h = if plain.point.distance(x[i]) <= snap || nrm == Vec3::ZERO {
+                        plain
+                    } else {
+                        let filter = Filter {
+                            bit,
+                            normal: Some((nrm, cos)),
+                        };
+                        fixed.closest(x[i], filter)?
+                    };
+                    if fixed.on_border(&h) {
+                        return None;
+                    }
+                    Some((h.point, h.point.distance(x[i])))
+                })
+                .collect();
+            // Outliers: farther than the limit, or than a few times the typical gap.
+            let mut gaps: Vec<f32> = hits.iter().flatten().map(|h| h.1).collect();
+            gaps.sort_by(f32::total_cmp);
+            let median = gaps.get(gaps.len() / 2).copied().unwrap_or(0.0);
+            let cut = limit.min((4.0 * median).max(0.02 * limit));
+            let mut w = vec![0.0; n];
+            let mut c = vec![DVec3::ZERO; n];
+            let (mut count, mut sum) = (0usize, 0.0f64);
+            for (i, h) in hits.iter().enumerate() {
+                if let Some((pt, d)) = h {
+                    if *d <= cut {
+                        w[i] = 1.0;
+                        c[i] = pt.as_dvec3();
+                        count += 1;
+                        sum += *d as f64;
+                    }
+                }
+            }
+            if count == 0 && m.landmarks.is_empty() {
+                break;
+            }
+            solve(alpha, &w, &c, &mut u)?;
+            solves += 1;
+            matched = count as f64 / n.max(1) as f64;
+            mean_gap = if count > 0 {
+                sum / count as f64 / m.scale.max(f32::MIN_POSITIVE) as f64
+            } else {
+                0.0
+            };
+        }
+    }
+    let positions = p.iter().zip(&u).map(|(a, b)| (*a + *b).as_vec3()).collect();
+    Ok(Registered {
+        positions,
+        solves,
+        matched,
+        mean_gap,
+    })
+}
