@@ -72,7 +72,10 @@
 //!    without cancelling `p`, `f(p) − p` once per vertex for all motions); each target
 //!    vertex bound to a triangle that has a moved vertex gets `Σ b_k g(p_k)`, i.e. the paper's
 //!    barycentric position in the deformed displaced triangle minus its neutral position.
-//!    Offsets shorter than `min_offset_factor × ENS0` (target) are dropped.
+//!    A target feature-point vertex bound in step 4 moves in the direction of its source
+//!    point's displacement `d` (with the length of `g`): a FAP moves its feature point in the
+//!    same direction on every face, and the Jacobian of `f` would turn it (on alma → bruno
+//!    by up to 7 % of the motion). Offsets shorter than `min_offset_factor × ENS0` (target) are dropped.
 //!
 //! Target vertices that belong to no triangle (Candide-3 has four unused duplicates of
 //! midline vertices) are not part of the surface and get no motion.
@@ -561,6 +564,8 @@ pub fn clone_rbf(
     // anatomical point, whatever the rays find around it (an eyelid's ray can slip to the
     // other lid of a narrow eye).
     let mut fp_binding: HashMap<u32, (u32, [f32; 3])> = HashMap::new();
+    // Target feature-point vertex → its source feature-point vertex.
+    let mut fp_source: HashMap<u32, u32> = HashMap::new();
     let incident = VertexTriangles::new(source.positions.len(), &source.triangles);
     for (id, &tv) in &target.fp_vertices {
         let Some(&sv) = source.fp_vertices.get(id) else {
@@ -569,6 +574,7 @@ pub fn clone_rbf(
         if let Some(tri) = incident.around(sv).next() {
             let t = source.triangles[tri as usize];
             fp_binding.insert(tv, (tri, t.map(|v| if v == sv { 1.0 } else { 0.0 })));
+            fp_source.insert(tv, sv);
         }
     }
     let binding: Vec<Option<(u32, [f32; 3], bool)>> = (0..target.positions.len())
@@ -628,6 +634,7 @@ pub fn clone_rbf(
         .filter(|&&v| !bound_to[v as usize].is_empty())
         .map(|&v| (v, f.displacement(source.positions[v as usize].as_dvec3())))
         .collect();
+    let fp_source_vertices: std::collections::HashSet<u32> = fp_source.values().copied().collect();
     let out: Vec<SurfaceMotion> = motions
         .par_iter()
         .map(|m| {
@@ -640,6 +647,12 @@ pub fn clone_rbf(
                     Some((v, f.moved_from(p, *disp.get(&v)?, d)))
                 })
                 .collect();
+            let raw: HashMap<u32, Vec3> = m
+                .offsets
+                .iter()
+                .filter(|o| fp_source_vertices.contains(&o.0))
+                .copied()
+                .collect();
             let mut qs: Vec<u32> = moved
                 .keys()
                 .flat_map(|&v| bound_to[v as usize].iter().copied())
@@ -649,6 +662,15 @@ pub fn clone_rbf(
             let offsets = qs
                 .into_iter()
                 .filter_map(|q| {
+                    // A feature point moves the way its FAP says on every face: in its source
+                    // displacement's direction, not turned by the Jacobian of `f` (whose
+                    // stretch still sets the length).
+                    if let Some(&sv) = fp_source.get(&q) {
+                        let d = raw.get(&sv).copied().unwrap_or(Vec3::ZERO);
+                        let len = moved.get(&sv).map_or(0.0, |g| g.length());
+                        let o = d.normalize_or_zero() * len;
+                        return (o.length() > min_offset).then_some((q, o));
+                    }
                     let (tri, w, _) = binding[q as usize]?;
                     let t = source.triangles[tri as usize];
                     let o = (0..3)
