@@ -444,6 +444,31 @@ mod tests {
     }
 
     #[test]
+    fn a_dead_end_lip_walk_becomes_the_shortest_path() {
+        // The start's neighbours both lie behind it (as where a lip of a mixed quad/triangle
+        // mesh curls into the mouth), so the xy angle rule has nowhere to go.
+        let pos = vec![
+            Vec3::ZERO,
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::new(1.0, 3.0, 0.0),
+            Vec3::new(4.0, 0.0, 0.0),
+            Vec3::new(-1.0, -1.0, 0.0),
+        ];
+        let tris = vec![[0, 1, 4], [1, 3, 2]];
+        let adj = adjacency(pos.len(), &tris);
+        let vt = VertexTriangles::new(pos.len(), &tris);
+        let mesh = (&vt, tris.as_slice());
+        assert!(lip_walk(&pos, &adj, mesh, 0, 3, true).is_err());
+        assert_eq!(
+            lip_contour(&pos, &adj, mesh, (0, None, 3), true).unwrap(),
+            vec![0, 1, 3]
+        );
+        // An end that cannot be reached at all is an error, never a panic.
+        let lone = adjacency(pos.len(), &tris[..1]);
+        assert!(lip_contour(&pos, &lone, mesh, (0, None, 3), true).is_err());
+    }
+
+    #[test]
     fn greedy_eye_loop_walks_around_a_ring() {
         // An octagon ring around a centre vertex 8, plus the centre.
         let mut pos: Vec<Vec3> = (0..8)
