@@ -103,14 +103,16 @@ fn both_cloners_against_the_real_head_truth() {
             for k in &r.keys {
                 eprintln!("    {:<22} {:6.1} %", k.key, k.all);
             }
-            // The targets are median ≤ 10 % and no FAP above 100 %. fmc meets them
-            // (measured median 7.7 %, worst thrust_jaw 16 %); rbf does not (median 77.5 %,
-            // worst stretch_r_cornerlip 139 %: its volume morph on this mesh), so its limits
-            // hold the measured figures with margin, to catch regressions, not to bless them.
+            // The targets are median ≤ 10 % and no FAP above 100 % (fit: ≤ 4 %).
+            // Measured on B and B×10: fmc median 7.4 %, worst thrust_jaw 15.9 %; rbf median
+            // 5.5 %, worst thrust_jaw 14.1 % (without refinement rounds, its default); fit
+            // median 2.6 %, worst thrust_jaw 13.7 % (the jaw error is the rigid teeth and
+            // gums: on the skin alone open_jaw is 1.7 %). The subdivided target scores a little
+            // higher. The limits are those figures with a small margin, to catch regressions.
             let (med_max, worst_max) = match m {
-                Method::Fmc => (10.0, 25.0),
-                Method::Rbf => (90.0, 160.0),
-                Method::Fit => (4.0, 25.0),
+                Method::Fmc => (9.0, 18.0),
+                Method::Rbf => (8.0, 18.0),
+                Method::Fit => (4.0, 15.0),
             };
             assert!(med <= med_max, "{m:?} case {ci}: median {med}");
             assert!(worst.all < worst_max, "{m:?} case {ci}: {worst:?}");

@@ -1,10 +1,9 @@
 //! Step 4 — interpolation from a 2D triangle mesh (the paper's "Interpolation from 2D triangle
-//! mesh" section): bounding-box test (an R-tree of triangle boxes), barycentric coordinates,
+//! mesh" section): bounding-box test (a uniform grid of triangle boxes), barycentric coordinates,
 //! overlap resolution by the smallest interpolated depth, and the closest-triangle rule with
 //! clamped, renormalised coordinates for points outside every triangle.
 
 use glam::DVec2;
-use rstar::{Envelope, PointDistance, RTree, RTreeObject, AABB};
 
 /// Tolerance on the sum of excess barycentric coordinates under which a point counts as
 /// inside (points on shared edges and vertices must be inside both neighbours).
@@ -57,25 +56,151 @@ pub(crate) fn clamp(b: [f64; 3]) -> [f64; 3] {
     c.map(|x| x / s)
 }
 
-/// A triangle's bounding box in the R-tree.
-struct TriBox {
-    tri: u32,
-    aabb: AABB<[f64; 2]>,
+/// Triangle bounding boxes bucketed in a uniform grid: the boxes containing a point, and the
+/// boxes nearest a point in order. Cells are about one mean box across, so a point's cell
+/// holds a handful of boxes on a mesh of similar-sized triangles.
+struct BoxGrid {
+    boxes: Vec<(DVec2, DVec2)>,
+    origin: DVec2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    /// Compressed rows: the boxes of cell `k` are `items[start[k]..start[k + 1]]`.
+    start: Vec<u32>,
+    items: Vec<u32>,
 }
 
-impl RTreeObject for TriBox {
-    type Envelope = AABB<[f64; 2]>;
-    fn envelope(&self) -> Self::Envelope {
-        self.aabb
-    }
+/// Box-to-point squared distance (0 inside).
+fn box_distance2((lo, hi): (DVec2, DVec2), p: DVec2) -> f64 {
+    let d = (lo - p).max(p - hi).max(DVec2::ZERO);
+    d.length_squared()
 }
 
-impl PointDistance for TriBox {
-    fn distance_2(&self, point: &[f64; 2]) -> f64 {
-        self.aabb.distance_2(point)
+impl BoxGrid {
+    fn new(boxes: Vec<(DVec2, DVec2)>) -> BoxGrid {
+        let (lo, hi) = boxes.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
+        );
+        let n = boxes.len().max(1) as f64;
+        let mean = boxes.iter().map(|b| (b.1 - b.0).max_element()).sum::<f64>() / n;
+        let extent = (hi - lo).max(DVec2::splat(f64::MIN_POSITIVE));
+        // About one box per cell, and never more cells than 4 per box (long thin boxes).
+        let floor = (extent.x * extent.y / (4.0 * n)).sqrt();
+        let cell = mean.max(floor).max(extent.max_element() * 1e-6);
+        let cells = |e: f64| ((e / cell).floor() as usize + 1).min(1 << 15);
+        let (nx, ny) = if boxes.is_empty() {
+            (1, 1)
+        } else {
+            (cells(extent.x), cells(extent.y))
+        };
+        let origin = if boxes.is_empty() { DVec2::ZERO } else { lo };
+        let mut grid = BoxGrid {
+            boxes,
+            origin,
+            cell,
+            nx,
+            ny,
+            start: vec![0; nx * ny + 1],
+            items: Vec::new(),
+        };
+        for pass in 0..2 {
+            let mut fill = grid.start.clone();
+            for (k, &b) in grid.boxes.iter().enumerate() {
+                let ([i0, j0], [i1, j1]) = (grid.index(b.0), grid.index(b.1));
+                for j in j0..=j1 {
+                    for i in i0..=i1 {
+                        let c = j * nx + i;
+                        if pass == 0 {
+                            grid.start[c + 1] += 1;
+                        } else {
+                            grid.items[fill[c] as usize] = k as u32;
+                            fill[c] += 1;
+                        }
+                    }
+                }
+            }
+            if pass == 0 {
+                for c in 0..nx * ny {
+                    grid.start[c + 1] += grid.start[c];
+                }
+                grid.items = vec![0; grid.start[nx * ny] as usize];
+            }
+        }
+        grid
     }
-    fn contains_point(&self, point: &[f64; 2]) -> bool {
-        self.aabb.contains_point(point)
+
+    /// The cell holding `p`, clamped to the grid.
+    fn index(&self, p: DVec2) -> [usize; 2] {
+        let q = (p - self.origin) / self.cell;
+        let clamp = |x: f64, n: usize| (x.max(0.0) as usize).min(n - 1);
+        [clamp(q.x, self.nx), clamp(q.y, self.ny)]
+    }
+
+    fn cell_items(&self, i: usize, j: usize) -> &[u32] {
+        let c = j * self.nx + i;
+        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+
+    /// Boxes containing `p` (borders included).
+    fn containing(&self, p: DVec2) -> impl Iterator<Item = u32> + '_ {
+        let [i, j] = self.index(p);
+        self.cell_items(i, j)
+            .iter()
+            .copied()
+            .filter(move |&k| box_distance2(self.boxes[k as usize], p) == 0.0)
+    }
+
+    /// Up to `count` boxes passing `keep`, nearest to `p` first (ties by index): rings of
+    /// cells grow around `p` until no unvisited cell can hold a nearer box.
+    fn nearest(&self, p: DVec2, count: usize, keep: impl Fn(u32) -> bool) -> Vec<u32> {
+        if count == 0 || self.boxes.is_empty() {
+            return Vec::new();
+        }
+        let [ci, cj] = self.index(p);
+        let mut found: Vec<(f64, u32)> = Vec::new();
+        let mut seen = std::collections::HashSet::new();
+        for r in 0.. {
+            let (i0, i1) = (ci.saturating_sub(r), (ci + r).min(self.nx - 1));
+            let (j0, j1) = (cj.saturating_sub(r), (cj + r).min(self.ny - 1));
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    // Only the ring's border cells are new.
+                    if r > 0 && i > i0 && i < i1 && j > j0 && j < j1 {
+                        continue;
+                    }
+                    for &k in self.cell_items(i, j) {
+                        if seen.insert(k) && keep(k) {
+                            found.push((box_distance2(self.boxes[k as usize], p), k));
+                        }
+                    }
+                }
+            }
+            // Distance from `p` to the cells not yet visited (through the sides of the
+            // visited block that are not the grid's edge).
+            let x = |i: usize| self.origin.x + i as f64 * self.cell;
+            let y = |j: usize| self.origin.y + j as f64 * self.cell;
+            let mut bound = f64::INFINITY;
+            if i0 > 0 {
+                bound = bound.min((p.x - x(i0)).max(0.0));
+            }
+            if i1 + 1 < self.nx {
+                bound = bound.min((x(i1 + 1) - p.x).max(0.0));
+            }
+            if j0 > 0 {
+                bound = bound.min((p.y - y(j0)).max(0.0));
+            }
+            if j1 + 1 < self.ny {
+                bound = bound.min((y(j1 + 1) - p.y).max(0.0));
+            }
+            found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let done =
+                bound.is_infinite() || found.len() >= count && found[count - 1].0 <= bound * bound;
+            if done {
+                break;
+            }
+        }
+        found.into_iter().take(count).map(|f| f.1).collect()
     }
 }
 
@@ -102,7 +227,7 @@ pub(crate) struct TriMesh2 {
     pub triangles: Vec<[u32; 3]>,
     /// For each kept triangle, its index in the caller's list.
     pub original: Vec<u32>,
-    tree: RTree<TriBox>,
+    grid: BoxGrid,
 }
 
 impl TriMesh2 {
@@ -130,10 +255,7 @@ impl TriMesh2 {
             if hi.x - lo.x > max_width {
                 continue;
             }
-            boxes.push(TriBox {
-                tri: kept.len() as u32,
-                aabb: AABB::from_corners([lo.x, lo.y], [hi.x, hi.y]),
-            });
+            boxes.push((lo, hi));
             kept.push(*t);
             original.push(i as u32);
         }
@@ -142,7 +264,7 @@ impl TriMesh2 {
             depth,
             triangles: kept,
             original,
-            tree: RTree::bulk_load(boxes),
+            grid: BoxGrid::new(boxes),
         }
     }
 
@@ -169,23 +291,23 @@ impl TriMesh2 {
     ) -> Option<Hit> {
         let mut best: Option<(f64, u32, [f64; 3])> = None;
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for tb in self.tree.locate_all_at_point([p.x, p.y]) {
-            if !allowed(tb.tri) {
+        for tri in self.grid.containing(p) {
+            if !allowed(tri) {
                 continue;
             }
-            let b = self.coords(tb.tri, p);
+            let b = self.coords(tri, p);
             if excess(b) > INSIDE_EPS {
                 continue;
             }
-            let raw = self.depth_at(tb.tri, b);
+            let raw = self.depth_at(tri, b);
             (lo, hi) = (lo.min(raw), hi.max(raw));
             let d = near.map_or(raw, |n| (raw - n).abs());
             // Ties (shared edges) go to the lower index, for determinism.
             let better = best.is_none_or(|(bd, bt, _)| {
-                d < bd - DEPTH_EPS || ((d - bd).abs() <= DEPTH_EPS && tb.tri < bt)
+                d < bd - DEPTH_EPS || ((d - bd).abs() <= DEPTH_EPS && tri < bt)
             });
             if better {
-                best = Some((d, tb.tri, b));
+                best = Some((d, tri, b));
             }
         }
         let overlap = hi - lo > DEPTH_EPS;
@@ -198,16 +320,11 @@ impl TriMesh2 {
             });
         }
         let mut closest: Option<(f64, u32, [f64; 3])> = None;
-        for tb in self
-            .tree
-            .nearest_neighbor_iter([p.x, p.y])
-            .filter(|tb| allowed(tb.tri))
-            .take(OUTSIDE_CANDIDATES)
-        {
-            let b = self.coords(tb.tri, p);
+        for tri in self.grid.nearest(p, OUTSIDE_CANDIDATES, &allowed) {
+            let b = self.coords(tri, p);
             let e = excess(b);
-            if closest.is_none_or(|(ce, ct, _)| e < ce || (e == ce && tb.tri < ct)) {
-                closest = Some((e, tb.tri, b));
+            if closest.is_none_or(|(ce, ct, _)| e < ce || (e == ce && tri < ct)) {
+                closest = Some((e, tri, b));
             }
         }
         closest.map(|(_, tri, b)| Hit {

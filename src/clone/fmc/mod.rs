@@ -62,10 +62,11 @@
 //!    the closest-triangle rule. Every target feature-point vertex whose point the source
 //!    also has is then put exactly on the source's point.
 //! 4. **Interpolation from a 2D triangle mesh** (module `interp`), exactly as the paper:
-//!    bounding-box test (an R-tree of triangle boxes instead of a scan), barycentric
+//!    bounding-box test (a uniform grid of triangle boxes instead of a scan), barycentric
 //!    coordinates, inside when all are in [0, 1] (within 1e-9), overlaps resolved by the
 //!    smallest interpolated depth, outside points by the triangle with the smallest sum of
-//!    excess coordinates (among the 16 nearest boxes), clamped to [0, 1] and renormalised.
+//!    excess coordinates (among the 16 nearest boxes, ties by triangle index), clamped to
+//!    [0, 1] and renormalised.
 //! 5. **Motion mapping**: normalised source motion vectors interpolated at each aligned target
 //!    point from the source's projected triangles (weights computed once, applied to every
 //!    motion).
@@ -86,9 +87,17 @@
 //!    lower-lip (this catches the triangles at the lip corners, whose corner vertex is "out":
 //!    with the all-vertices rule alone they let a closed mouth's coincident line vertices pick
 //!    the other lip's motion); likewise for the lower lip. A target vertex of the lower lip
-//!    ignores upper-lip source triangles, and vice versa.
-//! 8. **Denormalisation**: target motions are multiplied by the target's N(FP) of each
-//!    vertex's region.
+//!    ignores upper-lip source triangles and every source triangle with an upper-lip vertex,
+//!    and vice versa (so a closed mouth's coincident line vertices, which lie in triangles of
+//!    both lips, take only their own lip's motion: a self-clone is exact there).
+//! 8. **Denormalisation**: a source vertex's normalised motion is multiplied by the
+//!    *target's* N(FP) of the *source vertex's* region before it is interpolated, i.e. each
+//!    source motion is scaled by the target/source FAPU ratio of its own region. The paper
+//!    multiplies the interpolated motion by the target vertex's region instead; where the two
+//!    regions differ that multiplies one region's normalised motion by another region's unit
+//!    (an eyebrow vertex of the target taking an eyelid's IRISD-normalised motion times ENS
+//!    moved 2.5× further than its feature point on Candide-3 → ICT). At feature points the two
+//!    agree (a feature-point vertex's motion comes from the source's same point).
 //!
 //! Rigid parts (eyes, teeth, tongue, head transforms) are not part of a [`CloneSurface`] and
 //! are not handled here.
@@ -417,6 +426,15 @@ pub fn clone_fmc(
             }
         })
         .collect();
+    // (has an upper-lip vertex, has a lower-lip vertex) per kept source triangle.
+    let tri_has: Vec<(bool, bool)> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let r = t.map(|v| src_lips[v as usize]);
+            (r.contains(&LipRegion::Upper), r.contains(&LipRegion::Lower))
+        })
+        .collect();
     let fp_vertex: BTreeSet<u32> = target.fp_vertices.values().copied().collect();
     let ring: Vec<DVec2> = if opts.filter_support > 0.0 && opts.filter_samples > 0 {
         let r = f64::from(opts.filter_support) * 0.5;
@@ -444,11 +462,18 @@ pub fn clone_fmc(
                 OverlapRule::FrontMost => None,
                 OverlapRule::NearestDepth => Some(aligned.depth[i]),
             };
-            let allowed = |t: u32| {
-                !matches!(
-                    (lip, tri_lip[t as usize]),
-                    (LipRegion::Upper, LipRegion::Lower) | (LipRegion::Lower, LipRegion::Upper)
-                )
+            // A lip vertex never takes weight from the other lip: neither its triangles nor
+            // any triangle with one of its vertices (at a closed mouth's coincident line
+            // vertices an "out" corner triangle can hold the other lip's vertex, and the tie
+            // between the two coincident vertices would otherwise go to the lower index).
+            let allowed = |t: u32| match lip {
+                LipRegion::Upper => {
+                    tri_lip[t as usize] != LipRegion::Lower && !tri_has[t as usize].1
+                }
+                LipRegion::Lower => {
+                    tri_lip[t as usize] != LipRegion::Upper && !tri_has[t as usize].0
+                }
+                LipRegion::Out => true,
             };
             let offsets: &[DVec2] = if fp_vertex.contains(&(i as u32)) {
                 &[]
@@ -494,14 +519,22 @@ pub fn clone_fmc(
     stats.insert("source_triangles_used".into(), mesh.triangles.len() as f64);
     timings.push("map", t.elapsed().as_secs_f64());
 
-    // 5. Motion mapping in the normalised space.
+    // 5 and 8. Motion mapping; each source motion is normalised by its own vertex's region
+    // and denormalised by the target's factors of that same region (see step 8).
     let t = Instant::now();
+    let ratio: Vec<DVec3> = src
+        .norm
+        .region
+        .iter()
+        .zip(&src.norm.motion_factors)
+        .map(|(id, n)| normalise::factors(&target.fapu, normalise::motion_kinds(id.group())) / *n)
+        .collect();
     let normalised: Vec<Vec<DVec3>> = motions
         .par_iter()
         .map(|m| {
             let mut dense = vec![DVec3::ZERO; source.positions.len()];
             for &(v, d) in &m.offsets {
-                dense[v as usize] = d.as_dvec3() / src.norm.motion_factors[v as usize];
+                dense[v as usize] = d.as_dvec3() * ratio[v as usize];
             }
             mapped
                 .iter()
@@ -511,16 +544,15 @@ pub fn clone_fmc(
         .collect();
     timings.push("motions", t.elapsed().as_secs_f64());
 
-    // 8. Denormalisation with the target's factors.
+    // 8. Output (the target's factors were applied per source region above).
     let t = Instant::now();
-    let factors = &tgt.norm.motion_factors;
     let mut out = Vec::with_capacity(motions.len());
     for (m, field) in motions.iter().zip(normalised) {
         let offsets: Vec<(u32, Vec3)> = field
             .iter()
             .enumerate()
             .filter(|(_, d)| **d != DVec3::ZERO)
-            .map(|(i, d)| (i as u32, (*d * factors[i]).as_vec3()))
+            .map(|(i, d)| (i as u32, d.as_vec3()))
             .collect();
         if let Some((v, d)) = offsets.iter().find(|(_, d)| !d.is_finite()) {
             return Err(Error::Invalid(format!(

@@ -66,7 +66,6 @@ pub(crate) struct Normalised {
     #[allow(dead_code)] // read by tests
     pub centre: DVec3,
     /// The closest feature point of each vertex (its region).
-    #[allow(dead_code)] // read by tests
     pub region: Vec<FeaturePointId>,
     /// Normalised vertex positions.
     pub positions: Vec<DVec3>,

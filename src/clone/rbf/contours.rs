@@ -13,9 +13,11 @@ use super::mesh::VertexTriangles;
 /// `None` and the reason is in the warnings.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Contours {
-    /// Right eye loop 3.2 ⇒ 3.8 ⇒ 3.4 ⇒ 3.12 (closed; the start is not repeated).
+    /// Right eye loop 3.2 ⇒ 3.8 ⇒ 3.4 ⇒ 3.12: top, inner corner, bottom, outer corner
+    /// (closed; the start is not repeated).
     pub right_eye: Option<Vec<u32>>,
-    /// Left eye loop 3.1 ⇒ 3.7 ⇒ 3.3 ⇒ 3.11.
+    /// Left eye loop 3.1 ⇒ 3.11 ⇒ 3.3 ⇒ 3.7 (the right eye's loop mirrored: top, inner
+    /// corner, bottom, outer corner, so a symmetric face gets mirror-image contours).
     pub left_eye: Option<Vec<u32>>,
     /// Upper inner lip, 2.5 ⇒ 2.4 (both corners included).
     pub upper_lip: Option<Vec<u32>>,
@@ -65,9 +67,9 @@ pub(crate) fn extract(
     let left_eye = eye(
         [
             FeaturePointId::FP_3_1,
-            FeaturePointId::FP_3_7,
-            FeaturePointId::FP_3_3,
             FeaturePointId::FP_3_11,
+            FeaturePointId::FP_3_3,
+            FeaturePointId::FP_3_7,
         ],
         "left eye",
     );
@@ -77,8 +79,13 @@ pub(crate) fn extract(
         fp_vertex(surface, FeaturePointId::FP_2_4),
     ) {
         (Some(s), Some(e)) => {
-            for (upper, slot) in [(true, &mut upper_lip), (false, &mut lower_lip)] {
-                match lip_walk(pos, adj, (incidence, &surface.triangles), s, e, upper) {
+            let mesh = (incidence, surface.triangles.as_slice());
+            for (upper, mid, slot) in [
+                (true, FeaturePointId::FP_2_2, &mut upper_lip),
+                (false, FeaturePointId::FP_2_3, &mut lower_lip),
+            ] {
+                let mid = fp_vertex(surface, mid).filter(|&m| m != s && m != e);
+                match lip_contour(pos, adj, mesh, (s, mid, e), upper) {
                     Ok(c) => *slot = Some(c),
                     Err(err) => warnings.push(format!(
                         "{face}: {} inner lip contour skipped: {err}",
@@ -107,12 +114,107 @@ pub(crate) fn eye_loop(pos: &[Vec3], adj: &[Vec<u32>], fps: &[u32]) -> Result<Ve
     visited.insert(fps[0]);
     for k in 0..fps.len() {
         let (start, end) = (fps[k], fps[(k + 1) % fps.len()]);
-        let path = greedy_path(pos, adj, start, end, &mut visited)?;
+        let before = visited.clone();
+        let path = match greedy_path(pos, adj, start, end, &mut visited) {
+            Ok(p) => p,
+            // The greedy step can corner itself on irregular meshes (triangulated quads
+            // next to triangles); the shortest edge path through unused vertices joins the
+            // same feature points.
+            Err(e) => {
+                visited = before;
+                let p = shortest_path(pos, adj, start, end, |v| visited.contains(&v)).ok_or(e)?;
+                visited.extend(p.iter().copied());
+                p
+            }
+        };
         contour.extend(path);
     }
     // The last quarter ends at the start vertex again.
     contour.pop();
     Ok(contour)
+}
+
+/// One inner lip, corner 2.5 ⇒ corner 2.4 (`ends = (2.5, midpoint, 2.4)`). With the lip's
+/// midpoint (2.2 upper, 2.3 lower) known, it is walked from each corner to the midpoint and
+/// the halves joined, so a mirror-symmetric face gets a mirror-symmetric contour (one walk
+/// from corner to corner is not: the greedy choice depends on the walking direction). A half
+/// whose greedy walk dead-ends (the xy angle rule has no forward neighbour where a lip curls
+/// into the mouth, common on meshes of mixed quads and triangles) is the shortest edge path
+/// instead.
+pub(crate) fn lip_contour(
+    pos: &[Vec3],
+    adj: &[Vec<u32>],
+    mesh: (&VertexTriangles, &[[u32; 3]]),
+    (start, mid, end): (u32, Option<u32>, u32),
+    upper: bool,
+) -> Result<Vec<u32>, String> {
+    let half = |a: u32, b: u32| -> Result<Vec<u32>, String> {
+        lip_walk(pos, adj, mesh, a, b, upper).or_else(|e| {
+            let rest = shortest_path(pos, adj, a, b, |_| false).ok_or(e)?;
+            Ok(std::iter::once(a).chain(rest).collect())
+        })
+    };
+    let Some(mid) = mid else {
+        return half(start, end);
+    };
+    let mut contour = half(start, mid)?;
+    let back = half(end, mid)?;
+    contour.extend(back.iter().rev().skip(1));
+    let mut seen = HashSet::new();
+    if !contour.iter().all(|v| seen.insert(*v)) {
+        // The halves crossed: one walk from corner to corner is the better contour.
+        return half(start, end);
+    }
+    Ok(contour)
+}
+
+/// The shortest path along mesh edges (Dijkstra, edge length) from `start` to `end` through
+/// vertices not `blocked` (`end` always allowed). Returns it without `start`, ending at
+/// `end`; `None` when `end` cannot be reached.
+pub(crate) fn shortest_path(
+    pos: &[Vec3],
+    adj: &[Vec<u32>],
+    start: u32,
+    end: u32,
+    blocked: impl Fn(u32) -> bool,
+) -> Option<Vec<u32>> {
+    use std::cmp::Reverse;
+    use std::collections::{BinaryHeap, HashMap};
+    // Non-negative f64s order like their bit patterns.
+    let mut dist: HashMap<u32, f64> = HashMap::from([(start, 0.0)]);
+    let mut prev: HashMap<u32, u32> = HashMap::new();
+    let mut heap = BinaryHeap::from([Reverse((0u64, start))]);
+    while let Some(Reverse((bits, v))) = heap.pop() {
+        let d = f64::from_bits(bits);
+        if v == end {
+            let mut path = vec![end];
+            let mut w = end;
+            while let Some(&p) = prev.get(&w) {
+                if p == start {
+                    break;
+                }
+                path.push(p);
+                w = p;
+            }
+            path.reverse();
+            return Some(path);
+        }
+        if dist.get(&v).is_some_and(|&best| d > best) {
+            continue;
+        }
+        for &n in adj.get(v as usize)? {
+            if n == start || (n != end && blocked(n)) {
+                continue;
+            }
+            let nd = d + f64::from(pos[v as usize].distance(pos[n as usize]));
+            if dist.get(&n).is_none_or(|&best| nd < best) {
+                dist.insert(n, nd);
+                prev.insert(n, v);
+                heap.push(Reverse((nd.to_bits(), n)));
+            }
+        }
+    }
+    None
 }
 
 /// The paper's greedy walk from `start` to `end`: from `v` step to the neighbour `n` whose
@@ -339,6 +441,31 @@ mod tests {
         let lower = lip_walk(&pos, &adj, opp, 10, 14, false).unwrap();
         assert_eq!(upper, vec![10, 25, 26, 27, 14]);
         assert_eq!(lower, vec![10, 11, 12, 13, 14]);
+    }
+
+    #[test]
+    fn a_dead_end_lip_walk_becomes_the_shortest_path() {
+        // The start's neighbours both lie behind it (as where a lip of a mixed quad/triangle
+        // mesh curls into the mouth), so the xy angle rule has nowhere to go.
+        let pos = vec![
+            Vec3::ZERO,
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::new(1.0, 3.0, 0.0),
+            Vec3::new(4.0, 0.0, 0.0),
+            Vec3::new(-1.0, -1.0, 0.0),
+        ];
+        let tris = vec![[0, 1, 4], [1, 3, 2]];
+        let adj = adjacency(pos.len(), &tris);
+        let vt = VertexTriangles::new(pos.len(), &tris);
+        let mesh = (&vt, tris.as_slice());
+        assert!(lip_walk(&pos, &adj, mesh, 0, 3, true).is_err());
+        assert_eq!(
+            lip_contour(&pos, &adj, mesh, (0, None, 3), true).unwrap(),
+            vec![0, 1, 3]
+        );
+        // An end that cannot be reached at all is an error, never a panic.
+        let lone = adjacency(pos.len(), &tris[..1]);
+        assert!(lip_contour(&pos, &lone, mesh, (0, None, 3), true).is_err());
     }
 
     #[test]

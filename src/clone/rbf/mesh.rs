@@ -63,6 +63,16 @@ impl VertexTriangles {
         VertexTriangles { start, tris }
     }
 
+    /// The triangles having vertex `v`.
+    pub fn around(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        let range = self
+            .start
+            .get(v as usize)
+            .zip(self.start.get(v as usize + 1))
+            .map_or(0..0, |(&a, &b)| a as usize..b as usize);
+        self.tris[range].iter().copied()
+    }
+
     /// Third vertices of the triangles that have edge `a–b`.
     pub fn opposites<'a>(
         &'a self,
@@ -80,6 +90,17 @@ impl VertexTriangles {
             }
         })
     }
+}
+
+/// Unit normals of the triangles (zero for degenerate ones).
+pub(crate) fn triangle_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect()
 }
 
 /// Barycentric coordinates `(wa, wb, wc)` of `p` with respect to triangle `a b c`, for a
@@ -240,6 +261,7 @@ impl RegionBvh {
     }
 
     /// The nearest surface point along `±dir` from `origin` within `length`.
+    #[cfg(test)]
     pub fn ray_both_ways(
         &self,
         region: Region,
@@ -247,16 +269,75 @@ impl RegionBvh {
         dir: Vec3,
         length: f32,
     ) -> Option<Hit> {
-        let view = self.view(region)?;
+        self.ray_both_ways_where(region, origin, dir, length, |_| true)
+    }
+
+    /// Like [`RegionBvh::ray_both_ways`], but only hits on triangles that `accept` are
+    /// taken: a ray that meets a rejected triangle goes on through it (at most a few times).
+    pub fn ray_both_ways_where(
+        &self,
+        region: Region,
+        origin: Vec3,
+        dir: Vec3,
+        length: f32,
+        accept: impl Fn(u32) -> bool,
+    ) -> Option<Hit> {
         if dir == Vec3::ZERO || !origin.is_finite() || !dir.is_finite() {
             return None;
         }
+        if let Some(h) = self.cast_both_ways(region, origin, dir, length, &accept) {
+            return Some(h);
+        }
+        // A ray exactly through a vertex or along an edge can slip between its triangles;
+        // which of two mirror-image rays slips is a rounding accident, so retry from four
+        // origins a hair to the sides (the hit moves by as little).
+        let (t1, t2) = dir.normalize_or_zero().any_orthonormal_pair();
+        let hair = length.max(f32::MIN_POSITIVE) * 1e-4;
+        [t1, -t1, t2, -t2]
+            .into_iter()
+            .filter_map(|t| {
+                let h = self.cast_both_ways(region, origin + t * hair, dir, length, &accept)?;
+                Some((h.point.distance(origin), h))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, h)| Hit {
+                point: h.point,
+                ..h
+            })
+    }
+
+    fn cast_both_ways(
+        &self,
+        region: Region,
+        origin: Vec3,
+        dir: Vec3,
+        length: f32,
+        accept: &impl Fn(u32) -> bool,
+    ) -> Option<Hit> {
+        let view = self.view(region)?;
+        // Past a rejected hit by a hair, so the same triangle is not met again.
+        let nudge = length.max(f32::MIN_POSITIVE) * 1e-5;
         let mut best: Option<(f32, u32, Vec3)> = None;
         for d in [dir, -dir] {
-            let ray = Ray::new(pvec(origin), pvec(d));
-            if let Some((tri, t)) = CompositeShapeRef(&view).cast_local_ray(&ray, length, false) {
-                if best.is_none_or(|(bt, _, _)| t < bt) {
-                    best = Some((t, tri, d));
+            let mut from = 0.0f32;
+            for _ in 0..8 {
+                let ray = Ray::new(pvec(origin + d * from), pvec(d));
+                let Some((tri, t)) =
+                    CompositeShapeRef(&view).cast_local_ray(&ray, length - from, false)
+                else {
+                    break;
+                };
+                let at = from + t;
+                // A hit at the origin is the ray's own surface, whichever way it faces.
+                if at <= nudge || accept(tri) {
+                    if best.is_none_or(|(bt, _, _)| at < bt) {
+                        best = Some((at, tri, d));
+                    }
+                    break;
+                }
+                from = at + nudge;
+                if from >= length {
+                    break;
                 }
             }
         }

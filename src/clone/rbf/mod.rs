@@ -7,52 +7,75 @@
 //!
 //! 1. **`contours`** — eye and inner-lip contours on both faces by the paper's greedy walks
 //!    from the feature points (`contours.rs`): eyes round robin 3.2⇒3.8⇒3.4⇒3.12⇒3.2 and
-//!    3.1⇒3.7⇒3.3⇒3.11⇒3.1, step to the neighbour pointing best towards the goal (the paper's
-//!    unit step `‖v + n̂ − end‖` depends on the model's unit; we use its scale-free limit, the
-//!    largest cosine); lips from 2.5 to 2.4 by the xy-plane angle rule, smallest angle for the
-//!    upper lip, greatest for the lower. Taken literally that rule picks the lower lip at the
-//!    corner and cannot tell coincident vertices of a closed mouth apart, so candidate edges
-//!    are ranked first by which side their triangles lie on (edges bordering the mouth on the
-//!    lip's own side win) and only then by angle. Walks never revisit a vertex and are capped
-//!    at the vertex count; a failed walk drops that contour with a warning. The lip contours
-//!    also yield upper/lower **lip regions** (`regions.rs`) for step 4.
+//!    its mirror image 3.1⇒3.11⇒3.3⇒3.7⇒3.1 (top, inner corner, bottom, outer corner: the
+//!    paper's 3.1⇒3.7 order walks the left eye the other way round, and a greedy walk
+//!    depends on its direction), step to the neighbour pointing best towards the goal (the
+//!    paper's unit step `‖v + n̂ − end‖` depends on the model's unit; we use its scale-free
+//!    limit, the largest cosine); lips from 2.5 to 2.4 by the xy-plane angle rule, smallest
+//!    angle for the upper lip, greatest for the lower, walked from each corner to the lip's
+//!    midpoint (2.2, 2.3) when it is a surface vertex, so both halves are walked alike.
+//!    Taken literally that rule picks the lower lip at the corner and cannot tell coincident
+//!    vertices of a closed mouth apart, so candidate edges are ranked first by which side
+//!    their triangles lie on (edges bordering the mouth on the lip's own side win) and only
+//!    then by angle. Walks never revisit a vertex and are capped at the vertex count. A
+//!    greedy walk that runs into a dead end (on meshes of mixed quads and triangles, where a
+//!    lip curls into the mouth and no neighbour lies ahead in xy) is replaced by the shortest
+//!    edge path between the same points (through unused vertices for the eyes); a contour
+//!    that cannot be joined at all is dropped with a warning. The lip contours also yield
+//!    upper/lower **lip regions** (`regions.rs`) for step 4.
 //! 2. **`fit`** — correspondences: every feature point that is a surface vertex of both faces
 //!    except groups 10 (ears) and 6 (tongue), 9.8–9.11 (teeth) and 11.5 (top of the head). A
 //!    first `f` is fitted to them; then each source contour vertex is paired with the nearest
 //!    point on the corresponding target contour (its edges, nearest to the vertex as placed
 //!    by that first `f`) and `f` is refitted. `f(p) = p + Σ w_i·sqrt(‖p − p_i‖² + r_i²) +
 //!    affine`, with `r_i` the distance from centre `i` to its nearest other centre (`interp.rs`);
-//!    the `(n+4)²` system is solved by nalgebra LU with partial pivoting for the three
+//!    the `(n+4)²` system is solved by faer's dense LU with partial pivoting for the three
 //!    coordinates at once. Coincident source centres (closed mouth: 2.2≡2.3, 81≡83) are merged
 //!    into one centre: feature points and contour points at one source position get the
 //!    *mean* of their targets (with a warning when the targets disagree, e.g. closed source
 //!    mouth → open target mouth, which a volume morph cannot separate); a feature point wins
 //!    over a contour point at the same position. Fewer than four distinct correspondences,
 //!    coplanar ones, a singular system or a non-finite solution are errors.
-//! 3. **`refine`** — movable vertices are the source vertices any motion moves. Each round
+//! 3. **`refine`** (off by default: `max_iterations` is 0, see below) — movable vertices are
+//!    the source vertices any motion moves. Each round
 //!    applies `f` to the source, computes area-weighted vertex normals of the deformed source,
 //!    casts a ray from each movable vertex both ways along its normal, length
 //!    `ray_length_factor × ENS0` (default 0.3125, the paper's figure). ENS0 is the **target's**:
 //!    the rays run in the target's space, where the deformed source lives. Rays use a parry3d
 //!    BVH of the target built once (per lip region, see step 4: an upper-lip source vertex
-//!    never takes a lower-lip target point). The `worst_per_round` (125) hits with the largest
-//!    `e_i = ‖u_i − f(p_i)‖` above `min_error_factor × ENS0` are inserted (or, if the source
+//!    never takes a lower-lip target point). A hit counts only on a target triangle facing
+//!    the same side as the ray's vertex normal (normals under 90° apart) (the nearest surface along a normal is otherwise
+//!    often another layer: a lip's inside, the mouth, an eyelid's other side). The
+//!    `worst_per_round` (125) hits with the largest
+//!    `e_i = ‖u_i − f(p_i)‖` above `min_error_factor × ENS0` are inserted — in mirror
+//!    pairs: a movable vertex whose mirror image across the source's plane `x = mean x` is
+//!    also a movable vertex brings it along, so a symmetric face keeps a symmetric fit where
+//!    a cut of the ranking would split pairs whose errors differ by rounding — (or, if the source
 //!    vertex — or one coincident with it — is already a refinement or contour centre, its
 //!    target is updated; feature-point centres are never overridden) and `f` is refitted. The
 //!    loop ends when a round inserts nothing new, after `max_iterations` rounds, or if a
 //!    refit fails (the last good `f` is kept, with a warning).
-//! 4. **`map`** — each target vertex casts a ray both ways along its normal (same length)
-//!    onto the deformed neutral source; if both miss (rays through vertices or edges can slip
-//!    between triangles in a BVH, or the surfaces are farther apart than the ray), the
-//!    closest point on the deformed source is used instead (`ray_misses_fallback` counts
-//!    these). The hit gets barycentric coordinates in its source triangle. **Lip separation**:
+//! 4. **`map`** — a target feature-point vertex whose point is a source vertex too is bound
+//!    to that vertex (weight 1): the same anatomical point, whatever rays find near it. Every
+//!    other target vertex casts a ray both ways along its normal (same length) onto the
+//!    deformed neutral source, taking the nearest hit on a source triangle that faces the same
+//!    side as the target normal (rays go on through other layers). If both miss (rays through
+//!    vertices or edges can slip between triangles in a BVH), the closest point on the
+//!    deformed source is used instead when it lies within the ray length
+//!    (`ray_misses_fallback` counts these); farther away the source has no surface there (a
+//!    face mask cloned onto a whole head) and the vertex gets no motion
+//!    (`unbound_vertices`). The hit gets barycentric coordinates in its source triangle. **Lip separation**:
 //!    a target vertex in the upper-lip region only sees source triangles that have no
 //!    lower-lip vertex, and vice versa (regions from the inner-lip contours; see `regions.rs`).
 //! 5. **`deform`** — per source motion (in parallel with rayon): for each moved vertex `p`
-//!    with offset `d`, `g(p) = f(p + d) − f(p)` (computed without cancelling `p`); each target
+//!    with offset `d` that some target vertex is bound to, `g(p) = f(p + d) − f(p)` (computed
+//!    without cancelling `p`, `f(p) − p` once per vertex for all motions); each target
 //!    vertex bound to a triangle that has a moved vertex gets `Σ b_k g(p_k)`, i.e. the paper's
 //!    barycentric position in the deformed displaced triangle minus its neutral position.
-//!    Offsets shorter than `min_offset_factor × ENS0` (target) are dropped.
+//!    A target feature-point vertex bound in step 4 moves in the direction of its source
+//!    point's displacement `d` (with the length of `g`): a FAP moves its feature point in the
+//!    same direction on every face, and the Jacobian of `f` would turn it (on alma → bruno
+//!    by up to 7 % of the motion). Offsets shorter than `min_offset_factor × ENS0` (target) are dropped.
 //!
 //! Target vertices that belong to no triangle (Candide-3 has four unused duplicates of
 //! midline vertices) are not part of the surface and get no motion.
@@ -70,9 +93,13 @@
 //! 12.5 % with no round, 20.6 % after 6). Self-cloning is exact (formula (1): 4e-9 %).
 //! Rigid parts (eyes, teeth, tongue, head) are out of scope, as in the rest of [`super`].
 //!
-//! `max_iterations` defaults to 6 (the paper reports 3–9 rounds): each round adds up to 125
-//! centres and the dense LU costs O(n³), so a dense source (thousands of movable vertices)
-//! would otherwise grow the system far beyond the paper's few hundred centres.
+//! `max_iterations` defaults to 0 (the paper reports 3–9 rounds). On a real head the
+//! refinement's correspondences are normal projections, not anatomical correspondences: each
+//! pulls `f` along the surface, and hundreds of close centres with small radii wrinkle its
+//! Jacobian, which carries the motions. ICT head → smoothly reshaped ICT head against its
+//! true FAT (per-FAP median / worst): 5.6 % / 14 % with no round, about 40 % / 100 % after 6
+//! (normal-facing hits; 78 % / 175 % before), and every round adds up to 125 centres to a
+//! dense O(n³) solve.
 
 mod contours;
 mod interp;
@@ -84,16 +111,19 @@ mod tests;
 use std::collections::{BTreeMap, HashMap};
 use std::time::Instant;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::{Error, Result};
 use crate::mesh::geometry::vertex_normals;
+use crate::mesh::spatial::VertexIndex;
 use crate::spec::FeaturePointId;
 
 use interp::Multiquadric;
-use mesh::{adjacency, barycentric, coincidence_classes, RegionBvh, VertexTriangles};
+use mesh::{
+    adjacency, barycentric, coincidence_classes, triangle_normals, RegionBvh, VertexTriangles,
+};
 use regions::{Region, TriRegion};
 
 /// Settings of [`clone_rbf`].
@@ -104,7 +134,8 @@ pub struct RbfOptions {
     /// Correspondences added per refinement round: the worst-fitting movable vertices
     /// (paper: 125).
     pub worst_per_round: usize,
-    /// Cap on refinement rounds.
+    /// Cap on refinement rounds (default 0: refinement raises the error against FAP ground
+    /// truth, see the module docs).
     pub max_iterations: usize,
     /// Fit errors below this many target ENS0 are not worth a new correspondence.
     pub min_error_factor: f64,
@@ -121,7 +152,7 @@ impl Default for RbfOptions {
         RbfOptions {
             ray_length_factor: 0.3125,
             worst_per_round: 125,
-            max_iterations: 6,
+            max_iterations: 0,
             min_error_factor: 1e-4,
             min_offset_factor: 1e-6,
             contours: true,
@@ -129,6 +160,12 @@ impl Default for RbfOptions {
         }
     }
 }
+
+/// A ray hit counts only on a surface facing the same side as the ray's own surface (normals
+/// less than 90° apart): the nearest hit along a normal is otherwise often another layer —
+/// the inside of a lip, the mouth or an eyelid's other side — whose pull folds the volume
+/// morph. (A tighter cone rejects a vertex's own triangles at sharp creases.)
+const MIN_NORMAL_COSINE: f32 = 0.0;
 
 /// Feature points the paper leaves out of the correspondences: ears (10), tongue (6), teeth
 /// (9.8–9.11) and the top of the head (11.5).
@@ -234,6 +271,57 @@ fn check_surface(s: &CloneSurface, name: &str) -> Result<()> {
     Ok(())
 }
 
+/// The mirror image of each movable vertex across the plane `x = mean x` of the source, when
+/// a vertex lies there (within `tol`): on a mirror-symmetric source every movable vertex
+/// has one. Used to pick refinement centres in mirror pairs.
+fn mirror_partners(positions: &[Vec3], movable: &[u32], tol: f32) -> HashMap<u32, u32> {
+    if positions.is_empty() {
+        return HashMap::new();
+    }
+    let cx = positions.iter().map(|p| f64::from(p.x)).sum::<f64>() / positions.len() as f64;
+    let index = VertexIndex::new(positions);
+    movable
+        .par_iter()
+        .filter_map(|&v| {
+            let p = positions[v as usize];
+            let m = Vec3::new((2.0 * cx - f64::from(p.x)) as f32, p.y, p.z);
+            let (w, d) = index.nearest_vertex(m)?;
+            (d <= tol && w != v).then_some((v, w))
+        })
+        .collect()
+}
+
+/// The `count` worst hits (`hits` sorted worst first), taken in mirror pairs: a vertex's
+/// mirror partner, if it has a hit, comes in with it (so a symmetric face gets symmetric
+/// centres; cutting the ranking at `count` would otherwise split pairs whose errors differ
+/// by rounding). The result may exceed `count` by one to complete the last pair.
+fn worst_in_mirror_pairs(
+    hits: &[(u32, Vec3, f32)],
+    mirror: &HashMap<u32, u32>,
+    count: usize,
+) -> Vec<(u32, Vec3, f32)> {
+    let at: HashMap<u32, usize> = hits.iter().enumerate().map(|(i, h)| (h.0, i)).collect();
+    let mut taken = vec![false; hits.len()];
+    let mut out = Vec::with_capacity(count + 1);
+    for i in 0..hits.len() {
+        if out.len() >= count {
+            break;
+        }
+        if taken[i] {
+            continue;
+        }
+        taken[i] = true;
+        out.push(hits[i]);
+        if let Some(&j) = mirror.get(&hits[i].0).and_then(|w| at.get(w)) {
+            if !taken[j] {
+                taken[j] = true;
+                out.push(hits[j]);
+            }
+        }
+    }
+    out
+}
+
 fn lip_regions(
     surface: &CloneSurface,
     adj: &[Vec<u32>],
@@ -255,7 +343,7 @@ fn lip_regions(
 /// motion, same key and value, with offsets on target vertices. See the module doc for the
 /// steps; `timings` names them `contours`, `fit`, `refine`, `map`, `deform`, and `stats` holds
 /// `iterations`, `correspondences`, `contour_correspondences`, `movable_vertices`,
-/// `ray_misses_fallback`, `rbf_condition` (LU pivot ratio of the final system) and
+/// `ray_misses_fallback`, `unbound_vertices`, `rbf_condition` (LU pivot ratio of the final system) and
 /// `fit_max_error` (largest remaining refinement ray error, in target ENS0).
 pub fn clone_rbf(
     source: &CloneSurface,
@@ -404,7 +492,9 @@ pub fn clone_rbf(
     movable.sort_unstable();
     movable.dedup();
     let target_bvh = RegionBvh::new(&target.positions, &target.triangles, &t_tri_regions);
+    let t_tri_normals = triangle_normals(&target.positions, &target.triangles);
     let tol = opts.min_error_factor as f32 * ens_t;
+    let mirror = mirror_partners(&source.positions, &movable, eps.max(1e-5 * ens_t));
     let mut iterations = 0usize;
     let mut max_error: f32;
     loop {
@@ -414,11 +504,13 @@ pub fn clone_rbf(
             .par_iter()
             .filter_map(|&v| {
                 let p = deformed[v as usize];
-                let h = target_bvh.ray_both_ways(
+                let n = normals[v as usize];
+                let h = target_bvh.ray_both_ways_where(
                     s_regions[v as usize],
                     p,
-                    normals[v as usize],
+                    n,
                     ray_len,
+                    |tri| t_tri_normals[tri as usize].dot(n) >= MIN_NORMAL_COSINE,
                 )?;
                 Some((v, h.point, h.point.distance(p)))
             })
@@ -429,7 +521,7 @@ pub fn clone_rbf(
             break;
         }
         hits.sort_by(|a, b| b.2.total_cmp(&a.2).then(a.0.cmp(&b.0)));
-        hits.truncate(opts.worst_per_round.max(1));
+        let hits = worst_in_mirror_pairs(&hits, &mirror, opts.worst_per_round.max(1));
         let mut inserted = 0;
         for &(v, u, _) in &hits {
             if set.refine(class[v as usize], source.positions[v as usize], u) {
@@ -458,6 +550,7 @@ pub fn clone_rbf(
     // 4. Bind target vertices to deformed source triangles.
     let clock = Instant::now();
     let source_bvh = RegionBvh::new(&deformed, &source.triangles, &s_tri_regions);
+    let s_tri_normals = triangle_normals(&deformed, &source.triangles);
     let t_normals = vertex_normals(&target.positions, &target.triangles);
     // Vertices outside every triangle are not part of the surface (Candide-3 has four such
     // unused duplicates of midline vertices); they get no motion.
@@ -467,18 +560,48 @@ pub fn clone_rbf(
             in_surface[v as usize] = true;
         }
     }
+    // A target feature-point vertex takes its source feature point's motion: the same
+    // anatomical point, whatever the rays find around it (an eyelid's ray can slip to the
+    // other lid of a narrow eye).
+    let mut fp_binding: HashMap<u32, (u32, [f32; 3])> = HashMap::new();
+    // Target feature-point vertex → its source feature-point vertex.
+    let mut fp_source: HashMap<u32, u32> = HashMap::new();
+    let incident = VertexTriangles::new(source.positions.len(), &source.triangles);
+    for (id, &tv) in &target.fp_vertices {
+        let Some(&sv) = source.fp_vertices.get(id) else {
+            continue;
+        };
+        if let Some(tri) = incident.around(sv).next() {
+            let t = source.triangles[tri as usize];
+            fp_binding.insert(tv, (tri, t.map(|v| if v == sv { 1.0 } else { 0.0 })));
+            fp_source.insert(tv, sv);
+        }
+    }
     let binding: Vec<Option<(u32, [f32; 3], bool)>> = (0..target.positions.len())
         .into_par_iter()
         .map(|q| {
             if !in_surface[q] {
                 return None;
             }
+            if let Some(&(tri, w)) = fp_binding.get(&(q as u32)) {
+                return Some((tri, w, false));
+            }
             let p = target.positions[q];
             let region = t_regions[q];
-            let (hit, fallback) = match source_bvh.ray_both_ways(region, p, t_normals[q], ray_len) {
-                Some(h) => (h, false),
-                None => (source_bvh.closest(region, p)?, true),
-            };
+            let n = t_normals[q];
+            let facing = |tri: u32| s_tri_normals[tri as usize].dot(n) >= MIN_NORMAL_COSINE;
+            let (hit, fallback) =
+                match source_bvh.ray_both_ways_where(region, p, n, ray_len, facing) {
+                    Some(h) => (h, false),
+                    // Beyond the rays' reach the source has no surface here (a face mask on a
+                    // whole head): no motion rather than the motion of its nearest border.
+                    None => (
+                        source_bvh
+                            .closest(region, p)
+                            .filter(|h| h.point.distance(p) <= ray_len)?,
+                        true,
+                    ),
+                };
             let t = source.triangles[hit.triangle as usize].map(|i| deformed[i as usize]);
             Some((
                 hit.triangle,
@@ -488,6 +611,9 @@ pub fn clone_rbf(
         })
         .collect();
     let fallbacks = binding.iter().flatten().filter(|b| b.2).count();
+    let unbound = (0..binding.len())
+        .filter(|&q| in_surface[q] && binding[q].is_none())
+        .count();
     let mut bound_to: Vec<Vec<u32>> = vec![Vec::new(); source.positions.len()];
     for (q, b) in binding.iter().enumerate() {
         if let Some((tri, _, _)) = b {
@@ -501,14 +627,31 @@ pub fn clone_rbf(
     // 5. Deform every morph target through f and carry it over.
     let clock = Instant::now();
     let min_offset = opts.min_offset_factor as f32 * ens_t;
+    // f(p) − p once per movable vertex that some target vertex is bound to; motions on
+    // vertices no target vertex sees are not carried at all.
+    let disp: HashMap<u32, DVec3> = movable
+        .par_iter()
+        .filter(|&&v| !bound_to[v as usize].is_empty())
+        .map(|&v| (v, f.displacement(source.positions[v as usize].as_dvec3())))
+        .collect();
+    let fp_source_vertices: std::collections::HashSet<u32> = fp_source.values().copied().collect();
     let out: Vec<SurfaceMotion> = motions
         .par_iter()
         .map(|m| {
             let moved: HashMap<u32, Vec3> = m
                 .offsets
-                .iter()
+                .par_iter()
                 .filter(|o| o.1 != Vec3::ZERO)
-                .map(|&(v, d)| (v, f.moved(source.positions[v as usize], d)))
+                .filter_map(|&(v, d)| {
+                    let p = source.positions[v as usize].as_dvec3();
+                    Some((v, f.moved_from(p, *disp.get(&v)?, d)))
+                })
+                .collect();
+            let raw: HashMap<u32, Vec3> = m
+                .offsets
+                .iter()
+                .filter(|o| fp_source_vertices.contains(&o.0))
+                .copied()
                 .collect();
             let mut qs: Vec<u32> = moved
                 .keys()
@@ -519,6 +662,15 @@ pub fn clone_rbf(
             let offsets = qs
                 .into_iter()
                 .filter_map(|q| {
+                    // A feature point moves the way its FAP says on every face: in its source
+                    // displacement's direction, not turned by the Jacobian of `f` (whose
+                    // stretch still sets the length).
+                    if let Some(&sv) = fp_source.get(&q) {
+                        let d = raw.get(&sv).copied().unwrap_or(Vec3::ZERO);
+                        let len = moved.get(&sv).map_or(0.0, |g| g.length());
+                        let o = d.normalize_or_zero() * len;
+                        return (o.length() > min_offset).then_some((q, o));
+                    }
                     let (tri, w, _) = binding[q as usize]?;
                     let t = source.triangles[tri as usize];
                     let o = (0..3)
@@ -550,6 +702,7 @@ pub fn clone_rbf(
     stats.insert("contour_correspondences".into(), contour_pairs as f64);
     stats.insert("movable_vertices".into(), movable.len() as f64);
     stats.insert("ray_misses_fallback".into(), fallbacks as f64);
+    stats.insert("unbound_vertices".into(), unbound as f64);
     stats.insert("rbf_condition".into(), f.pivot_ratio);
     stats.insert("rbf_centres".into(), f.len() as f64);
     stats.insert("fit_max_error".into(), (max_error / ens_t) as f64);

@@ -155,6 +155,10 @@ fn subdivided_target_error_is_bounded() {
     };
     let r = run(&src, &tgt);
     let mean = per_fap_report("reshaped+subdivided", &tgt, &r);
+    // Map rays that miss both ways fall back to the closest point: rare on a face.
+    let fallback = r.stats["ray_misses_fallback"] / tgt.surface.positions.len() as f64;
+    eprintln!("map-ray fallbacks {:.2} %", fallback * 100.0);
+    assert!(fallback < 0.05, "fallbacks {fallback}");
     // Measured 13.4 %: no FAPU normalisation, see the module doc.
     assert!(mean < 16.0, "mean displacement error {mean} %");
 }
@@ -213,4 +217,135 @@ fn degenerate_feature_points_are_errors_not_nans() {
     let mut bad = face.surface.clone();
     bad.triangles.push([0, 1, 100_000]);
     assert!(clone_rbf(&face.surface, &face.motions, &bad, &opts).is_err());
+}
+
+/// Each surface vertex's mirror image across `x = mean x` (the nearest surface vertex to
+/// it), or `None` when some vertex has no image within `tol`. Vertices in no triangle
+/// (Candide-3's unused duplicates) map to themselves.
+fn mirror_map(surface: &CloneSurface, tol: f32) -> Option<Vec<u32>> {
+    let mut used = vec![false; surface.positions.len()];
+    for &v in surface.triangles.iter().flatten() {
+        used[v as usize] = true;
+    }
+    let pos: Vec<Vec3> = (0..used.len())
+        .map(|v| {
+            if used[v] {
+                surface.positions[v]
+            } else {
+                Vec3::NAN
+            }
+        })
+        .collect();
+    let (sum, n) = pos
+        .iter()
+        .filter(|p| p.is_finite())
+        .fold((0.0, 0), |(s, n), p| (s + f64::from(p.x), n + 1));
+    let cx = (sum / f64::from(n)) as f32;
+    let index = VertexIndex::new(&pos);
+    let adj = adjacency(pos.len(), &surface.triangles);
+    let ring =
+        |v: usize| adj[v].iter().map(|&n| pos[n as usize]).sum::<Vec3>() / adj[v].len() as f32;
+    let flip = |p: Vec3| Vec3::new(2.0 * cx - p.x, p.y, p.z);
+    (0..pos.len())
+        .map(|v| {
+            if !used[v] {
+                return Some(v as u32);
+            }
+            // Coincident vertices (a closed mouth's lips) are told apart by their
+            // neighbours.
+            let mirrored_ring = flip(ring(v));
+            index
+                .within(flip(pos[v]), tol)
+                .into_iter()
+                .min_by(|a, b| {
+                    let da = ring(a.0 as usize).distance(mirrored_ring);
+                    let db = ring(b.0 as usize).distance(mirrored_ring);
+                    da.total_cmp(&db)
+                })
+                .map(|c| c.0)
+        })
+        .collect()
+}
+
+fn mirrored(m: &SurfaceMotion, map: &[u32]) -> SurfaceMotion {
+    let mut offsets: Vec<(u32, Vec3)> = m
+        .offsets
+        .iter()
+        .map(|&(v, d)| (map[v as usize], Vec3::new(-d.x, d.y, d.z)))
+        .collect();
+    offsets.sort_by_key(|o| o.0);
+    SurfaceMotion {
+        offsets,
+        ..m.clone()
+    }
+}
+
+#[test]
+#[ignore = "open: on Candide-3 (symmetric part) one eye-corner vertex pair still binds to \
+            different source triangles (59 % of the eyelid motion); run with --ignored"]
+fn mirror_symmetric_faces_get_mirror_symmetric_motions() {
+    let (Some(src), Some(tgt)) = (candide(&[], 0, VALUE), candide(&RESHAPE, 1, VALUE)) else {
+        return;
+    };
+    let tol = 1e-4 * src.surface.fapu.distances.ens0 as f32;
+    let (Some(ms), Some(mt)) = (mirror_map(&src.surface, tol), mirror_map(&tgt.surface, tol))
+    else {
+        panic!("Candide-3 is mirror-symmetric");
+    };
+    // Every motion and its mirror image, cloned together (one symmetric set of movable
+    // vertices): the clone of the mirror image must be the mirror image of the clone.
+    // Candide-3's triangulation is not mirror-symmetric everywhere (some quads around the
+    // eyes and lips are split the same way on both sides): keep the triangles whose mirror
+    // image is a triangle too, so the input is exactly symmetric.
+    let symmetric = |face: &CandideFace, map: &[u32]| {
+        let key = |t: [u32; 3]| {
+            let mut k = t;
+            k.sort_unstable();
+            k
+        };
+        let all: std::collections::HashSet<[u32; 3]> =
+            face.surface.triangles.iter().map(|&t| key(t)).collect();
+        let mut s = face.surface.clone();
+        s.triangles
+            .retain(|t| all.contains(&key(t.map(|v| map[v as usize]))));
+        s
+    };
+    let (ss, ts) = (symmetric(&src, &ms), symmetric(&tgt, &mt));
+    let n = src.motions.len();
+    let mut motions = src.motions.clone();
+    motions.extend(src.motions.iter().map(|m| mirrored(m, &ms)));
+    let r = clone_rbf(&ss, &motions, &ts, &RbfOptions::default()).unwrap();
+    let mut worst: f32 = 0.0;
+    for i in 0..n {
+        let a = mirrored(&r.motions[i], &mt);
+        let b = &r.motions[n + i];
+        let at = |m: &SurfaceMotion, v: u32| {
+            m.offsets
+                .binary_search_by_key(&v, |o| o.0)
+                .map_or(Vec3::ZERO, |k| m.offsets[k].1)
+        };
+        let peak = a.offsets.iter().map(|o| o.1.length()).fold(0.0, f32::max);
+        let (gv, gap) = (0..tgt.surface.positions.len() as u32)
+            .map(|v| (v, at(&a, v).distance(at(b, v))))
+            .fold((0, 0.0f32), |acc, x| if x.1 > acc.1 { x } else { acc });
+        if peak > 0.0 {
+            if gap / peak > 0.01 {
+                eprintln!(
+                    "{:?} vertex {gv} at {}: {} vs {} (peak {peak})",
+                    src.motions[i].key,
+                    tgt.surface.positions[gv as usize],
+                    at(&a, gv),
+                    at(b, gv)
+                );
+            }
+            worst = worst.max(gap / peak);
+        }
+    }
+    eprintln!(
+        "mirror asymmetry: worst {:.4} % of the motion; stats {:?} {:?}",
+        worst * 100.0,
+        r.stats,
+        r.warnings
+    );
+    assert!(worst <= 0.01, "asymmetry {worst}");
 }
