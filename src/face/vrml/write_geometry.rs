@@ -4,6 +4,7 @@
 use glam::{Quat, Vec3};
 
 use super::write::{add, set_field};
+use super::write_insert::insert_transforms;
 use crate::error::{Error, Result};
 use crate::face::{FaceMesh, FaceModel, FaceTransform};
 use crate::mesh::{Mesh, Polygons, SurfaceFlags};
@@ -97,12 +98,31 @@ fn add_shape(scene: &mut Scene, m: &FaceMesh) -> (NodeRef, NodeId) {
 }
 
 /// Writes the face's transforms and meshes into the nodes of the same DEF names in its own
-/// scene; a transform or mesh the scene lacks is an error.
+/// scene. A transform the scene lacks is added where its content sits (see
+/// [`insert_transforms`]); a mesh the scene lacks is an error.
 pub(super) fn patch_geometry(scene: &mut Scene, face: &FaceModel) -> Result<GeometryNodes> {
     let mut mesh_nodes: Vec<NodeId> = Vec::with_capacity(face.meshes.len());
+    for m in &face.meshes {
+        let id = find_def_of_type(scene, &m.name, "IndexedFaceSet").ok_or_else(|| {
+            Error::Invalid(format!(
+                "mesh `{}` is not in the face's scene; clear `scene` to write a new one",
+                m.name
+            ))
+        })?;
+        mesh_nodes.push(id);
+    }
+    let mut found: Vec<Option<NodeId>> = face
+        .transforms
+        .iter()
+        .map(|t| find_def_of_type(scene, &t.name, "Transform"))
+        .collect();
+    if found.iter().any(Option::is_none) {
+        insert_transforms(scene, face, &mut found, &mesh_nodes);
+    }
     let mut transform_nodes: Vec<NodeId> = Vec::with_capacity(face.transforms.len());
-    for t in &face.transforms {
-        let id = find_def_of_type(scene, &t.name, "Transform").ok_or_else(|| {
+    for (t, id) in face.transforms.iter().zip(found) {
+        // `insert_transforms` fills every gap; kept as an error rather than a panic.
+        let id = id.ok_or_else(|| {
             Error::Invalid(format!(
                 "transform `{}` is not in the face's scene; clear `scene` to write a new one",
                 t.name
@@ -111,15 +131,8 @@ pub(super) fn patch_geometry(scene: &mut Scene, face: &FaceModel) -> Result<Geom
         write_transform_fields(&mut scene.nodes[id.0], t);
         transform_nodes.push(id);
     }
-    for m in &face.meshes {
-        let id = find_def_of_type(scene, &m.name, "IndexedFaceSet").ok_or_else(|| {
-            Error::Invalid(format!(
-                "mesh `{}` is not in the face's scene; clear `scene` to write a new one",
-                m.name
-            ))
-        })?;
+    for (m, &id) in face.meshes.iter().zip(&mesh_nodes) {
         write_mesh_fields(scene, id, &m.mesh);
-        mesh_nodes.push(id);
     }
     Ok(GeometryNodes {
         meshes: mesh_nodes,
