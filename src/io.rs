@@ -209,6 +209,19 @@ impl AtomicDir {
         &self.path
     }
 
+    /// Writes the file `name` in the folder with `write` (given its temporary path); an error
+    /// names the file at its final place, never the temporary folder.
+    pub fn write_file(&self, name: &str, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+        write(&self.tmp.path().join(name)).map_err(|e| {
+            let path = self.path.join(name);
+            match e {
+                Error::Output { source, .. } => Error::output(path, source),
+                Error::Io { source, .. } => Error::output(path, source),
+                other => other,
+            }
+        })
+    }
+
     /// Renames the directory into place. An existing directory at the final path is first
     /// moved aside and removed only after the rename succeeded.
     pub fn commit(self) -> Result<()> {
