@@ -624,6 +624,33 @@ fn oversized_inputs_are_refused_without_reading_them() {
         assert_peak(name, &o);
         std::fs::remove_file(&p).unwrap();
     }
+    // 1e9 NUL bytes, under the size limit: text readers stop at the first one (this read
+    // 1 GB into 2 GB of memory in 28 s).
+    for (name, cmd) in [
+        ("zeros.wrl", &["face", "info"][..]),
+        ("zeros.obj", &["face", "info"][..]),
+        ("zeros.fap", &["fap", "info"][..]),
+        ("zeros.csv", &["fapu"][..]),
+    ] {
+        let p = lab.path(name);
+        std::fs::File::create(&p)
+            .unwrap()
+            .set_len(1_000_000_000)
+            .unwrap();
+        let mut args: Vec<&dyn AsRef<std::ffi::OsStr>> = cmd.iter().map(|c| c as _).collect();
+        args.push(&p);
+        let o = case_measured(
+            &format!("NULs {name}"),
+            &args,
+            Expect::BadInput,
+            name,
+            None,
+            true,
+        );
+        assert!(o.stderr.contains("NUL"), "{name}: {}", o.stderr);
+        assert_peak(name, &o);
+        std::fs::remove_file(&p).unwrap();
+    }
 }
 
 #[test]
@@ -861,6 +888,21 @@ fn a_tiny_stream_with_a_huge_span_is_refused_at_once() {
             o.stderr
         );
     }
+    // A million frames (the frame limit) of glTF: refused up front by the clip's memory
+    // estimate (it peaked at 3.0 GB).
+    let p_m = lab.file("million.fap", &two_frames("999999", "0", "25"));
+    let out = lab.out("million");
+    let glb = out.join("x.glb");
+    let o = case_measured(
+        "a million frames to glb",
+        &[&"play", &"alma", &p_m, &"-o", &glb],
+        Expect::BadInput,
+        "--frames",
+        Some(&out),
+        true,
+    );
+    assert!(o.stderr.contains("memory"), "{}", o.stderr);
+    assert_peak("a million frames to glb", &o);
     let out = lab.out("span-view");
     let html = out.join("x.html");
     case(
