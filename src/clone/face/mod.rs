@@ -118,6 +118,7 @@ mod rescale;
 mod rigid;
 mod skin_surface;
 mod split;
+mod target_check;
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -204,6 +205,7 @@ pub fn clone_face(
     report.timings.push("parts", clock.elapsed().as_secs_f64());
     check_parts(source, &sparts, "source", &mut report.warnings)?;
     check_parts(target, &tparts, "target", &mut report.warnings)?;
+    target_check::check_target(target, &tparts, &mut report.warnings);
     // 2. Alignment.
     let clock = Instant::now();
     let alignment = face_alignment(source, target, opts)?;
