@@ -98,13 +98,14 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
             }
         }
     }
-    let mut sorted: Vec<(&(u32, u32), &(u32, u32))> = edges.iter().collect();
+    // Edge → (uses a→b, uses b→a), in a fixed order so the places named are stable.
+    let mut sorted: Vec<_> = edges.into_iter().collect();
     sorted.sort_unstable();
     let place = |(a, b): (u32, u32)| format!("edge {a}-{b}");
     let non_manifold: Vec<String> = sorted
         .iter()
         .filter(|(_, (f, r))| f + r > 2)
-        .map(|(&e, _)| place(e))
+        .map(|&(e, _)| place(e))
         .collect();
     if !non_manifold.is_empty() {
         warnings.push(format!(
@@ -118,8 +119,8 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
     }
     let flipped: Vec<String> = sorted
         .iter()
-        .filter(|(_, &(f, r))| (f, r) == (2, 0) || (f, r) == (0, 2))
-        .map(|(&e, _)| place(e))
+        .filter(|(_, uses)| *uses == (2, 0) || *uses == (0, 2))
+        .map(|&(e, _)| place(e))
         .collect();
     if !flipped.is_empty() {
         warnings.push(format!(
@@ -135,7 +136,7 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
     // Holes: small loops of boundary edges (edges of one polygon).
     let mut loops = UnionFind::new(np);
     let mut boundary_edges = 0usize;
-    for (&(a, b), &(f, r)) in &sorted {
+    for &((a, b), (f, r)) in &sorted {
         if f + r == 1 {
             loops.union(a, b);
             boundary_edges += 1;
@@ -143,7 +144,7 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
     }
     if boundary_edges > 0 {
         let mut size: HashMap<u32, (usize, u32)> = HashMap::new();
-        for (&(a, _), &(f, r)) in &sorted {
+        for &((a, _), (f, r)) in &sorted {
             if f + r == 1 {
                 let e = size.entry(loops.find(a)).or_insert((0, a));
                 e.0 += 1;
