@@ -63,6 +63,7 @@ pub fn read_bounded_text(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
     }
     let mut buf = Vec::new();
     let mut chunk = vec![0u8; 1 << 16];
+    let mut is_gzip = None;
     let mut reader = file.take(max_bytes.saturating_add(1));
     loop {
         let n = match reader.read(&mut chunk) {
@@ -71,7 +72,8 @@ pub fn read_bounded_text(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
             Err(e) => return Err(Error::io(path, e)),
         };
-        let gzip = if buf.len() >= 2 { &buf[..] } else { &chunk[..n] }.starts_with(&[0x1F, 0x8B]);
+        // Decided by the first read (a whole 64 KiB chunk from a file).
+        let gzip = *is_gzip.get_or_insert_with(|| chunk[..n].starts_with(&[0x1F, 0x8B]));
         if !gzip {
             if let Some(i) = chunk[..n].iter().position(|&b| b == 0) {
                 let at = buf.len() + i;
@@ -520,7 +522,10 @@ mod tests {
         let e = read_text(&p).unwrap_err();
         assert!(t.elapsed().as_millis() < 500, "{:?}", t.elapsed());
         let m = e.to_string();
-        assert!(m.contains("zeros.fap:1:1: expected text") && m.contains("NUL"), "{m}");
+        assert!(
+            m.contains("zeros.fap:1:1: expected text") && m.contains("NUL"),
+            "{m}"
+        );
         assert!(e.is_input_error());
         let p = dir.path().join("late.wrl");
         std::fs::write(&p, b"#VRML V2.0 utf8\nGroup {\0}").unwrap();
