@@ -100,10 +100,10 @@
 //! # Where each step lives
 //!
 //! [`options`](CloneOptions) and [`report`](CloneReport) hold the settings and the report;
-//! `parts` step 1 (`split` cuts one-mesh heads), `align` step 2, `skin_surface` step 3
-//! (welding), `motions` the moves between meshes and the surface (steps 4 and 8), `rescale`
-//! step 6 and the guard, `rigid` and `part_motion` step 7 and `assemble` step 8. This file
-//! runs them in order.
+//! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
+//! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
+//! the surface (steps 4 and 8), `rescale` step 6 and the guard, `rigid` and `part_motion`
+//! step 7 and `assemble` step 8. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
 
