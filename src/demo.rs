@@ -18,6 +18,7 @@ use crate::export::picture::{cloning_grid_with, contact_sheet_rows, strip_fat};
 use crate::face::{BundledFace, FaceModel};
 use crate::fap::{read_stream_file, ReadOptions};
 use crate::fat::TableKey;
+use crate::io::AtomicDir;
 use crate::player::{PlayOptions, Player};
 
 /// Settings of [`run_demo`].
@@ -202,8 +203,11 @@ impl Clock {
     }
 }
 
-fn record(files: &mut Vec<DemoFile>, path: PathBuf, what: &str) -> Result<()> {
-    let bytes = std::fs::metadata(&path)
+/// Records the file `name` written into `dir` (its size from the temporary folder, its path
+/// the final one).
+fn record(files: &mut Vec<DemoFile>, dir: &AtomicDir, name: &str, what: &str) -> Result<()> {
+    let path = dir.path().join(name);
+    let bytes = std::fs::metadata(dir.temp_path().join(name))
         .map_err(|e| Error::io(&path, e))?
         .len();
     files.push(DemoFile {
@@ -267,7 +271,8 @@ impl DemoError {
 
 /// The end-to-end demo on the bundled samples: source `alma` (full FAT), target `bruno`
 /// stripped to meshes and feature points; clones alma→bruno, plays `speech.fap` on alma and
-/// on the cloned bruno, and writes into `out_dir` (created):
+/// on the cloned bruno, and writes into `out_dir` (all files or none: a temporary sibling
+/// renamed into place; an earlier demo's folder is replaced):
 ///
 /// - `bruno-cloned.wrl` — bruno with the cloned FAT;
 /// - `alma-speech.glb`, `bruno-speech.glb` — the speech animation on each face;
@@ -290,7 +295,11 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     let (truth, target_face) = bundled_face(&samples, BundledFace::Bruno)?;
     let target = strip_fat(&truth);
     clock.lap("load");
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::output(out_dir, e))?;
+    // Every file or none: written into a temporary sibling renamed into place at the end. An
+    // earlier demo's folder is replaced; a folder holding other files is refused.
+    let dir = crate::io::open_frame_dir(out_dir, |n| {
+        [".wrl", ".glb", ".png"].iter().any(|e| n.ends_with(e))
+    })?;
 
     let other = match opts.method {
         Method::Fmc => Method::Rbf,
@@ -348,10 +357,11 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     };
 
     let mut files = Vec::new();
-    let wrl = out_dir.join("bruno-cloned.wrl");
-    crate::face::vrml::write_face_file(&wrl, &bruno)?;
+    let wrl = "bruno-cloned.wrl";
+    dir.write_file(wrl, |p| crate::face::vrml::write_face_file(p, &bruno))?;
     record(
         &mut files,
+        &dir,
         wrl,
         "bruno with the FAT cloned from alma (VRML)",
     )?;
@@ -371,8 +381,8 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         let anim = player.animation()?;
         let export = export_face(face, Some(&anim))?;
         warnings.extend(export.warnings);
-        let path = out_dir.join(format!("{name}-speech.glb"));
-        export.document.write_glb(&path)?;
+        let file = format!("{name}-speech.glb");
+        dir.write_file(&file, |p| export.document.write_glb(p))?;
         let what = match name {
             "ict-head" => {
                 "speech.fap on the ICT head with its own FAT (from its ARKit shapes)".to_string()
@@ -382,7 +392,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
             }
             _ => format!("speech.fap played on {name} (animated glTF)"),
         };
-        record(&mut files, path, &what)?;
+        record(&mut files, &dir, &file, &what)?;
     }
     clock.lap("play + write glb");
 
@@ -393,11 +403,11 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         opts.sheet_frames,
         (opts.sheet_cell, opts.sheet_cell),
     )?;
-    let path = out_dir.join("contact-sheet.png");
-    sheet.write_png(&path)?;
+    dir.write_file("contact-sheet.png", |p| sheet.write_png(p))?;
     record(
         &mut files,
-        path,
+        &dir,
+        "contact-sheet.png",
         if played.len() > 2 {
             "the same speech frames, a row each: alma, cloned bruno, the ICT head with its own \
              FAT, the ICT head with alma's FAT"
@@ -420,14 +430,15 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
             Ok(clone_face(faces[i].1, &strip_fat(faces[j].1), &clone_opts)?.face)
         }
     })?;
-    let path = out_dir.join("cloning-grid.png");
-    grid_image.write_png(&path)?;
+    dir.write_file("cloning-grid.png", |p| grid_image.write_png(p))?;
     record(
         &mut files,
-        path,
+        &dir,
+        "cloning-grid.png",
         "joy at 63 cloned both ways (rows: source, columns: target)",
     )?;
     clock.lap("cloning grid (clone bruno→alma + render)");
+    dir.commit()?;
 
     Ok(DemoReport {
         out_dir: out_dir.to_path_buf(),

@@ -48,6 +48,55 @@ pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
     Ok(buf)
 }
 
+/// Like [`read_bounded`], for text formats: refuses the file at its first NUL byte (no text
+/// format fbakit reads has one), so a file of a billion zeros costs one 64 KiB chunk, not a
+/// billion bytes of memory and half a minute. Gzip data (magic `1F 8B`) is read whole, for
+/// readers that decompress it.
+pub fn read_bounded_text(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let meta = file.metadata().map_err(|e| Error::io(path, e))?;
+    if meta.is_dir() {
+        return read_bounded(path, max_bytes);
+    }
+    if meta.is_file() && meta.len() > max_bytes {
+        return Err(too_large(path, Some(meta.len()), max_bytes));
+    }
+    let mut buf = Vec::new();
+    let mut chunk = vec![0u8; 1 << 16];
+    let mut is_gzip = None;
+    let mut reader = file.take(max_bytes.saturating_add(1));
+    loop {
+        let n = match reader.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(Error::io(path, e)),
+        };
+        // Decided by the first read (a whole 64 KiB chunk from a file).
+        let gzip = *is_gzip.get_or_insert_with(|| chunk[..n].starts_with(&[0x1F, 0x8B]));
+        if !gzip {
+            if let Some(i) = chunk[..n].iter().position(|&b| b == 0) {
+                let at = buf.len() + i;
+                buf.extend_from_slice(&chunk[..i]);
+                let valid = match std::str::from_utf8(&buf) {
+                    Ok(t) => t,
+                    Err(e) => std::str::from_utf8(&buf[..e.valid_up_to()]).unwrap_or_default(),
+                };
+                return Err(Error::Parse(crate::error::ParseError {
+                    location: crate::error::Location::from_offset(path, valid, at),
+                    expected: "text".to_string(),
+                    found: Some("a NUL byte (binary data, not text)".to_string()),
+                }));
+            }
+        }
+        buf.extend_from_slice(&chunk[..n]);
+        if buf.len() as u64 > max_bytes {
+            return Err(too_large(path, None, max_bytes));
+        }
+    }
+    Ok(buf)
+}
+
 fn too_large(path: &Path, size: Option<u64>, max_bytes: u64) -> Error {
     let what = match size {
         Some(n) => format!("the file has {n} bytes, more than the {max_bytes}-byte input limit"),
@@ -63,7 +112,7 @@ fn too_large(path: &Path, size: Option<u64>, max_bytes: u64) -> Error {
 ///
 /// Invalid UTF-8 is an error that names the byte offset of the first bad sequence.
 pub fn read_text(path: &Path) -> Result<String> {
-    let bytes = read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
+    let bytes = read_bounded_text(path, DEFAULT_MAX_INPUT_BYTES)?;
     text_from_bytes(bytes, path)
 }
 
@@ -232,6 +281,19 @@ impl AtomicDir {
     /// The final path.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// Writes the file `name` in the folder with `write` (given its temporary path); an error
+    /// names the file at its final place, never the temporary folder.
+    pub fn write_file(&self, name: &str, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+        write(&self.tmp.path().join(name)).map_err(|e| {
+            let path = self.path.join(name);
+            match e {
+                Error::Output { source, .. } => Error::output(path, source),
+                Error::Io { source, .. } => Error::output(path, source),
+                other => other,
+            }
+        })
     }
 
     /// Renames the directory into place. An existing directory at the final path is first
@@ -487,6 +549,35 @@ mod tests {
         let e = read_bounded(&p, 99).unwrap_err();
         assert!(e.to_string().contains("input limit"), "{e}");
         assert!(e.is_input_error());
+    }
+
+    #[test]
+    fn text_reads_stop_at_the_first_nul() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("zeros.fap");
+        // 1e9 zeros as a sparse file: refused from the first chunk, not read whole.
+        std::fs::File::create(&p)
+            .unwrap()
+            .set_len(1_000_000_000)
+            .unwrap();
+        let t = std::time::Instant::now();
+        let e = read_text(&p).unwrap_err();
+        assert!(t.elapsed().as_millis() < 500, "{:?}", t.elapsed());
+        let m = e.to_string();
+        assert!(
+            m.contains("zeros.fap:1:1: expected text") && m.contains("NUL"),
+            "{m}"
+        );
+        assert!(e.is_input_error());
+        let p = dir.path().join("late.wrl");
+        std::fs::write(&p, b"#VRML V2.0 utf8\nGroup {\0}").unwrap();
+        let m = read_text(&p).unwrap_err().to_string();
+        assert!(m.contains("late.wrl:2:8"), "{m}");
+        // Gzip data may hold zeros: it is read whole (its reader decompresses it).
+        let mut z = Vec::new();
+        gzip(&[0u8; 100], &mut z).unwrap();
+        std::fs::write(&p, &z).unwrap();
+        assert_eq!(read_bounded_text(&p, 1 << 20).unwrap(), z);
     }
 
     #[test]

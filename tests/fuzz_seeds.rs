@@ -1,7 +1,7 @@
-//! Replays the seed corpora of the fuzz targets `face`, `gltf_rig`, `landmark_ids` and
-//! `weights_csv` (`fuzz/seeds/<target>/`) through the same library calls on the stable
-//! toolchain, plus truncations and single-byte flips of each seed, and the inputs the
-//! targets once crashed on (`tests/fuzz-regressions/<target>/`): no input may panic.
+//! Replays the seed corpora of the fuzz targets (`fuzz/seeds/<target>/`) through the same
+//! library calls on the stable toolchain, plus truncations and single-byte flips of each
+//! seed, and the inputs the targets once crashed on (`tests/fuzz-regressions/<target>/`): no
+//! input may panic.
 
 use std::path::{Path, PathBuf};
 
@@ -112,4 +112,72 @@ fn weights_csv_seeds() {
         let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, None);
         let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, Some(30.0));
     });
+}
+
+/// The parser targets' seeds read (each format's own reader), and their cuts and flips
+/// neither panic nor break the targets' round trips.
+#[test]
+fn parser_seeds() {
+    fn text(d: &[u8]) -> Option<&str> {
+        std::str::from_utf8(d).ok()
+    }
+    let strict = fbakit::fap::ReadOptions::strict();
+    for seed in seeds("fap") {
+        let t = std::fs::read_to_string(&seed).unwrap();
+        fbakit::fap::parse_fap(&t, &seed, &strict)
+            .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+    }
+    replay("fap", |d| {
+        let Some(t) = text(d) else { return };
+        let p = Path::new("fuzz.fap");
+        if let Ok((s, _)) = fbakit::fap::parse_fap(t, p, &strict) {
+            let out = fbakit::fap::write_fap_string(&s);
+            assert_eq!(fbakit::fap::parse_fap(&out, p, &strict).unwrap().0, s);
+        }
+    });
+    for seed in seeds("vrml") {
+        fbakit::vrml::parse_vrml_str(&std::fs::read_to_string(&seed).unwrap())
+            .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+    }
+    replay("vrml", |d| {
+        if let Some(Ok(scene)) = text(d).map(fbakit::vrml::parse_vrml_str) {
+            let written = fbakit::vrml::write_vrml_string(&scene);
+            assert_eq!(fbakit::vrml::parse_vrml_str(&written).unwrap(), scene);
+        }
+    });
+    for seed in seeds("obj") {
+        let t = std::fs::read_to_string(&seed).unwrap();
+        fbakit::mesh::obj::parse_obj(&t, &seed)
+            .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+    }
+    replay("obj", |d| {
+        if let Some(t) = text(d) {
+            let _ = fbakit::mesh::obj::parse_obj(t, Path::new("fuzz.obj"));
+        }
+    });
+    for seed in seeds("wfm") {
+        let t = std::fs::read_to_string(&seed).unwrap();
+        fbakit::candide::parse_wfm(&t, &seed).unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+    }
+    replay("wfm", |d| {
+        if let Some(t) = text(d) {
+            let _ = fbakit::candide::parse_wfm(t, Path::new("fuzz.wfm"));
+        }
+    });
+    for (target, name) in [
+        ("fdp_xml", "f.xml"),
+        ("fp_csv", "f.csv"),
+        ("xface_fdp", "f.fdp"),
+    ] {
+        for seed in seeds(target) {
+            let t = std::fs::read_to_string(&seed).unwrap();
+            fbakit::fdp::parse_feature_points(&t, Path::new(name))
+                .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+        }
+        replay(target, |d| {
+            if let Some(t) = text(d) {
+                let _ = fbakit::fdp::parse_feature_points(t, Path::new(name));
+            }
+        });
+    }
 }

@@ -236,6 +236,48 @@ fn two_frames(last: &str, value: &str, rate: &str) -> Vec<u8> {
 
 const TRIANGLE_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
+/// 68 vertices in iBUG-68 order, roughly where the landmarks sit on a face (jaw contour,
+/// brows, nose, eyes, lips; centimetres), with a fan of triangles so it reads as a mesh.
+fn ibug68_obj() -> String {
+    let mut v: Vec<[f32; 3]> = Vec::new();
+    for k in 0..17 {
+        let a = std::f32::consts::PI * (k as f32 / 16.0);
+        v.push([-7.0 * a.cos(), -2.0 - 7.0 * a.sin(), 0.0]);
+    }
+    for k in 0..10 {
+        let x = -6.0 + 12.0 * (k as f32 + (k / 5) as f32) / 10.0;
+        v.push([x, 4.0, 1.0]);
+    }
+    for k in 0..4 {
+        v.push([0.0, 2.0 - 1.2 * k as f32, 1.0 + 0.6 * k as f32]);
+    }
+    for k in 0..5 {
+        v.push([-1.6 + 0.8 * k as f32, -3.0, 1.5]);
+    }
+    for side in [-1.0f32, 1.0] {
+        for k in 0..6 {
+            let a = std::f32::consts::TAU * k as f32 / 6.0;
+            v.push([side * 3.0 + 1.2 * a.cos(), 2.0 + 0.5 * a.sin(), 0.5]);
+        }
+    }
+    for k in 0..12 {
+        let a = std::f32::consts::TAU * k as f32 / 12.0;
+        v.push([-2.5 * a.cos(), -6.0 + 1.2 * a.sin(), 1.0]);
+    }
+    for k in 0..8 {
+        let a = std::f32::consts::TAU * k as f32 / 8.0;
+        v.push([-1.8 * a.cos(), -6.0 + 0.5 * a.sin(), 0.9]);
+    }
+    let mut text: String = v
+        .iter()
+        .map(|p| format!("v {} {} {}\n", p[0], p[1], p[2]))
+        .collect();
+    for k in 2..68 {
+        text.push_str(&format!("f 1 {k} {}\n", k + 1));
+    }
+    text
+}
+
 #[test]
 fn garbage_inputs_are_refused_by_every_reader() {
     let lab = Lab::new();
@@ -582,6 +624,33 @@ fn oversized_inputs_are_refused_without_reading_them() {
         assert_peak(name, &o);
         std::fs::remove_file(&p).unwrap();
     }
+    // 1e9 NUL bytes, under the size limit: text readers stop at the first one (this read
+    // 1 GB into 2 GB of memory in 28 s).
+    for (name, cmd) in [
+        ("zeros.wrl", &["face", "info"][..]),
+        ("zeros.obj", &["face", "info"][..]),
+        ("zeros.fap", &["fap", "info"][..]),
+        ("zeros.csv", &["fapu"][..]),
+    ] {
+        let p = lab.path(name);
+        std::fs::File::create(&p)
+            .unwrap()
+            .set_len(1_000_000_000)
+            .unwrap();
+        let mut args: Vec<&dyn AsRef<std::ffi::OsStr>> = cmd.iter().map(|c| c as _).collect();
+        args.push(&p);
+        let o = case_measured(
+            &format!("NULs {name}"),
+            &args,
+            Expect::BadInput,
+            name,
+            None,
+            true,
+        );
+        assert!(o.stderr.contains("NUL"), "{name}: {}", o.stderr);
+        assert_peak(name, &o);
+        std::fs::remove_file(&p).unwrap();
+    }
 }
 
 #[test]
@@ -755,29 +824,40 @@ fn unwritable_outputs_are_failures_that_leave_nothing() {
         None,
     );
     check_only_blocker("man pages folder");
+    // Folders of files: each is made beside its place and renamed in, so a place that
+    // cannot be written fails before the first file and leaves nothing.
+    for (case_name, args) in [
+        ("face morphs folder", vec!["face", "to-morphs", "alma"]),
+        ("demo folder", vec!["demo", "--single", "--out"]),
+    ] {
+        let target = blocker.join("folder");
+        let mut args: Vec<&dyn AsRef<std::ffi::OsStr>> = args
+            .iter()
+            .map(|a| a as &dyn AsRef<std::ffi::OsStr>)
+            .collect();
+        args.push(&target);
+        case(case_name, &args, Expect::Failure, "blocker", None);
+        check_only_blocker(case_name);
+    }
+    // Valid landmarks (68 vertices in landmark order), an output that cannot be written.
     let target = blocker.join("x.csv");
-    let mesh = lab.file("tri.obj", TRIANGLE_OBJ.as_bytes());
-    let ids = lab.file("ids.txt", b"0 1 2");
-    let o = case(
+    let mesh = lab.file("ibug68.obj", ibug68_obj().as_bytes());
+    let ids: Vec<String> = (0..68).map(|i| i.to_string()).collect();
+    let ids = lab.file("ids68.txt", ids.join(" ").as_bytes());
+    case(
         "fp from-landmarks output",
         &[
             &"fp",
             &"from-landmarks",
             &mesh,
-            &"--mediapipe468",
+            &"--ibug68",
             &ids,
             &"-o",
             &target,
         ],
-        Expect::BadInput,
-        "",
+        Expect::Failure,
+        "x.csv",
         None,
-    );
-    // Three landmarks are bad input before any writing; the output place is not reached.
-    assert!(
-        o.stderr.contains("468") || o.stderr.contains("ids"),
-        "{}",
-        o.stderr
     );
     check_only_blocker("fp from-landmarks output");
 }
@@ -808,6 +888,21 @@ fn a_tiny_stream_with_a_huge_span_is_refused_at_once() {
             o.stderr
         );
     }
+    // A million frames (the frame limit) of glTF: refused up front by the clip's memory
+    // estimate (it peaked at 3.0 GB).
+    let p_m = lab.file("million.fap", &two_frames("999999", "0", "25"));
+    let out = lab.out("million");
+    let glb = out.join("x.glb");
+    let o = case_measured(
+        "a million frames to glb",
+        &[&"play", &"alma", &p_m, &"-o", &glb],
+        Expect::BadInput,
+        "--frames",
+        Some(&out),
+        true,
+    );
+    assert!(o.stderr.contains("memory"), "{}", o.stderr);
+    assert_peak("a million frames to glb", &o);
     let out = lab.out("span-view");
     let html = out.join("x.html");
     case(
@@ -908,4 +1003,51 @@ fn a_frame_sequence_stopped_midway_leaves_nothing() {
         1,
         "no temporary left"
     );
+}
+
+/// Runs `fbakit ARGS` with outputs limited to `blocks` × 512 bytes per file and SIGXFSZ
+/// ignored, so a write past the limit fails with "file too large" (root cannot bypass it).
+#[cfg(unix)]
+fn run_with_file_limit(blocks: u32, args: &[&std::ffi::OsStr]) -> std::process::Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f {blocks}; exec \"$0\" \"$@\""
+        ))
+        .arg(env!("CARGO_BIN_EXE_fbakit"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run fbakit under sh")
+}
+
+#[cfg(unix)]
+#[test]
+fn folders_failing_while_written_leave_nothing() {
+    let lab = Lab::new();
+    for (case_name, args, blocks) in [
+        ("face morphs folder", &["face", "to-morphs", "alma"][..], 64),
+        ("man pages folder", &["man", "-o"][..], 4),
+    ] {
+        let out = lab.out(&case_name.replace(' ', "-"));
+        let target = out.join("folder");
+        let mut all: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+        all.push(target.as_os_str());
+        let o = run_with_file_limit(blocks, &all);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{case_name}: {err}");
+        let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+        assert_eq!(errors.len(), 1, "{case_name}: {err}");
+        // The error names the file at its final place, not the temporary folder.
+        assert!(
+            errors[0].contains("folder/") && !errors[0].contains(".fbakit-"),
+            "{case_name}: {}",
+            errors[0]
+        );
+        let left: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert!(left.is_empty(), "{case_name}: left behind {left:?}");
+    }
 }

@@ -65,11 +65,15 @@ pub fn man(a: ManArgs) -> Result<u8> {
             a.output.display()
         )));
     }
-    std::fs::create_dir_all(&a.output).map_err(|e| Error::output(&a.output, e))?;
+    // All pages or none: written into a temporary sibling renamed into place. Earlier pages
+    // are replaced; a folder holding other files is refused rather than replaced.
+    let dir =
+        fbakit::io::open_frame_dir(&a.output, |n| n.starts_with("fbakit") && n.ends_with(".1"))?;
     let mut pages = Vec::new();
     let mut cmd = Cli::command();
     cmd.build();
-    write_pages(&cmd, "fbakit", &a.output, &mut pages)?;
+    write_pages(&cmd, "fbakit", &dir, &mut pages)?;
+    dir.commit()?;
     let report = ManReport {
         directory: a.output.display().to_string(),
         pages,
@@ -91,7 +95,7 @@ pub fn man(a: ManArgs) -> Result<u8> {
 fn write_pages(
     cmd: &clap::Command,
     name: &str,
-    dir: &std::path::Path,
+    dir: &fbakit::io::AtomicDir,
     pages: &mut Vec<String>,
 ) -> Result<()> {
     // Subcommand pages carry the full name in their title (`fbakit-play`).
@@ -99,9 +103,9 @@ fn write_pages(
     let mut roff = Vec::new();
     clap_mangen::Man::new(page_cmd)
         .render(&mut roff)
-        .map_err(|e| Error::io(dir, e))?;
+        .map_err(|e| Error::io(dir.path(), e))?;
     let file = format!("{name}.1");
-    fbakit::io::write_atomic(&dir.join(&file), &roff)?;
+    dir.write_file(&file, |p| fbakit::io::write_atomic(p, &roff))?;
     pages.push(file);
     for sub in cmd.get_subcommands().filter(|s| !s.is_hide_set()) {
         if sub.get_name() == "help" {

@@ -196,14 +196,20 @@ pub fn run(a: PlayArgs) -> Result<u8> {
             frames: a.frames.clone(),
         },
     )?;
-    let per_frame = match format {
-        PlayFormat::Glb | PlayFormat::Gltf => budget::clip_bytes_per_frame(&face),
-        PlayFormat::Obj => budget::obj_bytes_per_frame(&face),
+    let span = player.frame_range();
+    match format {
+        PlayFormat::Glb | PlayFormat::Gltf => {
+            with_play_hint(budget::check_clip(&a.output, &span, &face))?
+        }
+        PlayFormat::Obj => check_budget(&a.output, &span, budget::obj_bytes_per_frame(&face))?,
         // A sheet renders a fixed number of frames whatever the span.
-        PlayFormat::Png if is_png_file(&a.output) => 0,
-        PlayFormat::Png => budget::image_bytes_per_frame(a.size.0, a.size.1),
-    };
-    check_budget(&a.output, &player.frame_range(), per_frame)?;
+        PlayFormat::Png if is_png_file(&a.output) => check_budget(&a.output, &span, 0)?,
+        PlayFormat::Png => check_budget(
+            &a.output,
+            &span,
+            budget::image_bytes_per_frame(a.size.0, a.size.1),
+        )?,
+    }
     let bar = progress(player.frame_count() as u64, "playing");
     let files_written = match format {
         PlayFormat::Glb | PlayFormat::Gltf => {
@@ -267,7 +273,12 @@ pub fn run(a: PlayArgs) -> Result<u8> {
 
 /// Refuses an output estimated too large ([`budget::check`]), saying how to play less.
 pub fn check_budget(output: &Path, frames: &Range<usize>, bytes_per_frame: u64) -> Result<()> {
-    budget::check(output, frames, bytes_per_frame).map_err(|mut e| {
+    with_play_hint(budget::check(output, frames, bytes_per_frame))
+}
+
+/// A budget refusal with the options that play less.
+pub fn with_play_hint(checked: Result<()>) -> Result<()> {
+    checked.map_err(|mut e| {
         if let Error::Export(ExportError::OverBudget { advice, .. }) = &mut e {
             *advice = "; play fewer with --frames a..b or a lower --fps".into();
         }

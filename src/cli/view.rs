@@ -91,11 +91,11 @@ pub fn run(a: ViewArgs) -> Result<u8> {
                     fbakit::export::viewer::MAX_FRAMES
                 )));
             }
-            super::play::check_budget(
+            super::play::with_play_hint(fbakit::export::budget::check_clip(
                 &a.output,
                 &player.frame_range(),
-                fbakit::export::budget::clip_bytes_per_frame(&face),
-            )?;
+                &face,
+            ))?;
             missing = player
                 .missing_tables()
                 .into_iter()

@@ -28,6 +28,40 @@ pub fn clip_bytes_per_frame(face: &FaceModel) -> u64 {
     4 + 4 * weights + 40 * transforms + bookkeeping + 16 * weights
 }
 
+/// Largest estimated memory of a glTF clip (or viewer page), which is built whole before it
+/// is written: 256 MiB.
+pub const MAX_CLIP_MEMORY_BYTES: u64 = 256 << 20;
+
+/// Memory per frame while a clip is built: [`clip_bytes_per_frame`] twice over (sampled
+/// frames, keys, accessors and the GLB buffer live at once; a 1 000 000-frame alma clip
+/// peaked at 3.0 GB, 1.6 times its estimate, for a 641 MB file).
+pub fn clip_memory_per_frame(face: &FaceModel) -> u64 {
+    2 * clip_bytes_per_frame(face)
+}
+
+/// [`check`] for a glTF clip, which must also fit [`MAX_CLIP_MEMORY_BYTES`] while it is built.
+pub fn check_clip(output: &Path, frames: &Range<usize>, face: &FaceModel) -> Result<()> {
+    check(output, frames, clip_bytes_per_frame(face))?;
+    let n = frames.len();
+    let estimate = (n as u64).saturating_mul(clip_memory_per_frame(face));
+    if estimate <= MAX_CLIP_MEMORY_BYTES {
+        return Ok(());
+    }
+    Err(super::ExportError::OverBudget {
+        output: output.to_path_buf(),
+        start: frames.start,
+        end: frames.end,
+        frames: n,
+        over: format!(
+            "about {} MB of memory while the clip is built, more than the {} MB a clip may take",
+            estimate >> 20,
+            MAX_CLIP_MEMORY_BYTES >> 20
+        ),
+        advice: String::new(),
+    }
+    .into())
+}
+
 /// Bytes per OBJ frame file: positions written as text (about 36 bytes a vertex) and the
 /// faces (about 24 bytes each).
 pub fn obj_bytes_per_frame(face: &FaceModel) -> u64 {

@@ -410,7 +410,8 @@ pub fn morph_values(face: &FaceModel, value: Option<f64>) -> Vec<(TableKey, Vec<
     out
 }
 
-/// Writes the face's FAT as a morph set into `dir` (created if needed): see the module docs.
+/// Writes the face's FAT as a morph set into `dir` (created, or replaced whole when it holds
+/// an earlier set; written atomically): see the module docs.
 /// `value` evaluates every table at that value instead of its reference values.
 pub fn write_morph_set(
     face: &FaceModel,
@@ -425,21 +426,20 @@ pub fn write_morph_set(
     face.check_structure()?;
     let mut eval = face.evaluator()?;
     let mut out = eval.output();
-    std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, e))?;
+    // Written into a temporary sibling renamed into place at the end: a failure half-way
+    // leaves no partial set. An existing set (OBJs and the CSV) is replaced whole; a folder
+    // holding anything else is refused.
+    let out_dir =
+        crate::io::open_frame_dir(dir, |n| n.ends_with(".obj") || n == FEATURE_POINTS_FILE)?;
 
     let neutral_frames = face.frames();
-    let neutral = merged_mesh(face, &neutral_frames.meshes, None)?;
-    write_obj_file(
-        &ObjScene {
-            mesh: neutral,
-            material_libraries: Vec::new(),
-        },
-        &dir.join(NEUTRAL_FILE),
-    )?;
-    write_csv_file(
-        &dir.join(FEATURE_POINTS_FILE),
-        &FeaturePointTable::from_set(&merged_feature_points(face)),
-    )?;
+    let neutral = ObjScene {
+        mesh: merged_mesh(face, &neutral_frames.meshes, None)?,
+        material_libraries: Vec::new(),
+    };
+    out_dir.write_file(NEUTRAL_FILE, |p| write_obj_file(&neutral, p))?;
+    let points = FeaturePointTable::from_set(&merged_feature_points(face));
+    out_dir.write_file(FEATURE_POINTS_FILE, |p| write_csv_file(p, &points))?;
 
     let mut written = Vec::new();
     for (key, values) in morph_values(face, value) {
@@ -454,21 +454,20 @@ pub fn write_morph_set(
             let frames = face.frames_with(&locals);
             let mut mesh = merged_mesh(face, &frames.meshes, Some(&out.displacements))?;
             mesh.name = key.name();
-            let file = dir.join(morph_file_name(key, v));
-            write_obj_file(
-                &ObjScene {
-                    mesh,
-                    material_libraries: Vec::new(),
-                },
-                &file,
-            )?;
+            let name = morph_file_name(key, v);
+            let scene = ObjScene {
+                mesh,
+                material_libraries: Vec::new(),
+            };
+            out_dir.write_file(&name, |p| write_obj_file(&scene, p))?;
             written.push(WrittenMorph {
-                file,
+                file: dir.join(name),
                 key,
                 value: v,
             });
         }
     }
+    out_dir.commit()?;
     Ok(written)
 }
 

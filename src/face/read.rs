@@ -94,7 +94,16 @@ pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, Face
         let rig = crate::rig::obj_folder::read_obj_rig(path)?;
         return super::from_rig::rig_face(path, &rig, opts.feature_points.as_deref());
     }
-    let bytes = crate::io::read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?;
+    // Text formats stop at the first NUL byte instead of reading a file of zeros whole.
+    let text = matches!(
+        opts.format.or_else(|| FaceFormat::of_extension(path)),
+        Some(FaceFormat::Vrml | FaceFormat::Obj | FaceFormat::Wfm)
+    );
+    let bytes = if text {
+        crate::io::read_bounded_text(path, DEFAULT_MAX_INPUT_BYTES)?
+    } else {
+        crate::io::read_bounded(path, DEFAULT_MAX_INPUT_BYTES)?
+    };
     read_bytes_at(path, &bytes, opts)
 }
 

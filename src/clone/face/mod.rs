@@ -102,10 +102,10 @@
 //! # Where each step lives
 //!
 //! [`options`](CloneOptions) and [`report`](CloneReport) hold the settings and the report;
-//! `parts` step 1 (`split` cuts one-mesh heads), `align` step 2, `skin_surface` step 3
-//! (welding), `motions` the moves between meshes and the surface (steps 4 and 8), `rescale`
-//! step 6 and the guard, `rigid` and `part_motion` step 7 and `assemble` step 8. This file
-//! runs them in order.
+//! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
+//! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
+//! the surface (steps 4 and 8), `rescale` step 6 and the guard, `rigid` and `part_motion`
+//! step 7 and `assemble` step 8. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
 
@@ -120,6 +120,7 @@ mod rescale;
 mod rigid;
 mod skin_surface;
 mod split;
+mod target_check;
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -208,6 +209,7 @@ pub fn clone_face(
     report.timings.push("parts", clock.elapsed().as_secs_f64());
     check_parts(source, &sparts, "source", &mut report.warnings)?;
     check_parts(target, &tparts, "target", &mut report.warnings)?;
+    target_check::check_target(target, &tparts, &mut report.warnings);
     // 2. Alignment.
     let clock = Instant::now();
     let alignment = face_alignment(source, target, opts)?;

@@ -15,8 +15,10 @@
 //! **Writing.** A face read from a file is written by patching that scene: mesh coordinates
 //! and polygons, transform fields, and the `FDP`'s feature points and tables are replaced;
 //! every other node (lights, viewpoints, unknown nodes, PROTOs, ROUTEs) is written back as it
-//! was. A face without a scene is written as `Face { fdp FDP { featurePointsCoord,
-//! faceSceneGraph [transforms and shapes], faceDefTables } }`, so every `USE` follows its `DEF`.
+//! was. A transform the scene lacks (cloning may add a `head` root or a part transform) is
+//! inserted where its shapes and child transforms sit, and they are moved into it. A face
+//! without a scene is written as `Face { fdp FDP { featurePointsCoord, faceSceneGraph
+//! [transforms and shapes], faceDefTables } }`, so every `USE` follows its `DEF`.
 //!
 //! **fbakit's feature-point record.** `featurePointsCoord` must list all 84 points, but real
 //! faces rarely have them all, and the standard does not say which vertex a point is. fbakit
@@ -42,6 +44,7 @@ mod read_geometry;
 mod write;
 mod write_fat;
 mod write_geometry;
+mod write_insert;
 
 pub use bindings::FP_RECORD_TITLE;
 pub use fp_match::FeaturePointMatch;

@@ -4,6 +4,7 @@
 use glam::{Quat, Vec3};
 
 use super::write::{add, set_field};
+use super::write_insert::insert_transforms;
 use crate::error::Result;
 use crate::face::{FaceError, FaceMesh, FaceModel, FaceTransform};
 use crate::mesh::{Mesh, Polygons, SurfaceFlags};
@@ -97,27 +98,37 @@ fn add_shape(scene: &mut Scene, m: &FaceMesh) -> (NodeRef, NodeId) {
 }
 
 /// Writes the face's transforms and meshes into the nodes of the same DEF names in its own
-/// scene; a transform or mesh the scene lacks is an error.
+/// scene. A transform the scene lacks is added where its content sits (see
+/// [`insert_transforms`]); a mesh the scene lacks is an error.
 pub(super) fn patch_geometry(scene: &mut Scene, face: &FaceModel) -> Result<GeometryNodes> {
     let mut mesh_nodes: Vec<NodeId> = Vec::with_capacity(face.meshes.len());
-    let mut transform_nodes: Vec<NodeId> = Vec::with_capacity(face.transforms.len());
-    for t in &face.transforms {
-        let id = find_def_of_type(scene, &t.name, "Transform").ok_or_else(|| {
-            FaceError::TransformNotInScene {
-                name: t.name.clone(),
-            }
-        })?;
-        write_transform_fields(&mut scene.nodes[id.0], t);
-        transform_nodes.push(id);
-    }
     for m in &face.meshes {
         let id = find_def_of_type(scene, &m.name, "IndexedFaceSet").ok_or_else(|| {
             FaceError::MeshNotInScene {
                 name: m.name.clone(),
             }
         })?;
-        write_mesh_fields(scene, id, &m.mesh);
         mesh_nodes.push(id);
+    }
+    let mut found: Vec<Option<NodeId>> = face
+        .transforms
+        .iter()
+        .map(|t| find_def_of_type(scene, &t.name, "Transform"))
+        .collect();
+    if found.iter().any(Option::is_none) {
+        insert_transforms(scene, face, &mut found, &mesh_nodes);
+    }
+    let mut transform_nodes: Vec<NodeId> = Vec::with_capacity(face.transforms.len());
+    for (t, id) in face.transforms.iter().zip(found) {
+        // `insert_transforms` fills every gap; kept as an error rather than a panic.
+        let id = id.ok_or_else(|| FaceError::TransformNotInScene {
+            name: t.name.clone(),
+        })?;
+        write_transform_fields(&mut scene.nodes[id.0], t);
+        transform_nodes.push(id);
+    }
+    for (m, &id) in face.meshes.iter().zip(&mesh_nodes) {
+        write_mesh_fields(scene, id, &m.mesh);
     }
     Ok(GeometryNodes {
         meshes: mesh_nodes,

@@ -49,11 +49,18 @@ pub(super) fn roles(face: &FaceModel, parts: &FaceParts) -> (BTreeMap<Part, usiz
     (map, head)
 }
 
-/// `base`, or `base_2`, `base_3`, ... : the first name no transform or mesh of `face` has.
+/// `base`, or `base_2`, `base_3`, ... : the first name no transform or mesh of `face` has,
+/// nor any node of its scene (the name becomes a DEF there).
 pub(super) fn unique_name(face: &FaceModel, base: &str) -> String {
     let mut name = base.to_string();
     let mut k = 1;
-    while face.transform_index(&name).is_some() || face.mesh_index(&name).is_some() {
+    while face.transform_index(&name).is_some()
+        || face.mesh_index(&name).is_some()
+        || face
+            .scene
+            .as_ref()
+            .is_some_and(|s| s.find_def(&name).is_some())
+    {
         k += 1;
         name = format!("{base}_{k}");
     }

@@ -112,11 +112,11 @@ impl RigidPlan {
         let head = head_transform(face, tparts, &mut created);
         let part_tf = part_transforms(face, tparts, head, &drive.needed, &mut created);
         if !created.is_empty() {
-            face.scene = None;
-            report.warnings.push(format!(
-                "created transforms {}; the output is written as a new scene",
-                created.join(", ")
-            ));
+            // The kept scene stays: its writer inserts the new transforms where their
+            // content sits, so nodes fbakit does not read are not lost.
+            report
+                .warnings
+                .push(format!("created transforms {}", created.join(", ")));
         }
         let mut installed = Vec::new();
         install_eye_centres(face, tparts, &part_tf, &mut installed);

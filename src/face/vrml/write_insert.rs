@@ -1,0 +1,210 @@
+//! Transforms the face has and its own scene lacks (cloning adds a `head` root or a part
+//! transform): a new DEF'd `Transform` is put where its content sits in the scene and that
+//! content (shapes, child transforms) is moved into it, so every other node of the file stays
+//! where it was.
+
+use std::collections::HashMap;
+
+use super::write::set_field;
+use crate::face::FaceModel;
+use crate::vrml::{FieldValue, Node, NodeId, NodeRef, Scene, Statement, UntypedItem};
+
+/// Where a node is defined (its one non-`USE` reference).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Slot {
+    /// Root statement `k`.
+    Root(usize),
+    /// Item `item` of field `field` of `node`.
+    Field {
+        node: NodeId,
+        field: usize,
+        item: usize,
+    },
+}
+
+/// The defining slot of every node reachable from the scene's statements.
+fn slots(scene: &Scene) -> HashMap<NodeId, Slot> {
+    let mut out = HashMap::new();
+    for (k, s) in scene.statements.iter().enumerate() {
+        if let Statement::Node(r) = s {
+            if !r.is_use {
+                out.insert(r.id, Slot::Root(k));
+            }
+        }
+    }
+    for (n, node) in scene.nodes.iter().enumerate() {
+        for (f, (_, value)) in node.fields.iter().enumerate() {
+            for (item, r) in refs_with_items(value) {
+                if !r.is_use {
+                    out.entry(r.id).or_insert(Slot::Field {
+                        node: NodeId(n),
+                        field: f,
+                        item,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The node references of a value with their item positions.
+fn refs_with_items(value: &FieldValue) -> Vec<(usize, NodeRef)> {
+    match value {
+        FieldValue::SFNode(Some(r)) => vec![(0, *r)],
+        FieldValue::MFNode(v) => v.iter().copied().enumerate().collect(),
+        FieldValue::Untyped { items, .. } => items
+            .iter()
+            .enumerate()
+            .filter_map(|(i, it)| match it {
+                UntypedItem::Node(r) => Some((i, *r)),
+                _ => None,
+            })
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// The `Transform` node nearest above `slot` (`None` at the top level).
+fn enclosing_transform(scene: &Scene, all: &HashMap<NodeId, Slot>, slot: Slot) -> Option<NodeId> {
+    let mut at = slot;
+    // Bounded: a cyclic graph cannot loop here.
+    for _ in 0..=scene.nodes.len() {
+        let Slot::Field { node, .. } = at else {
+            return None;
+        };
+        if scene.node(node).type_name == "Transform" {
+            return Some(node);
+        }
+        at = *all.get(&node)?;
+    }
+    None
+}
+
+/// Puts `new` in place of the reference at `slot`.
+fn replace_at(scene: &mut Scene, slot: Slot, new: NodeRef) {
+    match slot {
+        Slot::Root(k) => scene.statements[k] = Statement::Node(new),
+        Slot::Field { node, field, item } => match &mut scene.nodes[node.0].fields[field].1 {
+            FieldValue::SFNode(r) => *r = Some(new),
+            FieldValue::MFNode(v) => v[item] = new,
+            FieldValue::Untyped { items, .. } => items[item] = UntypedItem::Node(new),
+            _ => {}
+        },
+    }
+}
+
+/// Removes the reference at `slot`.
+fn remove_at(scene: &mut Scene, slot: Slot) {
+    match slot {
+        Slot::Root(k) => {
+            scene.statements.remove(k);
+        }
+        Slot::Field { node, field, item } => match &mut scene.nodes[node.0].fields[field].1 {
+            FieldValue::SFNode(r) => *r = None,
+            FieldValue::MFNode(v) => {
+                v.remove(item);
+            }
+            FieldValue::Untyped { items, bracketed } => {
+                items.remove(item);
+                // An empty unbracketed value would not parse back.
+                *bracketed = true;
+            }
+            _ => {}
+        },
+    }
+}
+
+/// Adds a DEF'd `Transform` node for each of the face's transforms `transform_nodes` lacks
+/// (fields are written by the caller), moving the shapes of its meshes and the nodes of its
+/// child transforms into it. It takes the place of its first content that sits directly in
+/// the parent transform; when none does, it is appended to the parent's `children`.
+pub(super) fn insert_transforms(
+    scene: &mut Scene,
+    face: &FaceModel,
+    transform_nodes: &mut [Option<NodeId>],
+    mesh_nodes: &[NodeId],
+) {
+    let depth = |mut t: usize| {
+        let mut d = 0;
+        while let Some(p) = face.transforms[t].parent {
+            if d > face.transforms.len() {
+                break;
+            }
+            d += 1;
+            t = p;
+        }
+        d
+    };
+    // Deepest first: a new transform's new children exist when it is placed.
+    let mut missing: Vec<usize> = (0..face.transforms.len())
+        .filter(|&t| transform_nodes[t].is_none())
+        .collect();
+    missing.sort_by_key(|&t| std::cmp::Reverse(depth(t)));
+    for t in missing {
+        let all = slots(scene);
+        // The content: shapes of the transform's meshes, nodes of its child transforms.
+        let mut content: Vec<NodeId> = Vec::new();
+        for (m, mesh) in face.meshes.iter().enumerate() {
+            if mesh.transform != Some(t) {
+                continue;
+            }
+            if let Some(Slot::Field { node, .. }) = all.get(&mesh_nodes[m]) {
+                if scene.node(*node).type_name == "Shape" {
+                    content.push(*node);
+                }
+            }
+        }
+        for (c, tr) in face.transforms.iter().enumerate() {
+            if tr.parent == Some(t) {
+                content.extend(transform_nodes[c]);
+            }
+        }
+        let parent_node = face.transforms[t].parent.and_then(|p| transform_nodes[p]);
+        let mut node = Node::new("Transform");
+        node.def_name = Some(face.transforms[t].name.clone());
+        let id = scene.add_node(node);
+        let new_ref = NodeRef { id, is_use: false };
+        let anchor = content.iter().position(|c| {
+            all.get(c)
+                .is_some_and(|&s| enclosing_transform(scene, &all, s) == parent_node)
+        });
+        match anchor {
+            Some(k) => replace_at(scene, all[&content[k]], new_ref),
+            None => match parent_node {
+                Some(p) => {
+                    let mut kids = scene
+                        .node(p)
+                        .field("children")
+                        .map(|v| v.node_refs())
+                        .unwrap_or_default();
+                    kids.push(new_ref);
+                    set_field(&mut scene.nodes[p.0], "children", FieldValue::MFNode(kids));
+                }
+                None => scene.statements.push(Statement::Node(new_ref)),
+            },
+        }
+        // Take the rest out of their places (slots move as items go, so look each up again).
+        for (k, &c) in content.iter().enumerate() {
+            if Some(k) == anchor {
+                continue;
+            }
+            if let Some(&s) = slots(scene).get(&c) {
+                remove_at(scene, s);
+            }
+        }
+        let children = content
+            .iter()
+            .map(|&c| NodeRef {
+                id: c,
+                is_use: false,
+            })
+            .collect();
+        set_field(
+            &mut scene.nodes[id.0],
+            "children",
+            FieldValue::MFNode(children),
+        );
+        transform_nodes[t] = Some(id);
+    }
+}

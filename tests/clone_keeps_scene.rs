@@ -1,0 +1,156 @@
+//! Cloning onto a target file keeps every node of it fbakit does not read, also when the
+//! clone must add transforms: a face without a head transform (a `head` root is added, and
+//! eye transforms under it) whose tongue shares the jaw's transform with the lower teeth (a
+//! tongue transform is added under the jaw).
+
+mod support;
+
+use std::path::Path;
+
+use fbakit::face::{FaceModel, FaceTransform};
+use glam::Vec3;
+use support::cli::{fbakit, text};
+
+/// Nodes and declarations fbakit does not interpret, put at the top of the file.
+const HEADER_EXTRAS: &str = r#"
+PROTO Gadget [ field SFFloat speed 1 ] { Group { } }
+EXTERNPROTO Remote [ field SFInt32 level ] [ "remote.wrl#Remote" ]
+WorldInfo { title "keep me" info [ "a note" ] }
+DEF Cam Viewpoint { position 0 0 900 description "front camera" }
+NavigationInfo { type [ "EXAMINE" ] headlight FALSE }
+Background { skyColor [ 0.1 0.2 0.3 ] }
+DEF Sun DirectionalLight { direction 0 -1 -1 intensity 0.7 }
+Inline { url [ "props.wrl" ] }
+DEF Spinner MyGadget { speed 3 label "unknown fields" mode 0x1F }
+DEF Clock TimeSensor { cycleInterval 4 loop TRUE }
+"#;
+
+/// A shape fbakit does not read as a mesh, inside the face's own scene graph.
+const GRAPH_EXTRA: &str = r#"DEF Hat Shape { geometry Sphere { radius 12.5 } } "#;
+
+/// Everything above, as it must appear in the output.
+const KEPT: [&str; 18] = [
+    "PROTO Gadget",
+    "EXTERNPROTO Remote",
+    "remote.wrl#Remote",
+    "\"keep me\"",
+    "\"a note\"",
+    "DEF Cam Viewpoint",
+    "front camera",
+    "NavigationInfo",
+    "skyColor",
+    "DEF Sun DirectionalLight",
+    "props.wrl",
+    "DEF Spinner MyGadget",
+    "\"unknown fields\"",
+    "0x1F",
+    "DEF Clock TimeSensor",
+    "ROUTE Clock.fraction_changed TO Spinner.set_fraction",
+    "DEF Hat Shape",
+    "radius 12.5",
+];
+
+/// bruno without a FAT and without transforms, except one `jaw_tf` root holding the lower
+/// teeth and the tongue; the meshes keep their world positions.
+fn flat_bruno() -> FaceModel {
+    let bruno = fbakit::face::read("bruno").unwrap();
+    let frames = bruno.frames();
+    let mut face = fbakit::export::picture::strip_fat(&bruno);
+    face.transforms = vec![FaceTransform::new("jaw_tf", None, Vec3::ZERO)];
+    for (m, mesh) in face.meshes.iter_mut().enumerate() {
+        for p in &mut mesh.mesh.positions {
+            *p = frames.meshes[m].transform_point3(*p);
+        }
+        mesh.transform = ["teeth_lower", "tongue"]
+            .contains(&mesh.name.as_str())
+            .then_some(0);
+    }
+    face
+}
+
+/// The target file: `flat_bruno` with the extras spliced in.
+fn target_text() -> String {
+    let base = fbakit::face::vrml::write_face_string(&flat_bruno()).unwrap();
+    let header_end = base.find('\n').unwrap() + 1;
+    let mut text = format!(
+        "{}{HEADER_EXTRAS}{}",
+        &base[..header_end],
+        &base[header_end..]
+    );
+    let graph = text.find("faceSceneGraph [").expect("a face scene graph") + 16;
+    text.insert_str(graph, GRAPH_EXTRA);
+    text.push_str("ROUTE Clock.fraction_changed TO Spinner.set_fraction\n");
+    text
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn cloning_keeps_unknown_nodes_when_it_adds_transforms() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("target.wrl");
+    std::fs::write(&target, target_text()).unwrap();
+    // The target reads as the flat face (the extras are not part of it).
+    let (read_target, _) = fbakit::face::read_with(&target, &Default::default()).unwrap();
+    assert_eq!(read_target.transforms.len(), 1);
+    assert_eq!(read_target.meshes.len(), flat_bruno().meshes.len());
+
+    let out = dir.path().join("cloned.wrl");
+    let o = fbakit(&["clone", "alma", s(&target), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(err.contains("created transforms"), "{err}");
+    assert!(!err.contains("new scene"), "{err}");
+
+    let written = std::fs::read_to_string(&out).unwrap();
+    for kept in KEPT {
+        assert!(written.contains(kept), "`{kept}` lost:\n{written}");
+    }
+    // Reads back with the new transforms around the old content, in the same places.
+    let (cloned, _) = fbakit::face::read_with(&out, &Default::default()).unwrap();
+    let names: Vec<&str> = cloned.transforms.iter().map(|t| t.name.as_str()).collect();
+    for t in ["head", "jaw_tf", "tongue_tf"] {
+        assert!(names.contains(&t), "{t} missing from {names:?}");
+    }
+    let parent = |t: &str| {
+        let i = cloned.transform_index(t).unwrap();
+        cloned.transforms[i]
+            .parent
+            .map(|p| cloned.transforms[p].name.as_str())
+    };
+    assert_eq!(parent("head"), None);
+    assert_eq!(parent("jaw_tf"), Some("head"));
+    assert_eq!(parent("tongue_tf"), Some("jaw_tf"));
+    let tongue = cloned.mesh_index("tongue").unwrap();
+    assert_eq!(
+        cloned.meshes[tongue].transform,
+        cloned.transform_index("tongue_tf")
+    );
+    assert!(!cloned.fat.tables.is_empty());
+    let flat = flat_bruno();
+    let (frames, flat_frames) = (cloned.frames(), flat.frames());
+    for (m, mesh) in flat.meshes.iter().enumerate() {
+        let c = cloned.mesh_index(&mesh.name).unwrap();
+        let worst = mesh
+            .mesh
+            .positions
+            .iter()
+            .zip(&cloned.meshes[c].mesh.positions)
+            .map(|(a, b)| {
+                flat_frames.meshes[m]
+                    .transform_point3(*a)
+                    .distance(frames.meshes[c].transform_point3(*b))
+            })
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-3, "{} moved by {worst}", mesh.name);
+    }
+
+    // And plays.
+    let glb = dir.path().join("speech.glb");
+    let stream = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/speech.fap");
+    let o = fbakit(&["play", s(&out), s(&stream), "-o", s(&glb)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    assert!(glb.exists());
+}
