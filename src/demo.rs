@@ -43,7 +43,7 @@ pub struct DemoOptions {
 
 impl Default for DemoOptions {
     /// The written outputs use the library's default method ([`Method::default`]); the
-    /// report measures both methods on alma→bruno.
+    /// report measures every method on alma→bruno.
     fn default() -> Self {
         DemoOptions {
             method: Method::default(),
@@ -301,14 +301,14 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         [".wrl", ".glb", ".png"].iter().any(|e| n.ends_with(e))
     })?;
 
-    let other = match opts.method {
-        Method::Fmc => Method::Rbf,
-        Method::Rbf | Method::Fit => Method::Fmc,
-    };
     let (main_quality, outcome) = measure(&alma, &target, &truth, opts.method, &mut clock)?;
     let mut quality = vec![main_quality];
     if opts.compare_methods {
-        quality.push(measure(&alma, &target, &truth, other, &mut clock)?.0);
+        for other in [Method::Fit, Method::Fmc, Method::Rbf] {
+            if other != opts.method {
+                quality.push(measure(&alma, &target, &truth, other, &mut clock)?.0);
+            }
+        }
     }
     warnings.extend(outcome.report.warnings.iter().cloned());
     let mut bruno = outcome.face;

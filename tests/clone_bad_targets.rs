@@ -14,7 +14,7 @@ use glam::Vec3;
 use support::cli::{fbakit, text};
 
 /// The cloning methods under test (add a method here and every case runs with it).
-const METHODS: &[&str] = &["fmc", "rbf"];
+const METHODS: &[&str] = &["fit", "fmc", "rbf"];
 
 /// A clean target: bruno without its FAT, one skin mesh free of UV and normal indices so
 /// polygons can be edited.

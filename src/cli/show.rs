@@ -101,7 +101,7 @@ pub struct DemoArgs {
     /// Output directory (created).
     #[arg(long, default_value = "fbakit-demo", value_name = "DIR")]
     pub out: PathBuf,
-    /// Cloning method for the outputs (the other one is measured too unless --single).
+    /// Cloning method for the outputs (the other methods are measured too unless --single).
     #[arg(long, value_enum, default_value_t)]
     pub method: MethodArg,
     /// Only run the chosen method (skip the comparison with the other one).

@@ -6,19 +6,20 @@ use crate::clone::fit::FitOptions;
 use crate::clone::fmc::{FmcOptions, NormalisationMode, OverlapRule};
 use crate::clone::rbf::RbfOptions;
 
-/// Which surface method clones the skin. The default, `Fmc`, is the one every command uses
-/// unless told otherwise: on the bundled procedural faces both reach the same figures (`Fmc`
-/// leaves faint seams at bruno's chin), but on the real ICT-FaceKit head `Rbf` tears the
-/// mouth open (its inner-lip contours are not found on that mesh) where `Fmc` keeps it whole.
+/// Which surface method clones the skin. The default, `Fit`, is the one every command uses
+/// unless told otherwise: on the real-head ground truth (ICT-FaceKit heads with known FATs)
+/// it has the lowest error of the three (median 2.6 % against fmc's 7.4 % and rbf's 5.5 %,
+/// better than fmc on every FAP), and on alma → bruno too (25.5 % against 30.6 / 31.5 %).
+/// `Fmc` is the fastest.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
     /// Pandžić 2003 ([`crate::clone::fmc`]).
-    #[default]
     Fmc,
     /// Fratarcangeli & Schaerf 2005 ([`crate::clone::rbf`]).
     Rbf,
     /// Dense correspondence by non-rigid registration ([`crate::clone::fit`]).
+    #[default]
     Fit,
 }
 
