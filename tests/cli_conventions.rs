@@ -161,7 +161,7 @@ fn one_default_cloning_method() {
         &["eval", "self-clone", "--help"],
     ] {
         let help = text(&fbakit(args).stdout);
-        assert!(help.contains("[default: fmc]"), "{args:?}:\n{help}");
+        assert!(help.contains("[default: fit]"), "{args:?}:\n{help}");
     }
 }
 

@@ -69,7 +69,12 @@ fn validate_exit_codes() {
     std::fs::write(&bin, b"\x00\xff\xfe garbage").unwrap();
     let o = fbakit(&["fap", "validate", bin.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("bin.fap:1:2: expected UTF-8 text"));
+    // Binary data is refused at its first NUL byte, before any UTF-8 check.
+    assert!(String::from_utf8_lossy(&o.stderr).contains("bin.fap:1:1: expected text"));
+    std::fs::write(&bin, b"2.1 x 25 1\n\xff\xfe garbage").unwrap();
+    let o = fbakit(&["fap", "validate", bin.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("bin.fap:2:1: expected UTF-8 text"));
 }
 
 #[test]

@@ -196,9 +196,10 @@ pub enum Command {
     /// Clone the facial animation (FAT) of a source face onto a target face.
     #[command(
         long_about = "Clone the Facial Animation Tables of SOURCE onto TARGET: the skin by \
-                      facial motion cloning (fmc, Pandzic 2003) or RBF cloning (rbf, \
-                      Fratarcangeli & Schaerf 2005), eyes, teeth, tongue and head by their \
-                      transforms. Faces are VRML face files, or OBJ meshes with a \
+                      dense correspondence from a landmark-guided non-rigid registration \
+                      (fit, the default), facial motion cloning (fmc, Pandzic 2003) or RBF \
+                      cloning (rbf, Fratarcangeli & Schaerf 2005), eyes, teeth, tongue and \
+                      head by their transforms. Faces are VRML face files, or OBJ meshes with a \
                       feature-point file. Exit codes: 0 ok, 2 bad usage or input (including \
                       missing feature points), 1 other failures.",
         after_help = "Examples:\n  fbakit clone alma.wrl bruno.wrl -o bruno-animated.wrl\n  \

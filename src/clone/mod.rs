@@ -26,6 +26,7 @@ pub mod fit;
 pub mod fmc;
 pub mod quality;
 pub mod rbf;
+mod tri_filter;
 
 pub use error::CloneError;
 

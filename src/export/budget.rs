@@ -47,19 +47,28 @@ pub fn check_clip(output: &Path, frames: &Range<usize>, face: &FaceModel) -> Res
     if estimate <= MAX_CLIP_MEMORY_BYTES {
         return Ok(());
     }
-    Err(super::ExportError::OverBudget {
-        output: output.to_path_buf(),
-        start: frames.start,
-        end: frames.end,
-        frames: n,
-        over: format!(
+    Err(over_budget(
+        output,
+        frames,
+        format!(
             "about {} MB of memory while the clip is built, more than the {} MB a clip may take",
             estimate >> 20,
             MAX_CLIP_MEMORY_BYTES >> 20
         ),
+    ))
+}
+
+/// The refusal of `frames` written to `output`, `over` saying which limit is passed.
+fn over_budget(output: &Path, frames: &Range<usize>, over: String) -> crate::error::Error {
+    super::ExportError::OverBudget {
+        output: output.to_path_buf(),
+        start: frames.start,
+        end: frames.end,
+        frames: frames.len(),
+        over,
         advice: String::new(),
     }
-    .into())
+    .into()
 }
 
 /// Bytes per OBJ frame file: positions written as text (about 36 bytes a vertex) and the
@@ -97,15 +106,7 @@ pub fn check(output: &Path, frames: &Range<usize>, bytes_per_frame: u64) -> Resu
     } else {
         return Ok(());
     };
-    Err(super::ExportError::OverBudget {
-        output: output.to_path_buf(),
-        start: frames.start,
-        end: frames.end,
-        frames: n,
-        over,
-        advice: String::new(),
-    }
-    .into())
+    Err(over_budget(output, frames, over))
 }
 
 #[cfg(test)]

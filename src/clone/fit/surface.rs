@@ -5,14 +5,11 @@
 use std::collections::HashMap;
 
 use glam::Vec3;
-use parry3d::math::{Pose, Vector as PVec};
-use parry3d::partitioning::Bvh;
-use parry3d::query::details::NormalConstraints;
-use parry3d::shape::{
-    CompositeShape, CompositeShapeRef, Shape, TriMesh, Triangle, TypedCompositeShape,
-};
+use parry3d::math::Vector as PVec;
+use parry3d::shape::{CompositeShapeRef, TriMesh};
 
 use super::regions::TriMask;
+use crate::clone::tri_filter::FilteredTriMesh;
 
 /// A closest-point hit.
 #[derive(Clone, Copy, Debug)]
@@ -46,58 +43,15 @@ pub(crate) struct Filter {
     pub normal: Option<(Vec3, f32)>,
 }
 
-struct View<'a> {
-    s: &'a QuerySurface,
-    mesh: &'a TriMesh,
-    filter: Filter,
-}
-
-impl View<'_> {
-    fn allowed(&self, i: u32) -> bool {
+impl QuerySurface {
+    /// Whether triangle `i` passes `filter` (side mask and normal compatibility).
+    fn allowed(&self, filter: Filter, i: u32) -> bool {
         let i = i as usize;
-        let mask_ok = self.s.masks.get(i).is_none_or(|m| m & self.filter.bit != 0);
+        let mask_ok = self.masks.get(i).is_none_or(|m| m & filter.bit != 0);
         mask_ok
-            && self
-                .filter
+            && filter
                 .normal
-                .is_none_or(|(n, c)| self.s.normals.get(i).is_none_or(|t| t.dot(n) >= c))
-    }
-}
-
-impl CompositeShape for View<'_> {
-    fn map_part_at(
-        &self,
-        shape_id: u32,
-        f: &mut dyn FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>),
-    ) {
-        let _ = self.map_untyped_part_at(shape_id, f);
-    }
-
-    fn bvh(&self) -> &Bvh {
-        self.mesh.bvh()
-    }
-}
-
-impl TypedCompositeShape for View<'_> {
-    type PartShape = Triangle;
-    type PartNormalConstraints = ();
-
-    fn map_typed_part_at<T>(
-        &self,
-        i: u32,
-        mut f: impl FnMut(Option<&Pose>, &Triangle, Option<&()>) -> T,
-    ) -> Option<T> {
-        self.allowed(i)
-            .then(|| f(None, &self.mesh.triangle(i), None))
-    }
-
-    fn map_untyped_part_at<T>(
-        &self,
-        i: u32,
-        mut f: impl FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>) -> T,
-    ) -> Option<T> {
-        self.allowed(i)
-            .then(|| f(None, &self.mesh.triangle(i), None))
+                .is_none_or(|(n, c)| self.normals.get(i).is_none_or(|t| t.dot(n) >= c))
     }
 }
 
@@ -155,10 +109,9 @@ impl QuerySurface {
         if !p.is_finite() {
             return None;
         }
-        let view = View {
-            s: self,
+        let view = FilteredTriMesh {
             mesh,
-            filter,
+            allowed: |i| self.allowed(filter, i),
         };
         let (tri, proj, _) = CompositeShapeRef(&view).project_local_point_and_get_location(
             PVec::new(p.x, p.y, p.z),

@@ -5,15 +5,12 @@
 use std::collections::HashMap;
 
 use glam::Vec3;
-use parry3d::math::{Pose, Vector as PVec};
-use parry3d::partitioning::Bvh;
-use parry3d::query::details::NormalConstraints;
+use parry3d::math::Vector as PVec;
 use parry3d::query::Ray;
-use parry3d::shape::{
-    CompositeShape, CompositeShapeRef, Shape, TriMesh, Triangle, TypedCompositeShape,
-};
+use parry3d::shape::{CompositeShapeRef, TriMesh};
 
 use super::regions::{Region, TriRegion};
+use crate::clone::tri_filter::FilteredTriMesh;
 
 /// Sorted, de-duplicated neighbours of every vertex (edges of the triangles).
 pub(crate) fn adjacency(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
@@ -184,61 +181,16 @@ pub(crate) struct RegionBvh {
     regions: Vec<TriRegion>,
 }
 
-/// The surface as seen from one region: the same BVH, with the other lip's triangles
-/// skipped during traversal (so no second BVH has to be built).
-struct View<'a> {
-    mesh: &'a TriMesh,
-    regions: &'a [TriRegion],
-    query: Region,
-}
-
-impl View<'_> {
-    fn allowed(&self, triangle: u32) -> bool {
-        let Some(r) = self.regions.get(triangle as usize) else {
-            return true;
-        };
-        match self.query {
-            Region::Other => true,
-            Region::Upper => matches!(r, TriRegion::Other | TriRegion::Upper),
-            Region::Lower => matches!(r, TriRegion::Other | TriRegion::Lower),
-        }
-    }
-}
-
-impl CompositeShape for View<'_> {
-    fn map_part_at(
-        &self,
-        shape_id: u32,
-        f: &mut dyn FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>),
-    ) {
-        let _ = self.map_untyped_part_at(shape_id, f);
-    }
-
-    fn bvh(&self) -> &Bvh {
-        self.mesh.bvh()
-    }
-}
-
-impl TypedCompositeShape for View<'_> {
-    type PartShape = Triangle;
-    type PartNormalConstraints = ();
-
-    fn map_typed_part_at<T>(
-        &self,
-        i: u32,
-        mut f: impl FnMut(Option<&Pose>, &Triangle, Option<&()>) -> T,
-    ) -> Option<T> {
-        self.allowed(i)
-            .then(|| f(None, &self.mesh.triangle(i), None))
-    }
-
-    fn map_untyped_part_at<T>(
-        &self,
-        i: u32,
-        mut f: impl FnMut(Option<&Pose>, &dyn Shape, Option<&dyn NormalConstraints>) -> T,
-    ) -> Option<T> {
-        self.allowed(i)
-            .then(|| f(None, &self.mesh.triangle(i), None))
+/// Whether a triangle of `regions` is seen from `query`: a query from one lip never sees
+/// the other lip's triangles.
+fn region_allows(regions: &[TriRegion], query: Region, triangle: u32) -> bool {
+    let Some(r) = regions.get(triangle as usize) else {
+        return true;
+    };
+    match query {
+        Region::Other => true,
+        Region::Upper => matches!(r, TriRegion::Other | TriRegion::Upper),
+        Region::Lower => matches!(r, TriRegion::Other | TriRegion::Lower),
     }
 }
 
@@ -252,11 +204,12 @@ impl RegionBvh {
         }
     }
 
-    fn view(&self, region: Region) -> Option<View<'_>> {
-        Some(View {
+    /// The surface as seen from `region`: the same BVH, the other lip's triangles skipped.
+    fn view(&self, region: Region) -> Option<FilteredTriMesh<'_, impl Fn(u32) -> bool + '_>> {
+        let regions = &self.regions;
+        Some(FilteredTriMesh {
             mesh: self.mesh.as_ref()?,
-            regions: &self.regions,
-            query: region,
+            allowed: move |i| region_allows(regions, region, i),
         })
     }
 
