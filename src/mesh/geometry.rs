@@ -278,6 +278,63 @@ pub fn validate(mesh: &Mesh) -> MeshValidation {
     v
 }
 
+/// Unit normals of triangles (zero for degenerate ones and for triangles with an index out of
+/// range).
+pub fn triangle_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| positions.get(v as usize).copied().unwrap_or(Vec3::ZERO));
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect()
+}
+
+/// Barycentric weights of `p` (on or near triangle `a b c`), clamped to the triangle and
+/// summing to one; a degenerate triangle gives its nearest corner weight one.
+pub fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+    let (e0, e1, ep) = ((b - a).as_dvec3(), (c - a).as_dvec3(), (p - a).as_dvec3());
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let (d20, d21) = (ep.dot(e0), ep.dot(e1));
+    let denom = d00 * d11 - d01 * d01;
+    let scale = d00.max(d11);
+    if denom.is_nan() || denom <= 1e-12 * scale * scale {
+        let d = [p.distance(a), p.distance(b), p.distance(c)];
+        let k = (0..3).min_by(|&i, &j| d[i].total_cmp(&d[j])).unwrap_or(0);
+        let mut w = [0.0; 3];
+        w[k] = 1.0;
+        return w;
+    }
+    let v = (d11 * d20 - d01 * d21) / denom;
+    let w = (d00 * d21 - d01 * d20) / denom;
+    let out = [(1.0 - v - w).max(0.0), v.max(0.0), w.max(0.0)];
+    let s: f64 = out.iter().sum();
+    if s.is_nan() || s <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    out.map(|x| (x / s) as f32)
+}
+
+/// Sorted, de-duplicated neighbours of every vertex (the edges of `triangles`; indices out of
+/// range are skipped).
+pub fn adjacency(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut adj = vec![Vec::new(); vertex_count];
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if a != b && (a as usize) < vertex_count && (b as usize) < vertex_count {
+                adj[a as usize].push(b);
+                adj[b as usize].push(a);
+            }
+        }
+    }
+    for n in &mut adj {
+        n.sort_unstable();
+        n.dedup();
+    }
+    adj
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,25 +11,7 @@ use parry3d::shape::{CompositeShapeRef, TriMesh};
 
 use super::regions::{Region, TriRegion};
 use crate::clone::tri_filter::FilteredTriMesh;
-
-/// Sorted, de-duplicated neighbours of every vertex (edges of the triangles).
-pub(crate) fn adjacency(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut adj = vec![Vec::new(); vertex_count];
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a != b {
-                adj[a as usize].push(b);
-                adj[b as usize].push(a);
-            }
-        }
-    }
-    for n in &mut adj {
-        n.sort_unstable();
-        n.dedup();
-    }
-    adj
-}
+pub(crate) use crate::mesh::geometry::{adjacency, barycentric, triangle_normals};
 
 /// The triangles around each vertex (compressed rows), to find the triangles on either side
 /// of an edge without a hash map over all edges.
@@ -87,43 +69,6 @@ impl VertexTriangles {
             }
         })
     }
-}
-
-/// Unit normals of the triangles (zero for degenerate ones).
-pub(crate) fn triangle_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
-    triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| positions[v as usize]);
-            (b - a).cross(c - a).normalize_or_zero()
-        })
-        .collect()
-}
-
-/// Barycentric coordinates `(wa, wb, wc)` of `p` with respect to triangle `a b c`, for a
-/// point on (or very near) the triangle. Small negative weights from rounding are clamped and
-/// the weights renormalised; a degenerate triangle gives its vertex nearest to `p` weight 1.
-pub(crate) fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
-    let (e0, e1, ep) = ((b - a).as_dvec3(), (c - a).as_dvec3(), (p - a).as_dvec3());
-    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
-    let (d20, d21) = (ep.dot(e0), ep.dot(e1));
-    let denom = d00 * d11 - d01 * d01;
-    let scale = d00.max(d11);
-    if denom.is_nan() || denom <= 1e-12 * scale * scale {
-        let d = [p.distance(a), p.distance(b), p.distance(c)];
-        let k = (0..3).min_by(|&i, &j| d[i].total_cmp(&d[j])).unwrap_or(0);
-        let mut w = [0.0; 3];
-        w[k] = 1.0;
-        return w;
-    }
-    let v = (d11 * d20 - d01 * d21) / denom;
-    let w = (d00 * d21 - d01 * d20) / denom;
-    let mut out = [(1.0 - v - w).max(0.0), v.max(0.0), w.max(0.0)];
-    let s: f64 = out.iter().sum();
-    for x in &mut out {
-        *x /= s;
-    }
-    out.map(|x| x as f32)
 }
 
 /// Groups of vertices at the same position (within `eps`): `class[v]` is the smallest vertex
