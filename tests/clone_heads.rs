@@ -209,14 +209,15 @@ fn lower_teeth_follow_the_jaw_upper_teeth_stay() {
     }
 }
 
-/// A target whose feature point 2.3 (the bottom inner-lip midpoint) has been rebound to a
-/// vertex at the back of the head: the lips are split wrongly and inner-lip FAPs leave their
+/// A target (bruno: not alma's mesh, whose welding a clone from alma would reuse) whose
+/// feature point 2.3 (the bottom inner-lip midpoint) has been rebound to a vertex at the
+/// back of the head: the lips are split wrongly and inner-lip FAPs leave their
 /// feature points still, so they fail the guard (repaired or dropped). Without --strict the clone is written and the failure reported; with it,
 /// exit 1 and nothing written.
 #[test]
 fn strict_refuses_failed_faps() {
     let dir = tempfile::tempdir().unwrap();
-    let mut target = strip_fat(&fbakit::face::read("alma").unwrap());
+    let mut target = strip_fat(&fbakit::face::read("bruno").unwrap());
     let id = FeaturePointId::FP_2_3;
     let skin = target.mesh_index("skin").expect("alma has a skin mesh");
     let back = target.meshes[skin]

@@ -113,6 +113,7 @@ mod align;
 mod assemble;
 mod motions;
 mod options;
+mod part_deform;
 mod part_motion;
 mod parts;
 mod report;
@@ -131,7 +132,7 @@ pub use parts::{identify_parts, FaceParts, Part};
 pub use report::{CloneOutcome, CloneReport, RigidReport};
 pub use rescale::FapFailure;
 pub use rigid::install_center;
-pub use skin_surface::{build_skin_surface, SkinSurface};
+pub use skin_surface::{build_skin_surface, build_skin_surface_like, SkinSurface};
 pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 
 use super::fit::clone_fit;
@@ -140,7 +141,7 @@ use super::rbf::clone_rbf;
 use super::{CloneSurface, SurfaceCloneResult, SurfaceMotion};
 use crate::error::{Error, Result};
 use crate::face::FaceModel;
-use crate::fat::morph::fat_to_morph_targets;
+use crate::fat::morph::{fat_to_morph_targets, MorphTarget};
 use crate::fat::{Fat, TableKey};
 use align::{alignment_rms, face_alignment};
 use assemble::{assemble_fat, ClonedMotions, SourceMotions};
@@ -219,7 +220,7 @@ pub fn clone_face(
     // 3. Surfaces.
     let clock = Instant::now();
     let ssurf = build_skin_surface(source, &sparts.skin, &Similarity::IDENTITY)?;
-    let tsurf = build_skin_surface(target, &tparts.skin, &alignment)?;
+    let tsurf = build_skin_surface_like(target, &tparts.skin, &alignment, Some(&ssurf))?;
     report.surface_vertices = [ssurf.surface.positions.len(), tsurf.surface.positions.len()];
     report
         .timings
@@ -246,13 +247,36 @@ pub fn clone_face(
     report.timings.push("rigid", clock.elapsed().as_secs_f64());
     // 8. FAT.
     let clock = Instant::now();
+    // Part meshes the source deforms (its tongue) bend the target's part of that role; the
+    // rigid step sees only what is left.
+    let deformed = part_deform::part_deformations(
+        source,
+        &sparts,
+        &targets,
+        &face,
+        &tparts,
+        &alignment,
+        &tsurf.surface.fapu,
+    );
+    let rigid_targets: Vec<MorphTarget> = targets
+        .iter()
+        .map(|t| MorphTarget {
+            meshes: t
+                .meshes
+                .iter()
+                .filter(|m| !deformed.handled.contains(&m.mesh))
+                .cloned()
+                .collect(),
+            ..t.clone()
+        })
+        .collect();
     let source_motions = SourceMotions {
         face: source,
         parts: &sparts,
-        targets: &targets,
+        targets: &rigid_targets,
     };
     // Split target parts the source moves only by deformation get that motion, rigidly.
-    let part_meshes = part_motion::part_motions(
+    let mut part_meshes = part_motion::part_motions(
         &sparts,
         &report.split_parts,
         &face,
@@ -261,6 +285,9 @@ pub fn clone_face(
         &alignment,
         &motions,
     );
+    for (key, meshes) in deformed.meshes {
+        part_meshes.entry(key).or_default().extend(meshes);
+    }
     let cloned = ClonedMotions {
         skin: cloned,
         parts: part_meshes,

@@ -80,6 +80,9 @@ pub(super) fn back_to_meshes(
         }
         let face_d = frame.inverse_vector(d.as_dvec3());
         for &c in skin.duplicates(w) {
+            if !skin.referenced.get(c as usize).copied().unwrap_or(false) {
+                continue;
+            }
             let k = skin.starts.partition_point(|&s| s <= c as usize) - 1;
             let local = c - skin.starts[k] as u32;
             per_mesh[k].push((local, inv[k] * face_d));

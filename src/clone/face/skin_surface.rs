@@ -27,6 +27,12 @@ pub struct SkinSurface {
     pub starts: Vec<usize>,
     /// Surface vertex of each concatenated vertex.
     pub welded: Vec<u32>,
+    /// Whether each concatenated vertex is a corner of some polygon. A point in no polygon
+    /// is invisible (CANDIDE-3 keeps unused copies of its midline points); cloned motion
+    /// never goes to it, as no FAT would move it.
+    pub referenced: Vec<bool>,
+    /// The concatenated meshes' triangles (before welding).
+    concat_triangles: Vec<[u32; 3]>,
     /// Concatenated vertices of each surface vertex (CSR: `members[member_start[w]..[w+1]]`).
     member_start: Vec<u32>,
     members: Vec<u32>,
@@ -54,6 +60,19 @@ pub fn build_skin_surface(
     skin: &[usize],
     frame: &Similarity,
 ) -> Result<SkinSurface> {
+    build_skin_surface_like(face, skin, frame, None)
+}
+
+/// [`build_skin_surface`], welded exactly as `like` when both skins are one mesh (the same
+/// vertex count and polygons): a face and its reshaped or rescaled copy may have seams that
+/// coincide on one and not on the other, and the same welding keeps their surfaces one mesh
+/// (so [`fit`](crate::clone::fit) matches them vertex to vertex).
+pub fn build_skin_surface_like(
+    face: &FaceModel,
+    skin: &[usize],
+    frame: &Similarity,
+    like: Option<&SkinSurface>,
+) -> Result<SkinSurface> {
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
     let (positions, triangles, starts) = concatenate_skin(face, &frames, skin, frame);
@@ -65,11 +84,34 @@ pub fn build_skin_surface(
         .into());
     }
     let (fp_positions, fapu) = framed_feature_points(face, frame)?;
+    let mut referenced = vec![false; positions.len()];
+    for &v in triangles.iter().flatten() {
+        referenced[v as usize] = true;
+    }
     // Weld, keeping the closed mouth apart.
     let eps = diag * frame.scale as f32 * 1e-6;
     let mouth = mouth_box(&fp_positions, &fapu);
-    let (welded, surface_positions) = weld_outside_mouth(&positions, eps, mouth);
+    let (welded, surface_positions) = match like {
+        Some(l) if l.welded.len() == positions.len() && l.concat_triangles == triangles => {
+            let count = l.welded.iter().map(|&w| w as usize + 1).max().unwrap_or(0);
+            let mut surface_positions = vec![Vec3::ZERO; count];
+            // Each surface vertex at its first member in a polygon (copies on the other
+            // face need not coincide here: an unused copy does not follow a reshape).
+            let mut placed = vec![false; count];
+            for pass_referenced in [true, false] {
+                for (i, &w) in l.welded.iter().enumerate() {
+                    if !placed[w as usize] && (referenced[i] || !pass_referenced) {
+                        placed[w as usize] = true;
+                        surface_positions[w as usize] = positions[i];
+                    }
+                }
+            }
+            (l.welded.clone(), surface_positions)
+        }
+        _ => weld_outside_mouth(&positions, eps, mouth),
+    };
     let (member_start, members) = duplicate_lists(&welded, surface_positions.len());
+
     let tris: Vec<[u32; 3]> = triangles
         .iter()
         .map(|t: &[u32; 3]| t.map(|v| welded[v as usize]))
@@ -97,6 +139,8 @@ pub fn build_skin_surface(
         meshes: skin.to_vec(),
         starts,
         welded,
+        referenced,
+        concat_triangles: triangles,
         member_start,
         members,
     })

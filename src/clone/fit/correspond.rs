@@ -8,6 +8,13 @@
 //! not cover (a source mask onto a whole head: the back of the head, the neck) lie far from
 //! it; their weight fades from 1 at [`FitOptions::fade`]`.0` × ES0 to 0 at `.1` × ES0, so
 //! they stay still instead of copying a border's motion.
+//!
+//! Seams: a target vertex that coincides with another (an unwelded seam, such as the
+//! duplicated midline of CANDIDE-3, whose FAT may move one copy and not the other) picks its
+//! source triangle from a point moved a little into its own triangles, then takes its weights
+//! at its true position in that triangle. Each copy so lands on the source triangles of its
+//! own side of the seam, and a seam vertex of a face cloned onto itself reads exactly its own
+//! vertex's motion.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -16,9 +23,62 @@ use super::regions::{query_bit, Side};
 use super::surface::{Filter, QuerySurface};
 use super::FitOptions;
 use crate::mesh::geometry::vertex_normals;
+use crate::mesh::spatial::find_coincident_vertices;
 
 /// Points closer than this (× ES0) to the surface match without the normal test.
 pub(crate) const SNAP: f32 = 1e-4;
+
+/// Vertices closer than this (× ES0) are copies of one point (a seam).
+const SEAM: f32 = 1e-6;
+
+/// How far (as a fraction of the way to the centroid of its triangles) a seam vertex looks
+/// into its own side for its source triangle: far enough to leave the seam behind, near
+/// enough to stay on the vertex's own triangles of the source.
+const SEAM_STEP: f32 = 0.25;
+
+/// How much farther (× ES0) than the closest point a seam vertex's own-side point may lie.
+const SEAM_SLACK: f32 = 0.01;
+
+/// For every target vertex that is a copy of another: where it looks for its source triangle
+/// (the centroid of its triangles' centroids, [`SEAM_STEP`] of the way from it); `None`
+/// elsewhere.
+fn seam_probes(target: &[Vec3], triangles: &[[u32; 3]], scale: f32) -> Vec<Option<Vec3>> {
+    let mut probes = vec![None; target.len()];
+    let clusters = find_coincident_vertices(target, SEAM * scale).clusters;
+    if clusters.is_empty() {
+        return probes;
+    }
+    let mut on_seam = vec![false; target.len()];
+    for &v in clusters.iter().flatten() {
+        if let Some(s) = on_seam.get_mut(v as usize) {
+            *s = true;
+        }
+    }
+    let mut sum = vec![(Vec3::ZERO, 0u32); target.len()];
+    for t in triangles {
+        let Some(c) = t
+            .iter()
+            .map(|&v| target.get(v as usize).copied())
+            .sum::<Option<Vec3>>()
+        else {
+            continue;
+        };
+        for &v in t {
+            if on_seam[v as usize] {
+                let e = &mut sum[v as usize];
+                e.0 += c / 3.0;
+                e.1 += 1;
+            }
+        }
+    }
+    for (v, &(c, n)) in sum.iter().enumerate() {
+        if n > 0 {
+            let p = target[v];
+            probes[v] = Some(p + (c / n as f32 - p) * SEAM_STEP);
+        }
+    }
+    probes
+}
 
 /// Where one target vertex lies on the source.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,14 +106,29 @@ pub(crate) fn correspond(
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let (near, far) = (opts.fade.0 as f32 * scale, opts.fade.1 as f32 * scale);
     let snap = SNAP * scale;
+    let probes = seam_probes(target, target_triangles, scale);
+    let seam_slack = SEAM_SLACK * scale;
     target
         .par_iter()
         .enumerate()
         .map(|(i, &p)| {
             let bit = query_bit(sides.get(i).copied().unwrap_or(Side::Other));
             let nrm = normals.get(i).copied().unwrap_or(Vec3::ZERO);
+            let any = Filter { bit, normal: None };
             // A point on the surface is its own match, whatever the normals at a crease say.
-            let plain = source.closest(p, Filter { bit, normal: None })?;
+            let plain = match probes.get(i).copied().flatten() {
+                Some(q) => {
+                    let plain = source.closest(p, any)?;
+                    // The probe's triangle, unless it lies clearly farther from the vertex
+                    // than the closest one (the seam opened during registration).
+                    source
+                        .closest(q, any)
+                        .and_then(|h| source.within(h.triangle, p))
+                        .filter(|h| h.point.distance(p) <= plain.point.distance(p) + seam_slack)
+                        .unwrap_or(plain)
+                }
+                None => source.closest(p, any)?,
+            };
             let hit = if plain.point.distance(p) <= snap || nrm == Vec3::ZERO {
                 plain
             } else {

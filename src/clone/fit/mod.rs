@@ -29,6 +29,13 @@
 //!    value moves the target by its own FAPU (compliance), and no vertex exceeds the largest
 //!    source displacement of the FAP in FAPU. Motions run in parallel (rayon).
 //!
+//! **One topology.** When both surfaces are one mesh — the same vertex count and the same
+//! triangles, as a face and its reshaped, rescaled or re-posed copy, or two identities of one
+//! template — vertex `i` of the target *is* vertex `i` of the source, so steps 1–3 are
+//! skipped and each target vertex takes its own vertex's motion (times the FAPU ratio). A
+//! registration could only approximate that correspondence
+//! ([`FitOptions::shared_topology`] turns it off).
+//!
 //! The source is registered onto the target, not the other way: the source's motion field
 //! is what must be sampled, and the target vertices then sample it where the registered
 //! source lies under them. A surface cloned onto itself registers to itself (every closest
@@ -81,6 +88,9 @@ pub struct FitOptions {
     /// Scale each low-level translation FAP by the target / source FAPU ratio of its unit.
     /// Default on.
     pub fapu_scale: bool,
+    /// Surfaces with the same vertex count and triangles correspond vertex to vertex, without
+    /// registration (module docs). Default on.
+    pub shared_topology: bool,
 }
 
 impl Default for FitOptions {
@@ -94,6 +104,7 @@ impl Default for FitOptions {
             max_distance: 0.25,
             fade: (0.05, 0.25),
             fapu_scale: true,
+            shared_topology: true,
         }
     }
 }
@@ -126,6 +137,11 @@ fn used_vertices(s: &CloneSurface) -> Vec<bool> {
         }
     }
     used
+}
+
+/// Whether `a` and `b` are one mesh: as many vertices and the same triangles.
+fn same_topology(a: &CloneSurface, b: &CloneSurface) -> bool {
+    a.positions.len() == b.positions.len() && a.triangles == b.triangles
 }
 
 /// Vertices coinciding with another one (within 1e-6 of the face scale) outside the slits.
@@ -174,6 +190,29 @@ pub fn clone_fit(
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
     let mut warnings = Vec::new();
+    if opts.shared_topology && same_topology(source, target) {
+        let clock = Instant::now();
+        let corr: Vec<_> = (0..target.positions.len() as u32)
+            .map(|v| {
+                Some(correspond::Correspondence {
+                    vertices: [v; 3],
+                    weights: [1.0, 0.0, 0.0],
+                    fade: 1.0,
+                })
+            })
+            .collect();
+        stats.insert("fit_shared_topology".into(), 1.0);
+        timings.push("correspond", clock.elapsed().as_secs_f64());
+        let clock = Instant::now();
+        let out = transfer::transfer(source, motions, target, &corr, opts.fapu_scale);
+        timings.push("transfer", clock.elapsed().as_secs_f64());
+        return Ok(SurfaceCloneResult {
+            motions: out,
+            timings,
+            stats,
+            warnings,
+        });
+    }
     // 1. Sides.
     let clock = Instant::now();
     let adj = adjacency(source.positions.len(), &source.triangles);

@@ -118,6 +118,19 @@ impl QuerySurface {
         })
     }
 
+    /// The closest point to `p` within triangle `tri` (its clamped barycentric weights):
+    /// how a query that chose its triangle elsewhere reads the weights at `p` itself.
+    pub fn within(&self, tri: u32, p: Vec3) -> Option<Hit> {
+        let t = self.triangles.get(tri as usize)?;
+        let [a, b, c] = t.map(|v| self.positions[v as usize]);
+        let weights = barycentric(p, a, b, c);
+        Some(Hit {
+            triangle: tri,
+            weights,
+            point: a * weights[0] + b * weights[1] + c * weights[2],
+        })
+    }
+
     /// Whether a hit lies on the surface's border (on a border edge of its triangle).
     pub fn on_border(&self, hit: &Hit) -> bool {
         self.border
