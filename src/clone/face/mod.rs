@@ -29,8 +29,11 @@
 //!    (`FaceModel::frames`), concatenated, polygons triangulated, coincident vertices welded
 //!    (within 1e-6 of the face's size) so seams do not cut the surface — except inside the
 //!    mouth box (between the lip corners, ±0.35 MNS0 around the lip line), where a closed
-//!    mouth's upper and lower lip vertices coincide and must stay apart. Results on a welded
-//!    vertex go back to every duplicate.
+//!    mouth's upper and lower lip vertices coincide and must stay apart. A target that is one
+//!    mesh with the source (same vertex counts and polygons) is welded exactly as the source
+//!    ([`build_skin_surface_like`]). Results on a welded vertex go back to every duplicate that
+//!    is a corner of some polygon: a vertex in no polygon is invisible and never moves
+//!    (CANDIDE-3 keeps such unused copies of its midline points).
 //! 4. **`motions`** — every table of the source FAT becomes one morph target per non-zero
 //!    interval border ([`fat_to_morph_targets`]); skin displacements are turned into the face
 //!    frame with each mesh's world 3×3 (a welded vertex takes the mean of its duplicates).
@@ -60,7 +63,11 @@
 //!    pose does not move. Source `FaceDefTransform`s then map by role: rotations copy their
 //!    axis (turned into the target's frame) and angle (AU is face independent); translations
 //!    scale by target/source FAPU of the FAP's unit (high-level tables: ES for eyes, MNS for
-//!    teeth and tongue, ENS for the head). Source tables that deform the tongue mesh
+//!    teeth and tongue, ENS for the head). When the target has a tongue or eyeball mesh of
+//!    its own, source tables that deform that part (tongue roll, pupil dilation) bend it
+//!    the same way (`part_deform`: vertex to vertex on one mesh, else nearest vertex of the
+//!    two parts normalised to their bounding boxes; times the FAPU ratio). Otherwise, source
+//!    tables that deform the tongue mesh
 //!    (no surface method applies to it) become a rigid translation of the target's tongue
 //!    transform by the FAPU-scaled displacement of the FAP's tongue feature point (the mean
 //!    tongue displacement for high-level tables), as Pandžić does; tables whose tongue
