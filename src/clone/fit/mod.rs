@@ -91,6 +91,20 @@ pub struct FitOptions {
     /// Surfaces with the same vertex count and triangles correspond vertex to vertex, without
     /// registration (module docs). Default on.
     pub shared_topology: bool,
+    /// How displacements are carried. Default [`FitTransfer::Barycentric`].
+    pub transfer: FitTransfer,
+}
+
+/// How [`clone_fit`] carries a displacement from the source to the target.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FitTransfer {
+    /// Interpolated as it is, in the aligned face frame (FAP directions stay on the face's
+    /// axes).
+    #[default]
+    Barycentric,
+    /// Turned first by its source vertex's local rotation under the registration (module
+    /// docs of `transfer.rs`).
+    LocalFrame,
 }
 
 impl Default for FitOptions {
@@ -105,6 +119,7 @@ impl Default for FitOptions {
             fade: (0.05, 0.25),
             fapu_scale: true,
             shared_topology: true,
+            transfer: FitTransfer::Barycentric,
         }
     }
 }
@@ -204,7 +219,7 @@ pub fn clone_fit(
         stats.insert("fit_shared_topology".into(), 1.0);
         timings.push("correspond", clock.elapsed().as_secs_f64());
         let clock = Instant::now();
-        let out = transfer::transfer(source, motions, target, &corr, opts.fapu_scale);
+        let out = transfer::transfer(source, motions, target, &corr, opts.fapu_scale, None);
         timings.push("transfer", clock.elapsed().as_secs_f64());
         return Ok(SurfaceCloneResult {
             motions: out,
@@ -312,7 +327,16 @@ pub fn clone_fit(
     timings.push("correspond", clock.elapsed().as_secs_f64());
     // 4. Transfer.
     let clock = Instant::now();
-    let out = transfer::transfer(source, motions, target, &corr, opts.fapu_scale);
+    let rotations = (opts.transfer == FitTransfer::LocalFrame)
+        .then(|| transfer::local_rotations(&source.positions, &reg.positions, &adj));
+    let out = transfer::transfer(
+        source,
+        motions,
+        target,
+        &corr,
+        opts.fapu_scale,
+        rotations.as_deref(),
+    );
     timings.push("transfer", clock.elapsed().as_secs_f64());
     Ok(SurfaceCloneResult {
         motions: out,
