@@ -550,8 +550,16 @@ pub fn clone_rbf(
     // 4. Bind target vertices to deformed source triangles.
     let clock = Instant::now();
     let source_bvh = RegionBvh::new(&deformed, &source.triangles, &s_tri_regions);
-    let s_tri_normals = triangle_normals(&deformed, &source.triangles);
-    let t_normals = vertex_normals(&target.positions, &target.triangles);
+    // Normals from consistently wound triangles: a few flipped polygons (CANDIDE-3 has 29
+    // such edges) would turn a vertex normal, and its map ray, away from its mirror image's.
+    let s_tri_normals = triangle_normals(
+        &deformed,
+        &crate::mesh::orient::orient_outwards(&source.triangles, &deformed),
+    );
+    let t_normals = vertex_normals(
+        &target.positions,
+        &crate::mesh::orient::orient_outwards(&target.triangles, &target.positions),
+    );
     // Vertices outside every triangle are not part of the surface (Candide-3 has four such
     // unused duplicates of midline vertices); they get no motion.
     let mut in_surface = vec![false; target.positions.len()];
