@@ -154,3 +154,66 @@ fn cloning_keeps_unknown_nodes_when_it_adds_transforms() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     assert!(glb.exists());
 }
+
+/// The target file: `face` (no scene of its own) written fresh with the extras spliced in.
+fn with_extras(face: &FaceModel) -> String {
+    let base = fbakit::face::vrml::write_face_string(face).unwrap();
+    let header_end = base.find('\n').unwrap() + 1;
+    let mut text = format!(
+        "{}{HEADER_EXTRAS}{}",
+        &base[..header_end],
+        &base[header_end..]
+    );
+    let graph = text.find("faceSceneGraph [").expect("a face scene graph") + 16;
+    text.insert_str(graph, GRAPH_EXTRA);
+    text.push_str("ROUTE Clock.fraction_changed TO Spinner.set_fraction\n");
+    text
+}
+
+/// A one-mesh head (the bundled `ict`: eyes, teeth and gums inside the skin mesh) has its
+/// parts cut into meshes of their own by the clone; their shapes join the file beside the
+/// skin's and everything else stays.
+#[test]
+fn cloning_a_one_mesh_head_keeps_unknown_nodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let ict = fbakit::export::picture::strip_fat(&fbakit::face::read("ict").unwrap());
+    assert_eq!(ict.meshes.len(), 1);
+    let target = dir.path().join("head.wrl");
+    std::fs::write(&target, with_extras(&ict)).unwrap();
+    let out = dir.path().join("cloned.wrl");
+    let o = fbakit(&["clone", "alma", s(&target), "--json", "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let split = v["report"]["split_parts"].as_array().unwrap();
+    assert!(split.len() >= 3, "{split:?}");
+
+    let written = std::fs::read_to_string(&out).unwrap();
+    for kept in KEPT {
+        assert!(written.contains(kept), "`{kept}` lost");
+    }
+    let (cloned, _) = fbakit::face::read_with(&out, &Default::default()).unwrap();
+    assert_eq!(cloned.meshes.len(), 1 + split.len());
+    for p in split {
+        let name = p["mesh"].as_str().unwrap();
+        assert!(cloned.mesh_index(name).is_some(), "{name} missing");
+    }
+    // Every vertex is still there, and where it was (a piece cut along the lip line has its
+    // cut vertices in both halves).
+    let total: usize = cloned.meshes.iter().map(|m| m.mesh.positions.len()).sum();
+    let n = ict.meshes[0].mesh.positions.len();
+    assert!(
+        total >= n && total <= n + n / 100,
+        "{total} vertices from {n}"
+    );
+    let index = fbakit::mesh::VertexIndex::new(&ict.meshes[0].mesh.positions);
+    let frames = cloned.frames();
+    for (m, mesh) in cloned.meshes.iter().enumerate() {
+        for &p in &mesh.mesh.positions {
+            let (_, d) = index
+                .nearest_vertex(frames.meshes[m].transform_point3(p))
+                .unwrap();
+            assert!(d < 1e-4, "{} vertex moved by {d}", mesh.name);
+        }
+    }
+    assert!(!cloned.fat.tables.is_empty());
+}

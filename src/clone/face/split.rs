@@ -196,8 +196,8 @@ pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
     if dest.keys().all(|p| p.is_none()) {
         return (face.clone(), Vec::new());
     }
+    // The scene stays: the writer adds the new part meshes' shapes beside the skin's.
     let mut out = face.clone();
-    out.scene = None;
     // Skin keeps its polygons and every vertex no part polygon uses (isolated ones too).
     let mut used_by_part = vec![false; mesh.positions.len()];
     for (p, polys) in &dest {

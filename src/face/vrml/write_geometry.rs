@@ -4,7 +4,7 @@
 use glam::{Quat, Vec3};
 
 use super::write::{add, set_field};
-use super::write_insert::insert_transforms;
+use super::write_insert::{insert_meshes, insert_transforms};
 use crate::error::Result;
 use crate::face::{FaceError, FaceMesh, FaceModel, FaceTransform};
 use crate::mesh::{Mesh, Polygons, SurfaceFlags};
@@ -98,23 +98,31 @@ fn add_shape(scene: &mut Scene, m: &FaceMesh) -> (NodeRef, NodeId) {
 }
 
 /// Writes the face's transforms and meshes into the nodes of the same DEF names in its own
-/// scene. A transform the scene lacks is added where its content sits (see
-/// [`insert_transforms`]); a mesh the scene lacks is an error.
+/// scene. A mesh or transform the scene lacks is added where its content sits (see
+/// [`insert_meshes`] and [`insert_transforms`]).
 pub(super) fn patch_geometry(scene: &mut Scene, face: &FaceModel) -> Result<GeometryNodes> {
-    let mut mesh_nodes: Vec<NodeId> = Vec::with_capacity(face.meshes.len());
-    for m in &face.meshes {
-        let id = find_def_of_type(scene, &m.name, "IndexedFaceSet").ok_or_else(|| {
-            FaceError::MeshNotInScene {
-                name: m.name.clone(),
-            }
-        })?;
-        mesh_nodes.push(id);
-    }
     let mut found: Vec<Option<NodeId>> = face
         .transforms
         .iter()
         .map(|t| find_def_of_type(scene, &t.name, "Transform"))
         .collect();
+    let mut found_meshes: Vec<Option<NodeId>> = face
+        .meshes
+        .iter()
+        .map(|m| find_def_of_type(scene, &m.name, "IndexedFaceSet"))
+        .collect();
+    if found_meshes.iter().any(Option::is_none) {
+        insert_meshes(scene, face, &mut found_meshes, &found, |scene, m| {
+            add_shape(scene, &face.meshes[m])
+        });
+    }
+    let mut mesh_nodes: Vec<NodeId> = Vec::with_capacity(face.meshes.len());
+    for (m, id) in face.meshes.iter().zip(found_meshes) {
+        // `insert_meshes` fills every gap; kept as an error rather than a panic.
+        mesh_nodes.push(id.ok_or_else(|| FaceError::MeshNotInScene {
+            name: m.name.clone(),
+        })?);
+    }
     if found.iter().any(Option::is_none) {
         insert_transforms(scene, face, &mut found, &mesh_nodes);
     }

@@ -1,7 +1,9 @@
-//! Transforms the face has and its own scene lacks (cloning adds a `head` root or a part
-//! transform): a new DEF'd `Transform` is put where its content sits in the scene and that
-//! content (shapes, child transforms) is moved into it, so every other node of the file stays
-//! where it was.
+//! Transforms and meshes the face has and its own scene lacks (cloning adds a `head` root or
+//! a part transform, and cuts eyes and teeth out of a one-mesh head): a new DEF'd `Transform`
+//! is put where its content sits in the scene and that content (shapes, child transforms) is
+//! moved into it; a new mesh's `Shape` goes right after the shape of a mesh under the same
+//! transform (else into that transform's `children`, else after the face's first shape). Every
+//! other node of the file stays where it was.
 
 use std::collections::HashMap;
 
@@ -112,6 +114,90 @@ fn remove_at(scene: &mut Scene, slot: Slot) {
             }
             _ => {}
         },
+    }
+}
+
+/// Inserts a new item right after the reference at `slot` (or appends at the top level).
+fn insert_after(scene: &mut Scene, slot: Slot, new: NodeRef) -> bool {
+    match slot {
+        Slot::Root(k) => {
+            scene.statements.insert(k + 1, Statement::Node(new));
+            true
+        }
+        Slot::Field { node, field, item } => match &mut scene.nodes[node.0].fields[field].1 {
+            FieldValue::MFNode(v) => {
+                v.insert(item + 1, new);
+                true
+            }
+            FieldValue::Untyped { items, bracketed } => {
+                items.insert(item + 1, UntypedItem::Node(new));
+                *bracketed = true;
+                true
+            }
+            _ => false,
+        },
+    }
+}
+
+/// The `Shape` holding `ifs` as its geometry, and that shape's slot.
+fn shape_of(scene: &Scene, all: &HashMap<NodeId, Slot>, ifs: NodeId) -> Option<(NodeId, Slot)> {
+    match all.get(&ifs)? {
+        Slot::Field { node, .. } if scene.node(*node).type_name == "Shape" => {
+            Some((*node, *all.get(node)?))
+        }
+        _ => None,
+    }
+}
+
+/// Places the `Shape` of each mesh `mesh_nodes` lacks (`make` builds it and returns the shape
+/// and its `IndexedFaceSet`), as the module docs say, filling `mesh_nodes`. Transforms must be
+/// placed afterwards ([`insert_transforms`] moves the new shapes with the rest).
+pub(super) fn insert_meshes(
+    scene: &mut Scene,
+    face: &FaceModel,
+    mesh_nodes: &mut [Option<NodeId>],
+    transform_nodes: &[Option<NodeId>],
+    mut make: impl FnMut(&mut Scene, usize) -> (NodeRef, NodeId),
+) {
+    for m in 0..face.meshes.len() {
+        if mesh_nodes[m].is_some() {
+            continue;
+        }
+        let all = slots(scene);
+        let tf = face.meshes[m].transform;
+        // A shape of an existing mesh under the same transform, else of any existing mesh.
+        let sibling = |same: bool| {
+            (0..face.meshes.len())
+                .filter(|&o| !same || face.meshes[o].transform == tf)
+                .filter_map(|o| mesh_nodes[o])
+                .find_map(|ifs| shape_of(scene, &all, ifs))
+        };
+        let (same_slot, any_slot) = (sibling(true).map(|x| x.1), sibling(false).map(|x| x.1));
+        // New nodes are appended to the scene: the slots found above stay valid.
+        let (shape, ifs) = make(scene, m);
+        let placed = match same_slot {
+            Some(slot) => insert_after(scene, slot, shape),
+            None => false,
+        } || match tf.and_then(|t| transform_nodes.get(t).copied().flatten()) {
+            Some(p) => {
+                let mut kids = scene
+                    .node(p)
+                    .field("children")
+                    .map(|v| v.node_refs())
+                    .unwrap_or_default();
+                kids.push(shape);
+                set_field(&mut scene.nodes[p.0], "children", FieldValue::MFNode(kids));
+                true
+            }
+            None => false,
+        } || match any_slot {
+            Some(slot) => insert_after(scene, slot, shape),
+            None => false,
+        };
+        if !placed {
+            scene.statements.push(Statement::Node(shape));
+        }
+        mesh_nodes[m] = Some(ifs);
     }
 }
 
