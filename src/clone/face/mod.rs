@@ -137,8 +137,8 @@ pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 use super::fit::clone_fit;
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
-use super::{CloneSurface, SurfaceCloneResult, SurfaceMotion};
-use crate::error::{Error, Result};
+use super::{CloneError, CloneSurface, SurfaceCloneResult, SurfaceMotion};
+use crate::error::Result;
 use crate::face::FaceModel;
 use crate::fat::morph::fat_to_morph_targets;
 use crate::fat::{Fat, TableKey};
@@ -180,10 +180,10 @@ pub fn clone_face(
     source.check_structure()?;
     target.check_structure()?;
     if source.fat.tables.is_empty() {
-        return Err(Error::Invalid(format!(
-            "source face `{}` has no FAT to clone",
-            source.name
-        )));
+        return Err(CloneError::NoSourceFat {
+            face: source.name.clone(),
+        }
+        .into());
     }
     // 1. Parts (a one-mesh target first has its eyes, teeth and gums cut into part meshes).
     let clock = Instant::now();
@@ -363,9 +363,10 @@ fn check_parts(
     warnings: &mut Vec<String>,
 ) -> Result<()> {
     if parts.skin.is_empty() {
-        return Err(Error::Invalid(format!(
-            "{side} face has no skin mesh: no mesh holds a skin feature point"
-        )));
+        return Err(CloneError::NoSkin {
+            face: format!("{side} face"),
+        }
+        .into());
     }
     if !parts.other.is_empty() {
         let names: Vec<&str> = parts

@@ -51,7 +51,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::mesh::spatial::find_coincident_vertices;
 use regions::{classify, triangle_masks};
 use register::{register, Moving};
@@ -98,25 +98,6 @@ impl Default for FitOptions {
     }
 }
 
-/// Checks a surface's numbers and indices.
-fn check_surface(s: &CloneSurface, side: &str) -> Result<()> {
-    if s.positions.is_empty() || s.triangles.is_empty() {
-        return Err(Error::Invalid(format!("fit: the {side} surface is empty")));
-    }
-    if s.positions.iter().any(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "fit: the {side} surface has a non-finite position"
-        )));
-    }
-    let n = s.positions.len();
-    if s.triangles.iter().flatten().any(|&v| v as usize >= n) {
-        return Err(Error::Invalid(format!(
-            "fit: the {side} surface has a triangle index out of range"
-        )));
-    }
-    Ok(())
-}
-
 /// Which vertices some triangle uses.
 fn used_vertices(s: &CloneSurface) -> Vec<bool> {
     let mut used = vec![false; s.positions.len()];
@@ -160,8 +141,7 @@ fn face_scale(s: &CloneSurface) -> f32 {
 /// Clones `motions` of `source` onto `target` (module docs). The result has one motion per
 /// source motion, in the same order, on the target's vertices.
 ///
-/// Errors: an empty surface, non-finite positions, out-of-range triangle indices, or a
-/// failing linear solve. Feature points missing on either side (fewer landmarks, slits not
+/// Errors: a surface failing [`CloneSurface::check`], or a failing linear solve. Feature points missing on either side (fewer landmarks, slits not
 /// found) are warnings.
 pub fn clone_fit(
     source: &CloneSurface,
@@ -169,8 +149,8 @@ pub fn clone_fit(
     target: &CloneSurface,
     opts: &FitOptions,
 ) -> Result<SurfaceCloneResult> {
-    check_surface(source, "source")?;
-    check_surface(target, "target")?;
+    source.check("source")?;
+    target.check("target")?;
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
     let mut warnings = Vec::new();

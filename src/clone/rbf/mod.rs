@@ -115,7 +115,8 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
-use crate::error::{Error, Result};
+use crate::clone::{CloneError, RbfFitError};
+use crate::error::Result;
 use crate::mesh::geometry::vertex_normals;
 use crate::mesh::spatial::VertexIndex;
 use crate::spec::FeaturePointId;
@@ -233,42 +234,10 @@ impl Correspondences {
         }
     }
 
-    fn fit(&self) -> Result<Multiquadric> {
+    fn fit(&self) -> Result<Multiquadric, RbfFitError> {
         let pairs: Vec<(Vec3, Vec3)> = self.pairs.iter().map(|e| (e.0, e.1)).collect();
         Multiquadric::fit(&pairs)
     }
-}
-
-fn check_surface(s: &CloneSurface, name: &str) -> Result<()> {
-    let n = s.positions.len();
-    if n == 0 || s.triangles.is_empty() {
-        return Err(Error::Invalid(format!("{name} surface has no triangles")));
-    }
-    if n > u32::MAX as usize {
-        return Err(Error::Invalid(format!(
-            "{name} surface has too many vertices"
-        )));
-    }
-    if let Some(i) = s.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "{name} surface: vertex {i} is not finite"
-        )));
-    }
-    if let Some(t) = s
-        .triangles
-        .iter()
-        .find(|t| t.iter().any(|&v| v as usize >= n))
-    {
-        return Err(Error::Invalid(format!(
-            "{name} surface: triangle {t:?} refers to a vertex beyond {n}"
-        )));
-    }
-    if let Some((id, v)) = s.fp_vertices.iter().find(|(_, &v)| v as usize >= n) {
-        return Err(Error::Invalid(format!(
-            "{name} surface: feature point {id} refers to vertex {v} beyond {n}"
-        )));
-    }
-    Ok(())
 }
 
 /// The mirror image of each movable vertex across the plane `x = mean x` of the source, when
@@ -351,29 +320,21 @@ pub fn clone_rbf(
     target: &CloneSurface,
     opts: &RbfOptions,
 ) -> Result<SurfaceCloneResult> {
-    check_surface(source, "source")?;
-    check_surface(target, "target")?;
-    for m in motions {
-        if let Some((v, d)) = m
-            .offsets
-            .iter()
-            .find(|(v, d)| *v as usize >= source.positions.len() || !d.is_finite())
-        {
-            return Err(Error::Invalid(format!(
-                "motion {:?}: offset {d} of vertex {v} is not finite or not a source vertex",
-                m.key
-            )));
-        }
-    }
+    source.check("source")?;
+    target.check("target")?;
+    source.check_motions(motions)?;
     for (name, x) in [
         ("ray_length_factor", opts.ray_length_factor),
         ("min_error_factor", opts.min_error_factor),
         ("min_offset_factor", opts.min_offset_factor),
     ] {
         if !x.is_finite() || x < 0.0 {
-            return Err(Error::Invalid(format!(
-                "RBF option {name} must be a finite non-negative number, got {x}"
-            )));
+            return Err(CloneError::BadOption {
+                method: "rbf",
+                option: name,
+                value: x.into(),
+            }
+            .into());
         }
     }
     let mut warnings = Vec::new();
@@ -433,10 +394,9 @@ pub fn clone_rbf(
         }
     }
     let fp_count = set.pairs.len();
-    let mut f = set.fit().map_err(|e| {
-        Error::Invalid(format!(
-            "RBF fit from {fp_count} distinct feature-point correspondences failed: {e}"
-        ))
+    let mut f = set.fit().map_err(|source| CloneError::RbfFeaturePointFit {
+        correspondences: fp_count,
+        source,
     })?;
     let mut contour_pairs = 0usize;
     if opts.contours {
@@ -687,13 +647,18 @@ pub fn clone_rbf(
         })
         .collect();
     timings.push("deform", clock.elapsed().as_secs_f64());
-    if out
-        .iter()
-        .any(|m| m.offsets.iter().any(|(_, o)| !o.is_finite()))
-    {
-        return Err(Error::Invalid(
-            "RBF cloning produced non-finite offsets (degenerate fit)".into(),
-        ));
+    if let Some((key, vertex)) = out.iter().find_map(|m| {
+        m.offsets
+            .iter()
+            .find(|(_, o)| !o.is_finite())
+            .map(|&(v, _)| (m.key, v))
+    }) {
+        return Err(CloneError::NonFiniteOutput {
+            method: "rbf",
+            key,
+            vertex,
+        }
+        .into());
     }
 
     stats.insert("iterations".into(), iterations as f64);

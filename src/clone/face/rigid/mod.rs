@@ -187,7 +187,9 @@ fn part_transforms(
     let mut part_tf: BTreeMap<Part, usize> = BTreeMap::new();
     for (&p, meshes) in &tparts.parts {
         let low = lowest_enclosing(face, meshes);
-        let exclusive = low.is_some_and(|t| {
+        // The enclosing transform when the part's meshes are all it holds; an `Option` so
+        // the exclusive case carries its transform and needs no unwrap.
+        let exclusive = low.filter(|&t| {
             t != head
                 && (0..face.meshes.len()).all(|m| {
                     !encloses(face, t, m)
@@ -199,8 +201,8 @@ fn part_transforms(
                                 .is_some_and(|x| x.contains(&m)))
                 })
         });
-        if exclusive {
-            part_tf.insert(p, low.expect("exclusive implies some"));
+        if let Some(t) = exclusive {
+            part_tf.insert(p, t);
         } else if needed.contains(&p) {
             let (name, new_t) = add_part_transform(face, p, meshes, low.unwrap_or(head));
             created.push(name);
