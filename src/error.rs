@@ -142,6 +142,35 @@ pub struct Diagnostic {
     pub message: String,
 }
 
+impl Diagnostic {
+    /// A warning about the whole input or operation (no location).
+    pub fn warning(message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            location: None,
+            message: message.into(),
+        }
+    }
+
+    /// A warning at `location`.
+    pub fn warning_at(location: Location, message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            location: Some(location),
+            message: message.into(),
+        }
+    }
+
+    /// The message with its location in front, without the severity: what a list that
+    /// names the severity once (`warning: …`) prints per entry.
+    pub fn located_message(&self) -> String {
+        match &self.location {
+            Some(loc) => format!("{loc}: {}", self.message),
+            None => self.message.clone(),
+        }
+    }
+}
+
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let sev = match self.severity {

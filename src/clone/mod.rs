@@ -190,7 +190,7 @@ pub struct SurfaceCloneResult {
     /// Method-specific figures (iterations, correspondence count, fallbacks, ...).
     pub stats: BTreeMap<String, f64>,
     /// Warnings for the user (missing optional feature points, ...).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::error::Diagnostic>,
 }
 
 /// CANDIDE-3 test faces with exact motions (tests and the `bench-fixtures` benchmarks only:

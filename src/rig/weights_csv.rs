@@ -26,7 +26,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::error::{ParseError, Result};
+use crate::error::{Diagnostic, ParseError, Result};
 
 /// Most weight columns a file may have.
 pub const MAX_COLUMNS: usize = 1024;
@@ -78,7 +78,7 @@ pub struct WeightCsv {
     /// The rows, frame numbers increasing.
     pub rows: Vec<WeightRow>,
     /// Clamped values and replaced rows, one line each.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// Reads a weight CSV file (bounded read); see [`parse_weights_csv`].
@@ -391,18 +391,18 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
     }
     let mut warnings = Vec::new();
     if let Some((line, col, name)) = first_clamp {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{}: {clamped} weight{} outside 0..1 clamped (first at line {line}, column {col} `{name}`)",
             file.display(),
             if clamped == 1 { "" } else { "s" }
-        ));
+        )));
     }
     if replaced > 0 {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{}: {replaced} row{} fell on the previous row's frame at {fps_value} fps and replaced it",
             file.display(),
             if replaced == 1 { "" } else { "s" }
-        ));
+        )));
     }
     Ok(WeightCsv {
         time: time_kind,
@@ -525,7 +525,7 @@ mod tests {
         assert_eq!(w.rows[3].weights[0], 1.0);
         assert_eq!(w.warnings.len(), 1, "{:?}", w.warnings);
         assert!(
-            w.warnings[0].contains(
+            w.warnings[0].message.contains(
                 "w.csv: 1 weight outside 0..1 clamped (first at line 5, column 3 `EyeBlinkLeft`)"
             ),
             "{}",

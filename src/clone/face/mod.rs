@@ -138,7 +138,7 @@ use super::fit::clone_fit;
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
 use super::{CloneError, CloneSurface, SurfaceCloneResult, SurfaceMotion};
-use crate::error::Result;
+use crate::error::{Diagnostic, Result};
 use crate::face::FaceModel;
 use crate::fat::morph::fat_to_morph_targets;
 use crate::fat::{Fat, TableKey};
@@ -337,7 +337,7 @@ fn clone_skin_motions(
         rescaled,
     );
     for f in &report.failed_faps {
-        report.warnings.push(format!(
+        report.warnings.push(Diagnostic::warning(format!(
             "FAP {} at {}: {} (factor {:.4}); {}",
             f.fap,
             f.value,
@@ -348,7 +348,7 @@ fn clone_skin_motions(
             } else {
                 "its table is dropped"
             }
-        ));
+        )));
     }
     report.timings.push("guard", clock.elapsed().as_secs_f64());
     Ok(result.motions)
@@ -360,7 +360,7 @@ fn check_parts(
     face: &FaceModel,
     parts: &FaceParts,
     side: &str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Diagnostic>,
 ) -> Result<()> {
     if parts.skin.is_empty() {
         return Err(CloneError::NoSkin {
@@ -374,10 +374,10 @@ fn check_parts(
             .iter()
             .map(|&m| face.meshes[m].name.as_str())
             .collect();
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{side} meshes {} are neither skin nor a part; they stay rigid with the head",
             names.join(", ")
-        ));
+        )));
     }
     Ok(())
 }

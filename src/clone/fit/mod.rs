@@ -259,7 +259,10 @@ pub fn clone_fit(
         motions: out,
         timings,
         stats,
-        warnings,
+        warnings: warnings
+            .into_iter()
+            .map(crate::error::Diagnostic::warning)
+            .collect(),
     })
 }
 

@@ -118,7 +118,7 @@ use rayon::prelude::*;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::clone::CloneError;
-use crate::error::Result;
+use crate::error::{Diagnostic, Result};
 use crate::spec::FeaturePointId;
 use interp::TriMesh2;
 use lips::{LipPolygons, LipRegion};
@@ -281,10 +281,10 @@ pub fn clone_fmc(
     for (face, name) in [(source, "source"), (target, "target")] {
         let m = missing(face, &optional);
         if !m.is_empty() {
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "{name} face lacks inner-lip points {}; the lip regions are coarser",
                 m.join(", ")
-            ));
+            )));
         }
     }
     source.check_motions(motions)?;

@@ -116,7 +116,7 @@ use rayon::prelude::*;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::clone::{CloneError, RbfFitError};
-use crate::error::Result;
+use crate::error::{Diagnostic, Result};
 use crate::mesh::geometry::vertex_normals;
 use crate::mesh::spatial::VertexIndex;
 use crate::spec::FeaturePointId;
@@ -386,10 +386,10 @@ pub fn clone_rbf(
         let (p, u) = (source.positions[sv as usize], target.positions[tv as usize]);
         if let Some(gap) = set.add_mean(class[sv as usize], p, u, Kind::FeaturePoint) {
             if gap > merge_eps {
-                warnings.push(format!(
+                warnings.push(Diagnostic::warning(format!(
                     "feature point {id} coincides with another on the source but not on the \
                      target ({gap:.3e} apart); their targets were averaged"
-                ));
+                )));
             }
         }
     }
@@ -427,17 +427,17 @@ pub fn clone_rbf(
             }
         }
         if disagreements > 0 {
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "{disagreements} coincident source contour vertices have distinct target \
                  points (e.g. a closed source mouth on an open target); targets averaged"
-            ));
+            )));
         }
         if contour_pairs > 0 {
             match set.fit() {
                 Ok(g) => f = g,
-                Err(e) => warnings.push(format!(
+                Err(e) => warnings.push(Diagnostic::warning(format!(
                     "RBF refit with contour correspondences failed ({e}); using feature points only"
-                )),
+                ))),
             }
         }
     }
@@ -492,10 +492,10 @@ pub fn clone_rbf(
         match fitted {
             Ok(g) => f = g,
             Err(e) => {
-                warnings.push(format!(
+                warnings.push(Diagnostic::warning(format!(
                     "RBF refit in refinement round {} failed ({e}); keeping the previous fit",
                     iterations + 1
-                ));
+                )));
                 break;
             }
         }
