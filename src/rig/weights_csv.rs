@@ -87,6 +87,27 @@ pub fn read_weights_csv(path: &Path, fps: Option<f64>) -> Result<WeightCsv> {
     parse_weights_csv(&text, path, fps)
 }
 
+/// Reads a weight CSV from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]); `source` names it in messages; see
+/// [`parse_weights_csv`].
+///
+/// ```
+/// use std::path::Path;
+/// let csv = "time,jawOpen\n0,0\n0.04,0.5\n0.08,1\n";
+/// let w = fbakit::rig::weights_csv::read_weights_csv_from(csv.as_bytes(), Path::new("w.csv"), None)?;
+/// assert_eq!(w.fps, 25.0);
+/// assert_eq!(w.rows.len(), 3);
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
+pub fn read_weights_csv_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+    fps: Option<f64>,
+) -> Result<WeightCsv> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_weights_csv(&text, source, fps)
+}
+
 /// One comma-separated field: its text (trimmed, quotes removed) and byte offset.
 struct Field<'a> {
     text: &'a str,
@@ -531,6 +552,16 @@ mod tests {
             "{}",
             w.warnings[0]
         );
+    }
+
+    #[test]
+    fn reader_matches_text_and_names_its_source() {
+        let text = "time,jawOpen\n0,0\n0.04,0.5\n0.08,1\n";
+        let from = read_weights_csv_from(text.as_bytes(), Path::new("w.csv"), None).unwrap();
+        assert_eq!(from.rows.len(), parse(text, None).unwrap().rows.len());
+        assert_eq!(from.fps, 25.0);
+        let e = read_weights_csv_from(&b"time,\xff\n"[..], Path::new("bad.csv"), None).unwrap_err();
+        assert!(e.to_string().contains("bad.csv"), "{e}");
     }
 
     #[test]
