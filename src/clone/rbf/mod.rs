@@ -332,7 +332,7 @@ pub fn clone_rbf(
             return Err(CloneError::BadOption {
                 method: "rbf",
                 option: name,
-                value: x.into(),
+                value: x,
             }
             .into());
         }
