@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use crate::clone::eval::{compliance, ground_truth_error, self_clone_error};
 use crate::clone::face::{clone_face, CloneOptions, Method};
-use crate::error::{Error, Result};
+use crate::error::{Diagnostic, Error, Result};
 use crate::export::gltf::export_face;
 use crate::export::picture::{cloning_grid_with, contact_sheet_rows, strip_fat};
 use crate::face::{BundledFace, FaceModel};
@@ -154,7 +154,7 @@ pub struct DemoReport {
     /// Total wall time in seconds.
     pub total_seconds: f64,
     /// Warnings from cloning, playing and exporting.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// The bundled samples folder: `./samples` when it holds `speech.fap` (running from the
@@ -290,7 +290,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     };
     let stream_path = samples.join("speech.fap");
     let (stream, stream_warnings) = read_stream_file(&stream_path, &ReadOptions::lenient())?;
-    let mut warnings: Vec<String> = stream_warnings.iter().map(|d| d.to_string()).collect();
+    let mut warnings: Vec<Diagnostic> = stream_warnings;
     let (alma, source_face) = bundled_face(&samples, BundledFace::Alma)?;
     let (truth, target_face) = bundled_face(&samples, BundledFace::Bruno)?;
     let target = strip_fat(&truth);
@@ -327,13 +327,10 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         let cloned = clone_face(&alma, &strip_fat(&ict), &clone_opts)?;
         let clone_seconds = t.elapsed().as_secs_f64();
         clock.lap(&format!("clone alma→ict-head ({})", opts.method.name()));
-        warnings.extend(
-            cloned
-                .report
-                .warnings
-                .iter()
-                .map(|w| format!("ict-head: {w}")),
-        );
+        warnings.extend(cloned.report.warnings.iter().map(|w| Diagnostic {
+            message: format!("ict-head: {}", w.message),
+            ..w.clone()
+        }));
         let c = compliance(&cloned.face)?;
         let vs_rig = ground_truth_error(&cloned.face, &ict)?;
         clock.lap("compliance + vs rig FAT (ict-head)");
@@ -376,11 +373,13 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         frames = player.frame_count();
         fps = player.fps();
         for (key, n) in player.missing_tables() {
-            warnings.push(format!("{name}: no table for {key} ({n} frames)"));
+            warnings.push(Diagnostic::warning(format!(
+                "{name}: no table for {key} ({n} frames)"
+            )));
         }
         let anim = player.animation()?;
         let export = export_face(face, Some(&anim))?;
-        warnings.extend(export.warnings);
+        warnings.extend(export.warnings.into_iter().map(Diagnostic::warning));
         let file = format!("{name}-speech.glb");
         dir.write_file(&file, |p| export.document.write_glb(p))?;
         let what = match name {

@@ -142,6 +142,35 @@ pub struct Diagnostic {
     pub message: String,
 }
 
+impl Diagnostic {
+    /// A warning about the whole input or operation (no location).
+    pub fn warning(message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            location: None,
+            message: message.into(),
+        }
+    }
+
+    /// A warning at `location`.
+    pub fn warning_at(location: Location, message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            location: Some(location),
+            message: message.into(),
+        }
+    }
+
+    /// The message with its location in front, without the severity: what a list that
+    /// names the severity once (`warning: …`) prints per entry.
+    pub fn located_message(&self) -> String {
+        match &self.location {
+            Some(loc) => format!("{loc}: {}", self.message),
+            None => self.message.clone(),
+        }
+    }
+}
+
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let sev = match self.severity {
@@ -197,10 +226,6 @@ pub enum Error {
     /// The input is not well-formed.
     #[error(transparent)]
     Parse(#[from] ParseError),
-    /// The catch-all for content problems that have no more specific type yet (the cloning
-    /// code still uses it); new code uses its layer's error enum.
-    #[error("{0}")]
-    Invalid(String),
     /// The requested operation or format is not supported.
     #[error("unsupported: {0}")]
     Unsupported(String),
@@ -301,9 +326,9 @@ impl Error {
                     | std::io::ErrorKind::InvalidData
                     | std::io::ErrorKind::FileTooLarge
             ),
-            Error::Parse(_) | Error::Invalid(_) | Error::Unsupported(_) => true,
+            Error::Parse(_) | Error::Unsupported(_) => true,
             Error::MissingTool(_) | Error::Output { .. } => false,
-            // Content and usage problems: bad input, exit code 2 (as `Invalid` was).
+            // Content and usage problems: bad input, exit code 2.
             Error::OutputPath(_) | Error::Encode(_) | Error::Usage(_) => true,
             Error::Fap(e) => e.is_input_error(),
             Error::Fdp(e) => e.is_input_error(),
@@ -373,7 +398,7 @@ mod tests {
             "a.wrl: refusing to write over the input file; choose another output path"
         );
         assert!(e.is_input_error());
-        // A wrapped error keeps the file prefix the old `Invalid(format!(..))` had.
+        // A wrapped error keeps the file prefix of the file at fault.
         let inner: Error = crate::fdp::FdpError::FapuNotPositive {
             details: "ES0 = 0".into(),
         }
@@ -383,6 +408,62 @@ mod tests {
             .to_string()
             .starts_with("fp.csv: cannot compute the FAPUs: ES0 = 0"));
         assert!(!Error::MissingTool("ffmpeg".into()).is_input_error());
+    }
+
+    #[test]
+    fn clone_errors_are_input_errors_naming_what_is_at_fault() {
+        use crate::clone::{CloneError, FitSystemError, RbfFitError};
+        let fp = |s: &str| s.parse::<crate::spec::FeaturePointId>().unwrap();
+        let cases: Vec<(Error, &str)> = vec![
+            (
+                CloneError::FeaturePointOutOfRange {
+                    side: "target".into(),
+                    id: fp("2.1"),
+                    vertex: 9,
+                    vertices: 4,
+                }
+                .into(),
+                "the target surface: feature point 2.1 names vertex 9 beyond the 4 vertices",
+            ),
+            (
+                CloneError::BadOption {
+                    method: "rbf",
+                    option: "ray_length_factor",
+                    value: -1.0,
+                }
+                .into(),
+                "rbf option ray_length_factor must be a finite non-negative number, got -1",
+            ),
+            (
+                CloneError::RbfFeaturePointFit {
+                    correspondences: 3,
+                    source: RbfFitError::TooFew { found: 3 },
+                }
+                .into(),
+                "RBF fit from 3 distinct feature-point correspondences failed: RBF fit needs at \
+                 least 4 distinct correspondences, got 3",
+            ),
+            (
+                CloneError::FitSystem(FitSystemError::NonFinite).into(),
+                "fit: non-finite solution",
+            ),
+            (
+                crate::face::FaceError::TooManySubdivided {
+                    face: "alma".into(),
+                    rounds: 9,
+                    vertices: 100,
+                    max: 1000,
+                }
+                .into(),
+                "face `alma`: 9 rounds of subdivision would make over 1000 vertices from 100; \
+                 use fewer rounds",
+            ),
+        ];
+        for (e, message) in cases {
+            assert_eq!(e.to_string(), message);
+            // Bad input: the CLI exits with 2.
+            assert!(e.is_input_error(), "{e}");
+        }
     }
 
     #[test]

@@ -216,7 +216,7 @@ pub struct SelfCloneArgs {
 /// Reads a face through the front door; an OBJ face must come with its feature points.
 fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
     if fp.is_none() && FaceFormat::of_extension(path) == Some(FaceFormat::Obj) {
-        return Err(Error::Invalid(format!(
+        return Err(Error::Usage(format!(
             "{}: an OBJ face needs its feature points (--fp-source / --fp-target / --fp FILE)",
             path.display()
         )));
@@ -261,7 +261,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     let format = OutputFormat::resolve(&args.output, OutputFormat::FACES, "the cloned face")?;
     let arkit_names = args.names == super::face_export::NamesArg::Arkit;
     if arkit_names && !matches!(format, OutputFormat::Glb | OutputFormat::Gltf) {
-        return Err(fbakit::error::Error::Invalid(format!(
+        return Err(Error::Usage(format!(
             "{}: --names arkit needs a .glb or .gltf output",
             args.output.display()
         )));

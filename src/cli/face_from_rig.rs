@@ -39,7 +39,7 @@ struct Output<'a> {
     tables: usize,
     #[serde(flatten)]
     report: &'a RigFatReport,
-    warnings: &'a [String],
+    warnings: &'a [fbakit::error::Diagnostic],
 }
 
 /// The mapping table `--map` names: `arkit` (built in) or a CSV file checked against `rig`.

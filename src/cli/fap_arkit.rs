@@ -92,7 +92,7 @@ struct FromOutput<'a> {
     output: String,
     #[serde(flatten)]
     report: &'a FromArkitReport,
-    warnings: &'a [String],
+    warnings: &'a [fbakit::error::Diagnostic],
 }
 
 /// Runs `fap from-arkit`.

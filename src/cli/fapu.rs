@@ -36,7 +36,7 @@ struct Report {
     file: String,
     source: FapuSource,
     units: Vec<Row>,
-    notes: Vec<String>,
+    notes: Vec<fbakit::error::Diagnostic>,
 }
 
 pub fn run(args: FapuArgs) -> Result<u8> {
@@ -102,7 +102,7 @@ fn text(r: &Report) -> String {
         let _ = writeln!(s, "{:<6} {:<14} {u}", row.fapu.abbreviation(), d);
     }
     for n in &r.notes {
-        let _ = writeln!(s, "note: {n}");
+        let _ = writeln!(s, "note: {}", n.located_message());
     }
     s
 }

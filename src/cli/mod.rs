@@ -7,6 +7,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use fbakit::error::Diagnostic;
 
 /// `println!` for lines that quote file content: control characters escaped (see
 /// [`print_text`]). Defined before the submodules so they can use it.
@@ -392,14 +393,40 @@ pub fn report_error(e: &fbakit::error::Error, json: bool) -> ExitCode {
 
 /// Prints warnings to stderr, each once and with one `warning:` prefix (library warnings
 /// sometimes carry their own).
-pub fn print_warnings<S: AsRef<str>>(warnings: &[S]) {
+pub fn print_warnings<S: WarningText>(warnings: &[S]) {
     let mut seen = std::collections::HashSet::new();
     for w in warnings {
-        let w = w.as_ref().trim();
+        let w = w.warning_text();
+        let w = w.trim();
         let w = w.strip_prefix("warning:").map_or(w, str::trim_start);
         if seen.insert(w.to_string()) {
             eprintln!("warning: {}", fbakit::error::escape_control(w));
         }
+    }
+}
+
+/// Something [`print_warnings`] can print: plain text or a [`Diagnostic`] (printed with its
+/// location, the `warning:` prefix once).
+pub trait WarningText {
+    /// The text after the `warning:` prefix.
+    fn warning_text(&self) -> std::borrow::Cow<'_, str>;
+}
+
+impl WarningText for String {
+    fn warning_text(&self) -> std::borrow::Cow<'_, str> {
+        self.as_str().into()
+    }
+}
+
+impl WarningText for &str {
+    fn warning_text(&self) -> std::borrow::Cow<'_, str> {
+        (*self).into()
+    }
+}
+
+impl WarningText for Diagnostic {
+    fn warning_text(&self) -> std::borrow::Cow<'_, str> {
+        self.located_message().into()
     }
 }
 

@@ -56,7 +56,7 @@ struct RigInfo<'a> {
     vertices: usize,
     meshes: Vec<MeshInfo<'a>>,
     shapes: Vec<ShapeInfo<'a>>,
-    warnings: &'a [String],
+    warnings: &'a [fbakit::error::Diagnostic],
 }
 
 fn info(rig: &Rig) -> RigInfo<'_> {

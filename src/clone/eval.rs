@@ -30,8 +30,8 @@ use super::face::{
     Method, Similarity,
 };
 use super::quality::morph_target_error;
-use super::SurfaceMotion;
-use crate::error::{Error, Result};
+use super::{CloneError, SurfaceMotion};
+use crate::error::Result;
 use crate::face::FaceModel;
 use crate::fat::eval::Activation;
 use crate::fat::morph::fat_to_morph_targets;
@@ -52,10 +52,10 @@ pub fn self_clone_error(face: &FaceModel, method: Method) -> Result<f64> {
 pub fn self_clone_error_with(face: &FaceModel, opts: &CloneOptions) -> Result<f64> {
     let parts = identify_parts(face);
     if parts.skin.is_empty() {
-        return Err(Error::Invalid(format!(
-            "face `{}` has no skin mesh",
-            face.name
-        )));
+        return Err(CloneError::NoSkin {
+            face: format!("face `{}`", face.name),
+        }
+        .into());
     }
     let skin = build_skin_surface(face, &parts.skin, &Similarity::IDENTITY)?;
     let targets = fat_to_morph_targets(&face.fat);
@@ -248,13 +248,10 @@ pub fn ground_truth_error(cloned: &FaceModel, truth: &FaceModel) -> Result<Groun
                 None => row.push((mi, v)),
                 Some(ix) => {
                     let Some((k, d)) = ix.nearest_vertex(p) else {
-                        return Err(Error::Invalid("cloned face has no vertices".into()));
+                        return Err(CloneError::EmptyClone.into());
                     };
                     if d > 1e-4 * (1.0 + p.length()) {
-                        return Err(Error::Invalid(
-                            "ground truth comparison needs the same neutral geometry on both faces"
-                                .into(),
-                        ));
+                        return Err(CloneError::TruthGeometryDiffers.into());
                     }
                     row.push(flat[k as usize]);
                 }
@@ -386,10 +383,10 @@ pub fn clone_against_truth(
     opts: &CloneOptions,
 ) -> Result<TruthRun> {
     if truth.fat.tables.is_empty() {
-        return Err(Error::Invalid(format!(
-            "face `{}` has no FAT to compare with: the truth must be a face with its true tables",
-            truth.name
-        )));
+        return Err(CloneError::NoTruthFat {
+            face: truth.name.clone(),
+        }
+        .into());
     }
     let outcome = clone_face(source, &without_fat(truth), opts)?;
     let report = ground_truth_error(&outcome.face, truth)?;

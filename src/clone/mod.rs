@@ -28,7 +28,7 @@ pub mod quality;
 pub mod rbf;
 mod tri_filter;
 
-pub use error::CloneError;
+pub use error::{CloneError, FitSystemError, RbfFitError};
 
 use std::collections::BTreeMap;
 
@@ -59,6 +59,93 @@ impl CloneSurface {
     /// Position of a feature point, if known.
     pub fn fp(&self, id: FeaturePointId) -> Option<Vec3> {
         self.fp_positions.get(&id).copied()
+    }
+
+    /// Checks what every cloning method relies on: at least one vertex and one triangle, at
+    /// most `u32::MAX` vertices, finite positions (vertices and feature points), and
+    /// triangles and feature points naming existing vertices. `side` (`source` or `target`)
+    /// names the surface in the error.
+    ///
+    /// ```
+    /// use fbakit::clone::{CloneError, CloneSurface};
+    /// use fbakit::fdp::{Fapu, FapuDistances};
+    /// use glam::Vec3;
+    ///
+    /// let d = FapuDistances { irisd0: 0.01, es0: 0.06, ens0: 0.04, mns0: 0.02, mw0: 0.05 };
+    /// let s = CloneSurface {
+    ///     positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+    ///     triangles: vec![[0, 1, 3]],
+    ///     fp_vertices: Default::default(),
+    ///     fp_positions: Default::default(),
+    ///     fapu: Fapu::from_distances(d).unwrap(),
+    /// };
+    /// let e = s.check("target").unwrap_err();
+    /// assert!(matches!(e, CloneError::TriangleOutOfRange { .. }));
+    /// assert!(e.to_string().starts_with("the target surface: triangle [0, 1, 3]"));
+    /// ```
+    pub fn check(&self, side: &str) -> Result<(), CloneError> {
+        let n = self.positions.len();
+        if n == 0 || self.triangles.is_empty() {
+            return Err(CloneError::EmptySurface { side: side.into() });
+        }
+        if u32::try_from(n).is_err() {
+            return Err(CloneError::TooManyVertices {
+                side: side.into(),
+                vertices: n,
+            });
+        }
+        if let Some(vertex) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(CloneError::NonFinitePosition {
+                side: side.into(),
+                vertex,
+            });
+        }
+        if let Some(&triangle) = self
+            .triangles
+            .iter()
+            .find(|t| t.iter().any(|&v| v as usize >= n))
+        {
+            return Err(CloneError::TriangleOutOfRange {
+                side: side.into(),
+                triangle,
+                vertices: n,
+            });
+        }
+        if let Some((&id, _)) = self.fp_positions.iter().find(|(_, p)| !p.is_finite()) {
+            return Err(CloneError::NonFiniteFeaturePoint {
+                side: side.into(),
+                id,
+            });
+        }
+        if let Some((&id, &vertex)) = self.fp_vertices.iter().find(|(_, &v)| v as usize >= n) {
+            return Err(CloneError::FeaturePointOutOfRange {
+                side: side.into(),
+                id,
+                vertex,
+                vertices: n,
+            });
+        }
+        Ok(())
+    }
+
+    /// Checks that every motion moves vertices of this (source) surface by finite offsets.
+    pub(crate) fn check_motions(&self, motions: &[SurfaceMotion]) -> Result<(), CloneError> {
+        let vertices = self.positions.len();
+        for m in motions {
+            if let Some(&(vertex, d)) = m
+                .offsets
+                .iter()
+                .find(|(v, d)| *v as usize >= vertices || !d.is_finite())
+            {
+                return Err(CloneError::BadMotion {
+                    key: m.key,
+                    vertex,
+                    offset: d.to_string(),
+                    vertices,
+                });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -103,7 +190,7 @@ pub struct SurfaceCloneResult {
     /// Method-specific figures (iterations, correspondence count, fallbacks, ...).
     pub stats: BTreeMap<String, f64>,
     /// Warnings for the user (missing optional feature points, ...).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::error::Diagnostic>,
 }
 
 /// CANDIDE-3 test faces with exact motions (tests and the `bench-fixtures` benchmarks only:

@@ -242,6 +242,18 @@ pub enum FaceError {
         /// The problem.
         source: Box<Error>,
     },
+    /// Subdividing a face would make more vertices than the limit.
+    #[error("face `{face}`: {rounds} rounds of subdivision would make over {max} vertices from {vertices}; use fewer rounds")]
+    TooManySubdivided {
+        /// The face.
+        face: String,
+        /// Rounds asked for.
+        rounds: usize,
+        /// Vertices before subdividing.
+        vertices: usize,
+        /// The limit ([`crate::face::subdivide::MAX_SUBDIVIDED_VERTICES`]).
+        max: usize,
+    },
 }
 
 impl FaceError {

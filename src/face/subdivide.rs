@@ -19,7 +19,8 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::face::FaceError;
 use crate::face::FaceModel;
 use crate::fat::FaceDefMesh;
 use crate::mesh::geometry::triangulate;
@@ -35,10 +36,13 @@ pub fn subdivide_face(face: &FaceModel, scheme: Scheme, rounds: usize) -> Result
     let vertices: usize = face.meshes.iter().map(|m| m.mesh.positions.len()).sum();
     let estimate = (0..rounds).try_fold(vertices, |v, _| v.checked_mul(4));
     if estimate.is_none_or(|v| v > MAX_SUBDIVIDED_VERTICES) {
-        return Err(Error::Invalid(format!(
-            "face `{}`: {rounds} rounds of subdivision would make over {MAX_SUBDIVIDED_VERTICES} vertices from {vertices}; use fewer rounds",
-            face.name
-        )));
+        return Err(FaceError::TooManySubdivided {
+            face: face.name.clone(),
+            rounds,
+            vertices,
+            max: MAX_SUBDIVIDED_VERTICES,
+        }
+        .into());
     }
     let mut out = face.clone();
     out.scene = None;

@@ -114,8 +114,8 @@ pub struct FaceSummary {
     pub fat: FatSummary,
     /// Feature points matched to vertices, when the reader matched any.
     pub fp_matches: Option<MatchSummary>,
-    /// Reader diagnostics (errors and warnings), as text.
-    pub diagnostics: Vec<String>,
+    /// Reader diagnostics (errors and warnings).
+    pub diagnostics: Vec<crate::error::Diagnostic>,
 }
 
 fn transform_path(face: &FaceModel, t: Option<usize>) -> String {
@@ -265,9 +265,7 @@ pub fn summarize(face: &FaceModel, report: Option<&FaceReadReport>) -> FaceSumma
         units: crate::face::units::detect_unit(face),
         fat,
         fp_matches,
-        diagnostics: report
-            .map(|r| r.diagnostics.iter().map(|d| d.to_string()).collect())
-            .unwrap_or_default(),
+        diagnostics: report.map(|r| r.diagnostics.clone()).unwrap_or_default(),
     }
 }
 

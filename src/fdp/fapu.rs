@@ -71,7 +71,7 @@ impl Fapu {
         let iris = if has(l_top) && has(l_bottom) {
             (l_top, l_bottom)
         } else if has(r_top) && has(r_bottom) {
-            notes.push(format!(
+            notes.push(crate::error::Diagnostic::warning(format!(
                 "IRISD0 measured on the right eye (3.2.y - 3.4.y) because {} {} no position",
                 missing_list(&[l_top, l_bottom], points),
                 if has(l_top) || has(l_bottom) {
@@ -79,7 +79,7 @@ impl Fapu {
                 } else {
                     "have"
                 },
-            ));
+            )));
             (r_top, r_bottom)
         } else {
             (l_top, l_bottom)
@@ -189,8 +189,9 @@ impl Fapu {
 pub struct FapuMeasurement {
     /// The units.
     pub fapu: Fapu,
-    /// Deviations from the standard's primary definition (e.g. the right eye used for IRISD0).
-    pub notes: Vec<String>,
+    /// Deviations from the standard's primary definition (e.g. the right eye used for IRISD0),
+    /// as warnings.
+    pub notes: Vec<crate::error::Diagnostic>,
 }
 
 fn missing_list(ids: &[FeaturePointId], points: &FeaturePointSet) -> String {
@@ -292,7 +293,7 @@ mod feature_point_tests {
         assert!((m.fapu.distances.irisd0 - 0.6).abs() < 1e-6);
         assert_eq!(m.notes.len(), 1);
         assert!(
-            m.notes[0].contains("right eye") && m.notes[0].contains("3.3"),
+            m.notes[0].message.contains("right eye") && m.notes[0].message.contains("3.3"),
             "{:?}",
             m.notes
         );

@@ -180,6 +180,24 @@ pub fn read_fap_map(path: &Path) -> Result<FapMap> {
     parse_fap_map(&text, path)
 }
 
+/// Reads a mapping table from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]; strict like [`read_fap_map`]); `source` names it
+/// in errors.
+///
+/// ```
+/// use std::path::Path;
+/// use fbakit::fat::TableKey;
+/// use fbakit::spec::FapId;
+/// let csv = "fap,positive,negative,reasoning\nopen_jaw,jawOpen,,drops the jaw\n";
+/// let map = fbakit::rig::fap_map::read_fap_map_from(csv.as_bytes(), Path::new("map.csv"))?;
+/// assert!(map.row(TableKey::LowLevel(FapId::new(3).unwrap())).is_some());
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
+pub fn read_fap_map_from<R: std::io::BufRead>(reader: R, source: &Path) -> Result<FapMap> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_fap_map(&text, source)
+}
+
 /// Parses a mapping table; `file` names it in errors (`file:line:column: expected ...`).
 pub fn parse_fap_map(text: &str, file: &Path) -> Result<FapMap> {
     let mut reader = csv::ReaderBuilder::new()
@@ -350,6 +368,15 @@ mod tests {
             .unwrap();
         assert_eq!(smile.negative[0][0].shape, "mouthFrownLeft");
         assert!(m.rows.iter().all(|r| !r.reasoning.is_empty()));
+    }
+
+    #[test]
+    fn reader_matches_text_and_names_its_source() {
+        let from = read_fap_map_from(ARKIT_MAP_CSV.as_bytes(), Path::new("m.csv")).unwrap();
+        let text = parse_fap_map(ARKIT_MAP_CSV, Path::new("m.csv")).unwrap();
+        assert_eq!(from.rows, text.rows);
+        let e = read_fap_map_from(&b"fap,positive\n\xff\n"[..], Path::new("bad.csv")).unwrap_err();
+        assert!(e.to_string().contains("bad.csv"), "{e}");
     }
 
     #[test]

@@ -24,7 +24,7 @@ use ::gltf::{Accessor, Document, Gltf};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use super::{BlendShape, Rig, RigError, RigMesh, ShapeDelta, MAX_RIG_SHAPES, MAX_RIG_VERTICES};
-use crate::error::{Error, Result};
+use crate::error::{Diagnostic, Error, Result};
 use crate::mesh::{FaceGroup, Mesh, Polygons};
 
 /// Largest glTF file (and each external buffer) read: 1 GiB.
@@ -620,10 +620,10 @@ impl Reader<'_> {
         match prim.mode() {
             Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan => {}
             other => {
-                self.rig.warnings.push(format!(
+                self.rig.warnings.push(Diagnostic::warning(format!(
                     "{}: {at}: {other:?} primitive skipped (only triangles are faces)",
                     self.file.display()
-                ));
+                )));
                 return Ok(());
             }
         }
@@ -701,12 +701,12 @@ impl Reader<'_> {
         }
         let triangles = triangles(prim.mode(), &indices);
         if prim.mode() == Mode::Triangles && indices.len() % 3 != 0 {
-            self.rig.warnings.push(format!(
+            self.rig.warnings.push(Diagnostic::warning(format!(
                 "{}: {at}: {} indices is not a multiple of 3; the last {} ignored",
                 self.file.display(),
                 indices.len(),
                 indices.len() % 3
-            ));
+            )));
         }
         // glTF winding is counter-clockwise; a mirroring transform flips it.
         let flip = linear.determinant() < 0.0;

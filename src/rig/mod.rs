@@ -43,7 +43,7 @@ use std::path::Path;
 use glam::Vec3;
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::{Diagnostic, Error, Result};
 use crate::face::{FaceMesh, FaceModel};
 use crate::mesh::Mesh;
 
@@ -113,7 +113,7 @@ pub struct Rig {
     /// The blend shapes, in file order.
     pub shapes: Vec<BlendShape>,
     /// Things the reader skipped or worked around (printed as warnings).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Diagnostic>,
 }
 
 impl Rig {

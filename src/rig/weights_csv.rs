@@ -26,7 +26,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::error::{ParseError, Result};
+use crate::error::{Diagnostic, ParseError, Result};
 
 /// Most weight columns a file may have.
 pub const MAX_COLUMNS: usize = 1024;
@@ -78,13 +78,34 @@ pub struct WeightCsv {
     /// The rows, frame numbers increasing.
     pub rows: Vec<WeightRow>,
     /// Clamped values and replaced rows, one line each.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// Reads a weight CSV file (bounded read); see [`parse_weights_csv`].
 pub fn read_weights_csv(path: &Path, fps: Option<f64>) -> Result<WeightCsv> {
     let text = crate::io::read_text(path)?;
     parse_weights_csv(&text, path, fps)
+}
+
+/// Reads a weight CSV from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]); `source` names it in messages; see
+/// [`parse_weights_csv`].
+///
+/// ```
+/// use std::path::Path;
+/// let csv = "time,jawOpen\n0,0\n0.04,0.5\n0.08,1\n";
+/// let w = fbakit::rig::weights_csv::read_weights_csv_from(csv.as_bytes(), Path::new("w.csv"), None)?;
+/// assert_eq!(w.fps, 25.0);
+/// assert_eq!(w.rows.len(), 3);
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
+pub fn read_weights_csv_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+    fps: Option<f64>,
+) -> Result<WeightCsv> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_weights_csv(&text, source, fps)
 }
 
 /// One comma-separated field: its text (trimmed, quotes removed) and byte offset.
@@ -391,18 +412,18 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
     }
     let mut warnings = Vec::new();
     if let Some((line, col, name)) = first_clamp {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{}: {clamped} weight{} outside 0..1 clamped (first at line {line}, column {col} `{name}`)",
             file.display(),
             if clamped == 1 { "" } else { "s" }
-        ));
+        )));
     }
     if replaced > 0 {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{}: {replaced} row{} fell on the previous row's frame at {fps_value} fps and replaced it",
             file.display(),
             if replaced == 1 { "" } else { "s" }
-        ));
+        )));
     }
     Ok(WeightCsv {
         time: time_kind,
@@ -525,12 +546,22 @@ mod tests {
         assert_eq!(w.rows[3].weights[0], 1.0);
         assert_eq!(w.warnings.len(), 1, "{:?}", w.warnings);
         assert!(
-            w.warnings[0].contains(
+            w.warnings[0].message.contains(
                 "w.csv: 1 weight outside 0..1 clamped (first at line 5, column 3 `EyeBlinkLeft`)"
             ),
             "{}",
             w.warnings[0]
         );
+    }
+
+    #[test]
+    fn reader_matches_text_and_names_its_source() {
+        let text = "time,jawOpen\n0,0\n0.04,0.5\n0.08,1\n";
+        let from = read_weights_csv_from(text.as_bytes(), Path::new("w.csv"), None).unwrap();
+        assert_eq!(from.rows.len(), parse(text, None).unwrap().rows.len());
+        assert_eq!(from.fps, 25.0);
+        let e = read_weights_csv_from(&b"time,\xff\n"[..], Path::new("bad.csv"), None).unwrap_err();
+        assert!(e.to_string().contains("bad.csv"), "{e}");
     }
 
     #[test]

@@ -145,8 +145,8 @@ pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 use super::fit::clone_fit;
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
-use super::{CloneSurface, SurfaceCloneResult, SurfaceMotion};
-use crate::error::{Error, Result};
+use super::{CloneError, CloneSurface, SurfaceCloneResult, SurfaceMotion};
+use crate::error::{Diagnostic, Result};
 use crate::face::FaceModel;
 use crate::fat::morph::{fat_to_morph_targets, MorphTarget};
 use crate::fat::{Fat, TableKey};
@@ -188,10 +188,10 @@ pub fn clone_face(
     source.check_structure()?;
     target.check_structure()?;
     if source.fat.tables.is_empty() {
-        return Err(Error::Invalid(format!(
-            "source face `{}` has no FAT to clone",
-            source.name
-        )));
+        return Err(CloneError::NoSourceFat {
+            face: source.name.clone(),
+        }
+        .into());
     }
     // 1. Parts (a one-mesh target first has its eyes, teeth and gums cut into part meshes).
     let clock = Instant::now();
@@ -371,7 +371,7 @@ fn clone_skin_motions(
         rescaled,
     );
     for f in &report.failed_faps {
-        report.warnings.push(format!(
+        report.warnings.push(Diagnostic::warning(format!(
             "FAP {} at {}: {} (factor {:.4}); {}",
             f.fap,
             f.value,
@@ -382,7 +382,7 @@ fn clone_skin_motions(
             } else {
                 "its table is dropped"
             }
-        ));
+        )));
     }
     report.timings.push("guard", clock.elapsed().as_secs_f64());
     Ok(result.motions)
@@ -394,12 +394,13 @@ fn check_parts(
     face: &FaceModel,
     parts: &FaceParts,
     side: &str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Diagnostic>,
 ) -> Result<()> {
     if parts.skin.is_empty() {
-        return Err(Error::Invalid(format!(
-            "{side} face has no skin mesh: no mesh holds a skin feature point"
-        )));
+        return Err(CloneError::NoSkin {
+            face: format!("{side} face"),
+        }
+        .into());
     }
     if !parts.other.is_empty() {
         let names: Vec<&str> = parts
@@ -407,10 +408,10 @@ fn check_parts(
             .iter()
             .map(|&m| face.meshes[m].name.as_str())
             .collect();
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{side} meshes {} are neither skin nor a part; they stay rigid with the head",
             names.join(", ")
-        ));
+        )));
     }
     Ok(())
 }

@@ -36,7 +36,7 @@ pub struct CloneReport {
     /// Figures from the surface method and the face layer.
     pub stats: BTreeMap<String, f64>,
     /// Warnings for the user.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::error::Diagnostic>,
     /// Source parts.
     pub source_parts: FaceParts,
     /// Target parts.

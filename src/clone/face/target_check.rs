@@ -9,6 +9,7 @@ use std::collections::HashMap;
 use glam::Vec3;
 
 use super::FaceParts;
+use crate::error::Diagnostic;
 use crate::face::FaceModel;
 use crate::mesh::components::UnionFind;
 
@@ -30,7 +31,7 @@ const SHOWN: usize = 3;
 
 /// Adds a warning for each kind of damage found in `target` (its skin meshes and feature
 /// points).
-pub(super) fn check_target(target: &FaceModel, tparts: &FaceParts, warnings: &mut Vec<String>) {
+pub(super) fn check_target(target: &FaceModel, tparts: &FaceParts, warnings: &mut Vec<Diagnostic>) {
     for &m in &tparts.skin {
         check_mesh(target, m, warnings);
     }
@@ -46,7 +47,7 @@ fn at(p: Vec3) -> String {
     format!("({:.1}, {:.1}, {:.1})", p.x, p.y, p.z)
 }
 
-fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
+fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<Diagnostic>) {
     let fm = &target.meshes[m];
     let mesh = &fm.mesh;
     let np = mesh.positions.len();
@@ -66,7 +67,7 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
     // A short seam of coincident vertices is deliberate (closed lips that open); many mean a
     // mesh whose polygons were never joined.
     if dups.len() > (np / 50).max(16) {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{prefix}: {}; the surface is welded there",
             listed(
                 dups.len(),
@@ -76,7 +77,7 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
                 ),
                 &dups[..dups.len().min(SHOWN)]
             )
-        ));
+        )));
     }
 
     // Edges: how often each is used, and in which direction.
@@ -108,14 +109,14 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
         .map(|&(e, _)| place(e))
         .collect();
     if !non_manifold.is_empty() {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{prefix}: {}; motion is not carried across them",
             listed(
                 non_manifold.len(),
                 "non-manifold edges (more than two polygons)",
                 &non_manifold[..non_manifold.len().min(SHOWN)]
             )
-        ));
+        )));
     }
     let flipped: Vec<String> = sorted
         .iter()
@@ -123,14 +124,14 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
         .map(|&(e, _)| place(e))
         .collect();
     if !flipped.is_empty() {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "{prefix}: {}; normals there point the wrong way",
             listed(
                 flipped.len(),
                 "edges between polygons wound opposite ways (flipped polygons)",
                 &flipped[..flipped.len().min(SHOWN)]
             )
-        ));
+        )));
     }
 
     // Holes: small loops of boundary edges (edges of one polygon).
@@ -163,16 +164,16 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<String>) {
                 .take(SHOWN)
                 .map(|&v| format!("at vertex {v} {}", at(mesh.positions[v as usize])))
                 .collect();
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "{prefix}: {}; the motion across them is interpolated",
                 listed(holes.len(), "holes", &places)
-            ));
+            )));
         }
     }
 }
 
 /// Feature points far from every vertex, and feature points at the same place.
-fn check_feature_points(target: &FaceModel, warnings: &mut Vec<String>) {
+fn check_feature_points(target: &FaceModel, warnings: &mut Vec<Diagnostic>) {
     let frames = target.frames();
     let world: Vec<Vec3> = target
         .meshes
@@ -209,11 +210,11 @@ fn check_feature_points(target: &FaceModel, warnings: &mut Vec<String>) {
         })
         .collect();
     if !off.is_empty() {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "target feature points off the mesh: {}; the clone aligns and scales by them as \
              they are",
             off.join(", ")
-        ));
+        )));
     }
     let mut same = Vec::new();
     for (i, (a, pa)) in points.iter().enumerate() {
@@ -227,9 +228,9 @@ fn check_feature_points(target: &FaceModel, warnings: &mut Vec<String>) {
         }
     }
     if !same.is_empty() {
-        warnings.push(format!(
+        warnings.push(Diagnostic::warning(format!(
             "target feature points coincide: {}; distances measured between them are zero",
             same.join(", ")
-        ));
+        )));
     }
 }

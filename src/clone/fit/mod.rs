@@ -58,7 +58,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::mesh::spatial::find_coincident_vertices;
 use regions::{classify, triangle_masks};
 use register::{register, Moving};
@@ -124,25 +124,6 @@ impl Default for FitOptions {
     }
 }
 
-/// Checks a surface's numbers and indices.
-fn check_surface(s: &CloneSurface, side: &str) -> Result<()> {
-    if s.positions.is_empty() || s.triangles.is_empty() {
-        return Err(Error::Invalid(format!("fit: the {side} surface is empty")));
-    }
-    if s.positions.iter().any(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "fit: the {side} surface has a non-finite position"
-        )));
-    }
-    let n = s.positions.len();
-    if s.triangles.iter().flatten().any(|&v| v as usize >= n) {
-        return Err(Error::Invalid(format!(
-            "fit: the {side} surface has a triangle index out of range"
-        )));
-    }
-    Ok(())
-}
-
 /// Which vertices some triangle uses.
 fn used_vertices(s: &CloneSurface) -> Vec<bool> {
     let mut used = vec![false; s.positions.len()];
@@ -191,8 +172,7 @@ fn face_scale(s: &CloneSurface) -> f32 {
 /// Clones `motions` of `source` onto `target` (module docs). The result has one motion per
 /// source motion, in the same order, on the target's vertices.
 ///
-/// Errors: an empty surface, non-finite positions, out-of-range triangle indices, or a
-/// failing linear solve. Feature points missing on either side (fewer landmarks, slits not
+/// Errors: a surface failing [`CloneSurface::check`], or a failing linear solve. Feature points missing on either side (fewer landmarks, slits not
 /// found) are warnings.
 pub fn clone_fit(
     source: &CloneSurface,
@@ -200,11 +180,11 @@ pub fn clone_fit(
     target: &CloneSurface,
     opts: &FitOptions,
 ) -> Result<SurfaceCloneResult> {
-    check_surface(source, "source")?;
-    check_surface(target, "target")?;
+    source.check("source")?;
+    target.check("target")?;
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = Vec::new();
     if opts.shared_topology && same_topology(source, target) {
         let clock = Instant::now();
         let corr: Vec<_> = (0..target.positions.len() as u32)
@@ -225,7 +205,7 @@ pub fn clone_fit(
             motions: out,
             timings,
             stats,
-            warnings,
+            warnings: Vec::new(),
         });
     }
     // 1. Sides.
@@ -260,13 +240,15 @@ pub fn clone_fit(
         .collect();
     if off_mesh > 0 {
         warnings.push(format!(
-            "fit: {off_mesh} feature points are not on any triangle of the source or target              surface; they are not used as landmarks"
+            "fit: {off_mesh} feature points are not on any triangle of the source or target \
+             surface; they are not used as landmarks"
         ));
     }
     let loose = loose_duplicates(target, &t_sides);
     if loose > 0 {
         warnings.push(format!(
-            "fit: {loose} target vertices duplicate another vertex away from the mouth and              eyes (an unwelded seam); each side is mapped on its own"
+            "fit: {loose} target vertices duplicate another vertex away from the mouth and \
+             eyes (an unwelded seam); each side is mapped on its own"
         ));
     }
     if landmarks.len() < 8 {
@@ -342,7 +324,10 @@ pub fn clone_fit(
         motions: out,
         timings,
         stats,
-        warnings,
+        warnings: warnings
+            .into_iter()
+            .map(crate::error::Diagnostic::warning)
+            .collect(),
     })
 }
 

@@ -8,6 +8,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, Side};
 
+use crate::clone::{CloneError, FitSystemError};
 use crate::error::{Error, Result};
 
 /// The smoothness matrix (lower triangle, compressed columns) and its symbolic factorisation.
@@ -37,8 +38,15 @@ fn laplacian_rows(adj: &[Vec<u32>]) -> Vec<Vec<(u32, f64)>> {
         .collect()
 }
 
-fn faer_error(what: &str, e: impl std::fmt::Debug) -> Error {
-    Error::Invalid(format!("fit: {what} failed ({e:?})"))
+fn fail(e: FitSystemError) -> Error {
+    CloneError::FitSystem(e).into()
+}
+
+fn faer_error(step: &'static str, e: impl std::fmt::Debug) -> Error {
+    fail(FitSystemError::Solver {
+        step,
+        details: format!("{e:?}"),
+    })
 }
 
 impl SmoothSystem {
@@ -47,9 +55,7 @@ impl SmoothSystem {
     pub fn new(adj: &[Vec<u32>], membrane: f64) -> Result<Self> {
         let n = adj.len();
         if n == 0 || n >= u32::MAX as usize / 2 {
-            return Err(Error::Invalid(format!(
-                "fit: cannot solve for {n} vertices"
-            )));
+            return Err(fail(FitSystemError::Size { vertices: n }));
         }
         let rows = laplacian_rows(adj);
         // Pattern: every pair inside a closed one-ring (the two-ring), lower triangle, and
@@ -121,7 +127,7 @@ impl SmoothSystem {
     pub fn solve(&self, alpha: f64, diag: &[f64], rhs: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
         let n = self.n;
         if diag.len() != n || rhs.len() != n {
-            return Err(Error::Invalid("fit: system size mismatch".into()));
+            return Err(fail(FitSystemError::SizeMismatch));
         }
         let mut vals: Vec<f64> = self.smooth.iter().map(|v| v * alpha).collect();
         for (j, &d) in diag.iter().enumerate() {
@@ -142,7 +148,7 @@ impl SmoothSystem {
         llt.solve_in_place(b.as_mut());
         let out: Vec<[f64; 3]> = (0..n).map(|i| [b[(i, 0)], b[(i, 1)], b[(i, 2)]]).collect();
         if out.iter().flatten().any(|x| !x.is_finite()) {
-            return Err(Error::Invalid("fit: non-finite solution".into()));
+            return Err(fail(FitSystemError::NonFinite));
         }
         Ok(out)
     }

@@ -117,7 +117,8 @@ use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
-use crate::error::{Error, Result};
+use crate::clone::CloneError;
+use crate::error::{Diagnostic, Result};
 use crate::spec::FeaturePointId;
 use interp::TriMesh2;
 use lips::{LipPolygons, LipRegion};
@@ -191,35 +192,6 @@ pub fn optional_feature_points() -> Vec<FeaturePointId> {
     lips::OPTIONAL.to_vec()
 }
 
-fn check_surface(surface: &CloneSurface, name: &str) -> Result<()> {
-    if let Some(i) = surface.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "{name} face: vertex {i} has a non-finite position"
-        )));
-    }
-    let n = surface.positions.len();
-    if let Some(t) = surface
-        .triangles
-        .iter()
-        .find(|t| t.iter().any(|&v| v as usize >= n))
-    {
-        return Err(Error::Invalid(format!(
-            "{name} face: triangle {t:?} refers to a vertex beyond the {n} vertices"
-        )));
-    }
-    if let Some((id, p)) = surface.fp_positions.iter().find(|(_, p)| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "{name} face: feature point {id} has a non-finite position {p}"
-        )));
-    }
-    if let Some((id, v)) = surface.fp_vertices.iter().find(|(_, &v)| v as usize >= n) {
-        return Err(Error::Invalid(format!(
-            "{name} face: feature point {id} names vertex {v} beyond the {n} vertices"
-        )));
-    }
-    Ok(())
-}
-
 fn missing(surface: &CloneSurface, ids: &[FeaturePointId]) -> Vec<String> {
     ids.iter()
         .filter(|id| !surface.fp_positions.contains_key(id))
@@ -238,9 +210,27 @@ struct Projected {
 }
 
 fn project_face(norm: normalise::Normalised, mouth_angle: f64, name: &str) -> Result<Projected> {
-    let fp = |s: &str| norm.fps[&s.parse::<FeaturePointId>().expect("label")];
-    let axis = Cylinder::solve(fp("9.3"), fp("8.3"), fp("8.4"), mouth_angle)
-        .map_err(|e| Error::Invalid(format!("{name} face: {e}")))?;
+    // The caller checked the required points, so a miss here is only a broken invariant;
+    // it still becomes an error rather than a panic.
+    let fp = |id: FeaturePointId| {
+        norm.fps
+            .get(&id)
+            .copied()
+            .ok_or_else(|| CloneError::MissingFeaturePoint {
+                side: name.into(),
+                id,
+            })
+    };
+    let axis = Cylinder::solve(
+        fp(FeaturePointId::FP_9_3)?,
+        fp(FeaturePointId::FP_8_3)?,
+        fp(FeaturePointId::FP_8_4)?,
+        mouth_angle,
+    )
+    .map_err(|reason| CloneError::Projection {
+        side: name.into(),
+        reason,
+    })?;
     let (uv, depth): (Vec<DVec2>, Vec<f64>) =
         norm.positions.par_iter().map(|&p| axis.project(p)).unzip();
     let fps = norm
@@ -275,53 +265,36 @@ pub fn clone_fmc(
     target: &CloneSurface,
     opts: &FmcOptions,
 ) -> Result<SurfaceCloneResult> {
-    check_surface(source, "source")?;
-    check_surface(target, "target")?;
+    source.check("source")?;
+    target.check("target")?;
     let required = required_feature_points();
     let (ms, mt) = (missing(source, &required), missing(target, &required));
     if !ms.is_empty() || !mt.is_empty() {
-        let mut parts = Vec::new();
-        if !ms.is_empty() {
-            parts.push(format!("source face lacks {}", ms.join(", ")));
+        return Err(CloneError::MissingFeaturePoints {
+            source_lacks: ms,
+            target_lacks: mt,
         }
-        if !mt.is_empty() {
-            parts.push(format!("target face lacks {}", mt.join(", ")));
-        }
-        return Err(Error::Invalid(format!(
-            "facial motion cloning needs these feature points: {}",
-            parts.join("; ")
-        )));
+        .into());
     }
     let mut warnings = Vec::new();
     let optional = optional_feature_points();
     for (face, name) in [(source, "source"), (target, "target")] {
         let m = missing(face, &optional);
         if !m.is_empty() {
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "{name} face lacks inner-lip points {}; the lip regions are coarser",
                 m.join(", ")
-            ));
-        }
-    }
-    for m in motions {
-        if let Some(&(v, d)) = m
-            .offsets
-            .iter()
-            .find(|(v, d)| *v as usize >= source.positions.len() || !d.is_finite())
-        {
-            return Err(Error::Invalid(format!(
-                "motion {:?}: offset {d} of vertex {v} is not a finite displacement of one of \
-                 the source's {} vertices",
-                m.key,
-                source.positions.len()
             )));
         }
     }
+    source.check_motions(motions)?;
     if !(opts.filter_support.is_finite() && opts.filter_support >= 0.0) {
-        return Err(Error::Invalid(format!(
-            "filter support {} must be a finite non-negative size",
-            opts.filter_support
-        )));
+        return Err(CloneError::BadOption {
+            method: "fmc",
+            option: "filter_support",
+            value: opts.filter_support.into(),
+        }
+        .into());
     }
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
@@ -402,9 +375,7 @@ pub fn clone_fmc(
         std::f64::consts::PI,
     );
     if mesh.triangles.is_empty() {
-        return Err(Error::Invalid(
-            "source face has no usable (non-degenerate) triangles".into(),
-        ));
+        return Err(CloneError::NoUsableTriangles.into());
     }
     let src_polys = LipPolygons::new(&src.fps);
     let tri_lip: Vec<LipRegion> = mesh
@@ -554,11 +525,13 @@ pub fn clone_fmc(
             .filter(|(_, d)| **d != DVec3::ZERO)
             .map(|(i, d)| (i as u32, d.as_vec3()))
             .collect();
-        if let Some((v, d)) = offsets.iter().find(|(_, d)| !d.is_finite()) {
-            return Err(Error::Invalid(format!(
-                "motion {:?} produced a non-finite displacement {d} at target vertex {v}",
-                m.key
-            )));
+        if let Some(&(vertex, _)) = offsets.iter().find(|(_, d)| !d.is_finite()) {
+            return Err(CloneError::NonFiniteOutput {
+                method: "fmc",
+                key: m.key,
+                vertex,
+            }
+            .into());
         }
         out.push(SurfaceMotion {
             key: m.key,

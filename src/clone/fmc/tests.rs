@@ -379,7 +379,7 @@ fn missing_required_points_are_all_listed_and_optional_ones_warned() {
     )
     .unwrap();
     assert!(
-        r.warnings.iter().any(|w| w.contains("2.6")),
+        r.warnings.iter().any(|w| w.message.contains("2.6")),
         "{:?}",
         r.warnings
     );

@@ -8,6 +8,7 @@ use crate::spec::FeaturePointId;
 
 use super::super::CloneSurface;
 use super::mesh::VertexTriangles;
+use crate::error::Diagnostic;
 
 /// The extracted contours of one face (vertex paths). A contour that could not be walked is
 /// `None` and the reason is in the warnings.
@@ -35,22 +36,24 @@ pub(crate) fn extract(
     adj: &[Vec<u32>],
     incidence: &VertexTriangles,
     face: &str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Diagnostic>,
 ) -> Contours {
     let pos = &surface.positions;
     let mut eye = |labels: [FeaturePointId; 4], name: &str| -> Option<Vec<u32>> {
         let fps: Option<Vec<u32>> = labels.iter().map(|&l| fp_vertex(surface, l)).collect();
         let Some(fps) = fps else {
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "{face}: {name} contour skipped: feature points {} are not all surface vertices",
                 labels.map(|l| l.to_string()).join(", ")
-            ));
+            )));
             return None;
         };
         match eye_loop(pos, adj, &fps) {
             Ok(c) => Some(c),
             Err(e) => {
-                warnings.push(format!("{face}: {name} contour skipped: {e}"));
+                warnings.push(Diagnostic::warning(format!(
+                    "{face}: {name} contour skipped: {e}"
+                )));
                 None
             }
         }
@@ -87,16 +90,16 @@ pub(crate) fn extract(
                 let mid = fp_vertex(surface, mid).filter(|&m| m != s && m != e);
                 match lip_contour(pos, adj, mesh, (s, mid, e), upper) {
                     Ok(c) => *slot = Some(c),
-                    Err(err) => warnings.push(format!(
+                    Err(err) => warnings.push(Diagnostic::warning(format!(
                         "{face}: {} inner lip contour skipped: {err}",
                         if upper { "upper" } else { "lower" }
-                    )),
+                    ))),
                 }
             }
         }
-        _ => warnings.push(format!(
+        _ => warnings.push(Diagnostic::warning(format!(
             "{face}: lip contours skipped: feature points 2.4 and 2.5 are not both surface vertices"
-        )),
+        ))),
     }
     Contours {
         right_eye,

@@ -19,7 +19,7 @@ use faer::linalg::solvers::Solve;
 use faer::Mat;
 use glam::{DVec3, Vec3};
 
-use crate::error::{Error, Result};
+use crate::clone::RbfFitError;
 
 /// A fitted multiquadric volume morph.
 #[derive(Clone, Debug)]
@@ -44,18 +44,14 @@ const MAX_PIVOT_RATIO: f64 = 1e13;
 impl Multiquadric {
     /// Fits `f(p_i) = u_i`. The centres must be distinct (merge coincident ones first) and
     /// span 3D space (at least four not coplanar), else the system is singular and this
-    /// returns [`Error::Invalid`].
-    pub fn fit(pairs: &[(Vec3, Vec3)]) -> Result<Multiquadric> {
+    /// returns the [`RbfFitError`] saying why.
+    pub fn fit(pairs: &[(Vec3, Vec3)]) -> Result<Multiquadric, RbfFitError> {
         let n = pairs.len();
         if n < 4 {
-            return Err(Error::Invalid(format!(
-                "RBF fit needs at least 4 distinct correspondences, got {n}"
-            )));
+            return Err(RbfFitError::TooFew { found: n });
         }
         if pairs.iter().any(|(p, u)| !p.is_finite() || !u.is_finite()) {
-            return Err(Error::Invalid(
-                "RBF fit: a correspondence is not finite".into(),
-            ));
+            return Err(RbfFitError::NonFinite);
         }
         let origin = pairs.iter().map(|(p, _)| p.as_dvec3()).sum::<DVec3>() / n as f64;
         let scale = pairs
@@ -63,9 +59,7 @@ impl Multiquadric {
             .map(|(p, _)| (p.as_dvec3() - origin).length())
             .fold(0.0, f64::max);
         if scale <= 0.0 || !scale.is_finite() {
-            return Err(Error::Invalid(
-                "RBF fit: all correspondence points coincide".into(),
-            ));
+            return Err(RbfFitError::AllCoincide);
         }
         let centres: Vec<DVec3> = pairs
             .iter()
@@ -84,9 +78,7 @@ impl Multiquadric {
             })
             .collect();
         if radii2.iter().any(|&r| r.is_nan() || r <= 1e-20) {
-            return Err(Error::Invalid(
-                "RBF fit: two correspondence points coincide (merge them first)".into(),
-            ));
+            return Err(RbfFitError::Coincide);
         }
         let m = n + 4;
         let mut a = Mat::<f64>::zeros(m, m);
@@ -115,16 +107,12 @@ impl Multiquadric {
         }
         let pivot_ratio = if lo > 0.0 { hi / lo } else { f64::INFINITY };
         if pivot_ratio.is_nan() || pivot_ratio >= MAX_PIVOT_RATIO {
-            return Err(Error::Invalid(format!(
-                "RBF fit: the linear system is singular (pivot ratio {pivot_ratio:.3e})"
-            )));
+            return Err(RbfFitError::Singular { pivot_ratio });
         }
         lu.solve_in_place(&mut b);
         let x = b;
         if (0..m).any(|i| (0..3).any(|k| !x[(i, k)].is_finite())) {
-            return Err(Error::Invalid(
-                "RBF fit: the solution is not finite (singular system)".into(),
-            ));
+            return Err(RbfFitError::NonFiniteSolution);
         }
         let row = |i: usize| DVec3::new(x[(i, 0)], x[(i, 1)], x[(i, 2)]);
         let weights: Vec<DVec3> = (0..n).map(row).collect();
@@ -193,7 +181,7 @@ impl Multiquadric {
 }
 
 /// The affine part needs four centres that are not coplanar (else `P` loses rank).
-fn check_not_coplanar(centres: &[DVec3]) -> Result<()> {
+fn check_not_coplanar(centres: &[DVec3]) -> Result<(), RbfFitError> {
     let mean = centres.iter().sum::<DVec3>() / centres.len() as f64;
     let mut cov = nalgebra::Matrix3::<f64>::zeros();
     for c in centres {
@@ -205,11 +193,7 @@ fn check_not_coplanar(centres: &[DVec3]) -> Result<()> {
     let eig = cov.symmetric_eigenvalues();
     let (lo, hi) = (eig.min(), eig.max());
     if lo.is_nan() || hi.is_nan() || lo <= 1e-12 * hi || hi <= 0.0 {
-        return Err(Error::Invalid(
-            "RBF fit: the correspondence points are coplanar or collinear; at least 4 \
-             non-coplanar feature points are needed"
-                .into(),
-        ));
+        return Err(RbfFitError::Coplanar);
     }
     Ok(())
 }

@@ -115,7 +115,8 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
-use crate::error::{Error, Result};
+use crate::clone::{CloneError, RbfFitError};
+use crate::error::{Diagnostic, Result};
 use crate::mesh::geometry::vertex_normals;
 use crate::mesh::spatial::VertexIndex;
 use crate::spec::FeaturePointId;
@@ -233,42 +234,10 @@ impl Correspondences {
         }
     }
 
-    fn fit(&self) -> Result<Multiquadric> {
+    fn fit(&self) -> Result<Multiquadric, RbfFitError> {
         let pairs: Vec<(Vec3, Vec3)> = self.pairs.iter().map(|e| (e.0, e.1)).collect();
         Multiquadric::fit(&pairs)
     }
-}
-
-fn check_surface(s: &CloneSurface, name: &str) -> Result<()> {
-    let n = s.positions.len();
-    if n == 0 || s.triangles.is_empty() {
-        return Err(Error::Invalid(format!("{name} surface has no triangles")));
-    }
-    if n > u32::MAX as usize {
-        return Err(Error::Invalid(format!(
-            "{name} surface has too many vertices"
-        )));
-    }
-    if let Some(i) = s.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "{name} surface: vertex {i} is not finite"
-        )));
-    }
-    if let Some(t) = s
-        .triangles
-        .iter()
-        .find(|t| t.iter().any(|&v| v as usize >= n))
-    {
-        return Err(Error::Invalid(format!(
-            "{name} surface: triangle {t:?} refers to a vertex beyond {n}"
-        )));
-    }
-    if let Some((id, v)) = s.fp_vertices.iter().find(|(_, &v)| v as usize >= n) {
-        return Err(Error::Invalid(format!(
-            "{name} surface: feature point {id} refers to vertex {v} beyond {n}"
-        )));
-    }
-    Ok(())
 }
 
 /// The mirror image of each movable vertex across the plane `x = mean x` of the source, when
@@ -351,29 +320,21 @@ pub fn clone_rbf(
     target: &CloneSurface,
     opts: &RbfOptions,
 ) -> Result<SurfaceCloneResult> {
-    check_surface(source, "source")?;
-    check_surface(target, "target")?;
-    for m in motions {
-        if let Some((v, d)) = m
-            .offsets
-            .iter()
-            .find(|(v, d)| *v as usize >= source.positions.len() || !d.is_finite())
-        {
-            return Err(Error::Invalid(format!(
-                "motion {:?}: offset {d} of vertex {v} is not finite or not a source vertex",
-                m.key
-            )));
-        }
-    }
+    source.check("source")?;
+    target.check("target")?;
+    source.check_motions(motions)?;
     for (name, x) in [
         ("ray_length_factor", opts.ray_length_factor),
         ("min_error_factor", opts.min_error_factor),
         ("min_offset_factor", opts.min_offset_factor),
     ] {
         if !x.is_finite() || x < 0.0 {
-            return Err(Error::Invalid(format!(
-                "RBF option {name} must be a finite non-negative number, got {x}"
-            )));
+            return Err(CloneError::BadOption {
+                method: "rbf",
+                option: name,
+                value: x,
+            }
+            .into());
         }
     }
     let mut warnings = Vec::new();
@@ -425,18 +386,17 @@ pub fn clone_rbf(
         let (p, u) = (source.positions[sv as usize], target.positions[tv as usize]);
         if let Some(gap) = set.add_mean(class[sv as usize], p, u, Kind::FeaturePoint) {
             if gap > merge_eps {
-                warnings.push(format!(
+                warnings.push(Diagnostic::warning(format!(
                     "feature point {id} coincides with another on the source but not on the \
                      target ({gap:.3e} apart); their targets were averaged"
-                ));
+                )));
             }
         }
     }
     let fp_count = set.pairs.len();
-    let mut f = set.fit().map_err(|e| {
-        Error::Invalid(format!(
-            "RBF fit from {fp_count} distinct feature-point correspondences failed: {e}"
-        ))
+    let mut f = set.fit().map_err(|source| CloneError::RbfFeaturePointFit {
+        correspondences: fp_count,
+        source,
     })?;
     let mut contour_pairs = 0usize;
     if opts.contours {
@@ -467,17 +427,17 @@ pub fn clone_rbf(
             }
         }
         if disagreements > 0 {
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "{disagreements} coincident source contour vertices have distinct target \
                  points (e.g. a closed source mouth on an open target); targets averaged"
-            ));
+            )));
         }
         if contour_pairs > 0 {
             match set.fit() {
                 Ok(g) => f = g,
-                Err(e) => warnings.push(format!(
+                Err(e) => warnings.push(Diagnostic::warning(format!(
                     "RBF refit with contour correspondences failed ({e}); using feature points only"
-                )),
+                ))),
             }
         }
     }
@@ -532,10 +492,10 @@ pub fn clone_rbf(
         match fitted {
             Ok(g) => f = g,
             Err(e) => {
-                warnings.push(format!(
+                warnings.push(Diagnostic::warning(format!(
                     "RBF refit in refinement round {} failed ({e}); keeping the previous fit",
                     iterations + 1
-                ));
+                )));
                 break;
             }
         }
@@ -695,13 +655,18 @@ pub fn clone_rbf(
         })
         .collect();
     timings.push("deform", clock.elapsed().as_secs_f64());
-    if out
-        .iter()
-        .any(|m| m.offsets.iter().any(|(_, o)| !o.is_finite()))
-    {
-        return Err(Error::Invalid(
-            "RBF cloning produced non-finite offsets (degenerate fit)".into(),
-        ));
+    if let Some((key, vertex)) = out.iter().find_map(|m| {
+        m.offsets
+            .iter()
+            .find(|(_, o)| !o.is_finite())
+            .map(|&(v, _)| (m.key, v))
+    }) {
+        return Err(CloneError::NonFiniteOutput {
+            method: "rbf",
+            key,
+            vertex,
+        }
+        .into());
     }
 
     stats.insert("iterations".into(), iterations as f64);

@@ -86,6 +86,24 @@ pub fn read_landmark_ids(path: &Path) -> Result<LandmarkIds> {
     parse_landmark_ids(&text, path)
 }
 
+/// Reads landmark ids from `reader` (UTF-8, bounded by
+/// [`crate::io::DEFAULT_MAX_INPUT_BYTES`]); `source` names it in messages. The layout is
+/// chosen by content as in [`read_landmark_ids`].
+///
+/// ```
+/// use std::path::Path;
+/// let ids = fbakit::fdp::landmarks::read_landmark_ids_from(&b"[4, 8, 15]"[..], Path::new("ids.json"))?;
+/// assert_eq!(ids.ids, vec![4, 8, 15]);
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
+pub fn read_landmark_ids_from<R: std::io::BufRead>(
+    reader: R,
+    source: &Path,
+) -> Result<LandmarkIds> {
+    let text = crate::io::read_text_from(reader, source, crate::io::DEFAULT_MAX_INPUT_BYTES)?;
+    parse_landmark_ids(&text, source)
+}
+
 /// Parses landmark ids; `file` names the text in messages.
 pub fn parse_landmark_ids(text: &str, file: &Path) -> Result<LandmarkIds> {
     let trimmed = text.trim_start_matches('\u{feff}').trim_start();
@@ -205,6 +223,16 @@ mod tests {
 
     fn parse(name: &str, text: &str) -> Result<LandmarkIds> {
         parse_landmark_ids(text, Path::new(name))
+    }
+
+    #[test]
+    fn reader_matches_text_and_names_its_source() {
+        let text = "vertex\n4\n5, 6\n";
+        let from = read_landmark_ids_from(text.as_bytes(), Path::new("r.csv")).unwrap();
+        assert_eq!(from.ids, parse("r.csv", text).unwrap().ids);
+        assert_eq!(from.places[1], "r.csv:3:1");
+        let e = read_landmark_ids_from(&b"\xff"[..], Path::new("bad.csv")).unwrap_err();
+        assert!(e.to_string().contains("bad.csv"), "{e}");
     }
 
     #[test]

@@ -29,7 +29,9 @@ use crate::fdp::{FdpError, FeaturePoint, FeaturePointSet, VertexBinding};
 use crate::mesh::Mesh;
 use crate::spec::FeaturePointId;
 
-pub use ids::{parse_landmark_ids, read_landmark_ids, LandmarkIds, ICT_LANDMARK_KEY};
+pub use ids::{
+    parse_landmark_ids, read_landmark_ids, read_landmark_ids_from, LandmarkIds, ICT_LANDMARK_KEY,
+};
 pub use table::{PresetRow, Rule};
 
 /// A landmark scheme with a built-in preset table.

@@ -6,6 +6,7 @@ use std::collections::{BTreeMap, HashSet};
 use glam::{Affine3A, DVec3, Mat3, Vec3};
 
 use crate::clone::face::{FaceParts, Part, Similarity};
+use crate::error::Diagnostic;
 use crate::face::FaceModel;
 
 /// Moves `center` of transform `t` to the face-frame point `world`, compensating `translation`
@@ -118,15 +119,16 @@ pub(super) fn install_head_centre(
     face: &mut FaceModel,
     head: usize,
     installed: &mut Vec<(String, [f32; 3])>,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Diagnostic>,
 ) {
     match face
         .feature_points
         .position(crate::spec::FeaturePointId::FP_7_1)
     {
         Some(c) => install_recorded(face, head, c, installed),
-        None => warnings
-            .push("target lacks 7.1 (neck base): the head keeps its centre of rotation".into()),
+        None => warnings.push(Diagnostic::warning(
+            "target lacks 7.1 (neck base): the head keeps its centre of rotation",
+        )),
     }
 }
 

@@ -7,6 +7,7 @@ use glam::{Affine3A, DMat3, DVec3};
 
 use super::{tongue_mesh_names, RigidPlan, Role};
 use crate::clone::face::{CloneReport, FaceParts, Similarity, SkinSurface};
+use crate::error::Diagnostic;
 use crate::face::{FaceFrames, FaceModel};
 use crate::fat::morph::{MorphMesh, MorphTarget};
 use crate::fat::{FaceDefTransform, Fat, TableKey, TransformField};
@@ -130,7 +131,7 @@ impl RigidPlan {
         &self,
         ctx: &EntryContext,
         fat: &mut Fat,
-        warnings: &mut Vec<String>,
+        warnings: &mut Vec<Diagnostic>,
     ) -> usize {
         let mut entries = 0;
         let mut dropped_tf: BTreeSet<String> = BTreeSet::new();
@@ -152,10 +153,10 @@ impl RigidPlan {
             }
         }
         if !dropped_tf.is_empty() {
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "source transforms {} have no counterpart on the target; their motion is dropped",
                 dropped_tf.into_iter().collect::<Vec<_>>().join(", ")
-            ));
+            )));
         }
         entries
     }
@@ -169,7 +170,7 @@ impl RigidPlan {
         sparts: &FaceParts,
         targets: &[MorphTarget],
         fat: &mut Fat,
-        warnings: &mut Vec<String>,
+        warnings: &mut Vec<Diagnostic>,
     ) -> usize {
         let source = ctx.source;
         let tongue_meshes = tongue_mesh_names(source, sparts);
@@ -227,10 +228,10 @@ impl RigidPlan {
             }
         }
         if !dropped.is_empty() {
-            warnings.push(format!(
+            warnings.push(Diagnostic::warning(format!(
                 "non-skin deformations without a rigid equivalent are dropped: {}",
                 dropped.into_iter().collect::<Vec<_>>().join(", ")
-            ));
+            )));
         }
         rigid_tongue
     }

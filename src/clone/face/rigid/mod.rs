@@ -15,7 +15,7 @@ use centres::{install_eye_centres, install_head_centre, install_rotated_part_cen
 use hierarchy::{encloses, lowest_enclosing, roles, unique_name};
 
 use super::{CloneReport, FaceParts, Part, Similarity};
-use crate::error::Result;
+use crate::error::{Diagnostic, Result};
 use crate::face::{FaceModel, FaceTransform};
 use crate::fat::TransformField;
 
@@ -114,9 +114,10 @@ impl RigidPlan {
         if !created.is_empty() {
             // The kept scene stays: its writer inserts the new transforms where their
             // content sits, so nodes fbakit does not read are not lost.
-            report
-                .warnings
-                .push(format!("created transforms {}", created.join(", ")));
+            report.warnings.push(Diagnostic::warning(format!(
+                "created transforms {}",
+                created.join(", ")
+            )));
         }
         let mut installed = Vec::new();
         install_eye_centres(face, tparts, &part_tf, &mut installed);
@@ -187,7 +188,9 @@ fn part_transforms(
     let mut part_tf: BTreeMap<Part, usize> = BTreeMap::new();
     for (&p, meshes) in &tparts.parts {
         let low = lowest_enclosing(face, meshes);
-        let exclusive = low.is_some_and(|t| {
+        // The enclosing transform when the part's meshes are all it holds; an `Option` so
+        // the exclusive case carries its transform and needs no unwrap.
+        let exclusive = low.filter(|&t| {
             t != head
                 && (0..face.meshes.len()).all(|m| {
                     !encloses(face, t, m)
@@ -199,8 +202,8 @@ fn part_transforms(
                                 .is_some_and(|x| x.contains(&m)))
                 })
         });
-        if exclusive {
-            part_tf.insert(p, low.expect("exclusive implies some"));
+        if let Some(t) = exclusive {
+            part_tf.insert(p, t);
         } else if needed.contains(&p) {
             let (name, new_t) = add_part_transform(face, p, meshes, low.unwrap_or(head));
             created.push(name);
@@ -244,7 +247,7 @@ fn part_map(
     sroles: &BTreeMap<Part, usize>,
     part_tf: &BTreeMap<Part, usize>,
     driven: &HashSet<&str>,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Diagnostic>,
 ) -> HashMap<usize, (Role, usize)> {
     let mut map = HashMap::new();
     for (&p, &st) in sroles {
@@ -254,10 +257,10 @@ fn part_map(
             }
             None => {
                 if driven.contains(source.transforms[st].name.as_str()) {
-                    warnings.push(format!(
+                    warnings.push(Diagnostic::warning(format!(
                         "target has no {} part: its transform motion is dropped",
                         p.name()
-                    ));
+                    )));
                 }
             }
         }
@@ -266,7 +269,7 @@ fn part_map(
 }
 
 /// Warns about each part only one of the faces has.
-fn warn_unmatched_parts(sparts: &FaceParts, tparts: &FaceParts, warnings: &mut Vec<String>) {
+fn warn_unmatched_parts(sparts: &FaceParts, tparts: &FaceParts, warnings: &mut Vec<Diagnostic>) {
     for p in Part::ALL {
         if sparts.parts.contains_key(&p) != tparts.parts.contains_key(&p) {
             let side = if sparts.parts.contains_key(&p) {
@@ -274,7 +277,10 @@ fn warn_unmatched_parts(sparts: &FaceParts, tparts: &FaceParts, warnings: &mut V
             } else {
                 "source"
             };
-            warnings.push(format!("the {side} face has no {} mesh", p.name()));
+            warnings.push(Diagnostic::warning(format!(
+                "the {side} face has no {} mesh",
+                p.name()
+            )));
         }
     }
 }
