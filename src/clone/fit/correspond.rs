@@ -46,6 +46,7 @@ pub(crate) fn correspond(
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let (near, far) = (opts.fade.0 as f32 * scale, opts.fade.1 as f32 * scale);
     let snap = SNAP * scale;
+    let far_probe = far * 1.001;
     target
         .par_iter()
         .enumerate()
@@ -53,15 +54,28 @@ pub(crate) fn correspond(
             let bit = query_bit(sides.get(i).copied().unwrap_or(Side::Other));
             let nrm = normals.get(i).copied().unwrap_or(Vec3::ZERO);
             // A point on the surface is its own match, whatever the normals at a crease say.
-            let plain = source.closest(p, Filter { bit, normal: None })?;
-            let hit = if plain.point.distance(p) <= snap || nrm == Vec3::ZERO {
-                plain
+            // Every search is bounded: beyond `far` nothing matches, and a bounded search
+            // does not scan the whole source for triangles the filters reject.
+            let plain = Filter { bit, normal: None };
+            let hit = if nrm == Vec3::ZERO {
+                source.closest_within(p, plain, far_probe)?
+            } else if let Some(h) = source
+                .closest_within(p, plain, snap * 1.001)
+                .filter(|h| h.point.distance(p) <= snap)
+            {
+                h
             } else {
                 let oriented = Filter {
                     bit,
                     normal: Some((nrm, cos)),
                 };
-                source.closest(p, oriented).unwrap_or(plain)
+                match source.closest_within(p, oriented, far_probe) {
+                    Some(h) => h,
+                    // An oriented point beyond `far` fades to nothing; with no oriented
+                    // triangle at all the plain closest point stands in.
+                    None if source.any_allowed(oriented) => return None,
+                    None => source.closest_within(p, plain, far_probe)?,
+                }
             };
             let d = hit.point.distance(p);
             let fade = if d <= near {

@@ -99,33 +99,24 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let limit = opts.max_distance as f32 * m.scale;
     let snap = super::correspond::SNAP * m.scale;
+    let bounds = Bounds { cos, snap, limit };
+    // Each vertex's last matched triangle: its distance bounds the next search.
+    let mut previous: Vec<Option<u32>> = vec![None; n];
     let (mut matched, mut mean_gap) = (0.0, 0.0);
     for &alpha in &opts.stiffness {
         for _ in 0..opts.iterations.max(1) {
             let x: Vec<Vec3> = p.iter().zip(&u).map(|(a, b)| (*a + *b).as_vec3()).collect();
             let normals = vertex_normals(&x, m.triangles);
-            let hits: Vec<Option<(Vec3, f32)>> = (0..n)
+            let hits: Vec<Option<(Vec3, f32, u32)>> = (0..n)
                 .into_par_iter()
                 .map(|i| {
-                    let nrm = normals[i];
                     let bit = query_bit(m.sides[i]);
-                    let plain = fixed.closest(x[i], Filter { bit, normal: None })?;
-                    // On the surface already: a match, whatever a crease's normals say.
-                    let h = if plain.point.distance(x[i]) <= snap || nrm == Vec3::ZERO {
-                        plain
-                    } else {
-                        let filter = Filter {
-                            bit,
-                            normal: Some((nrm, cos)),
-                        };
-                        fixed.closest(x[i], filter)?
-                    };
-                    if fixed.on_border(&h) {
-                        return None;
-                    }
-                    Some((h.point, h.point.distance(x[i])))
+                    match_point(fixed, x[i], normals[i], bit, bounds, previous[i])
                 })
                 .collect();
+            for (prev, h) in previous.iter_mut().zip(&hits) {
+                *prev = h.and_then(|h| (h.2 != u32::MAX).then_some(h.2));
+            }
             // Outliers: farther than the limit, or than a few times the typical gap.
             let mut gaps: Vec<f32> = hits.iter().flatten().map(|h| h.1).collect();
             gaps.sort_by(f32::total_cmp);
@@ -135,7 +126,7 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
             let mut c = vec![DVec3::ZERO; n];
             let (mut count, mut sum) = (0usize, 0.0f64);
             for (i, h) in hits.iter().enumerate() {
-                if let Some((pt, d)) = h {
+                if let Some((pt, d, _)) = h {
                     if *d <= cut {
                         w[i] = 1.0;
                         c[i] = pt.as_dvec3();
@@ -164,4 +155,62 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
         matched,
         mean_gap,
     })
+}
+
+/// Distance limits of one closest-point match.
+#[derive(Clone, Copy)]
+struct Bounds {
+    /// Least cosine between the vertex normal and a triangle normal.
+    cos: f32,
+    /// Nearer than this, a point is on the surface and matches whatever the normals.
+    snap: f32,
+    /// Matches beyond this are rejected.
+    limit: f32,
+}
+
+/// The match of moving point `x` (unit normal `nrm`, side mask bit `bit`) on `fixed`:
+/// `(point, distance, triangle)`, with distance `∞` (and triangle `u32::MAX`) when no
+/// compatible point lies within the limit (a rejected outlier that still counts in the
+/// median gap), or `None` (no match at all, or a hit on the fixed surface's border).
+///
+/// The nearest point of the side comes first, searched only within the snap distance (a
+/// point on the surface matches there, whatever a crease's normals say); otherwise the
+/// nearest normal-compatible point, searched only within the limit (farther ones are
+/// rejected anyway) and within the distance to `previous`, the triangle matched in the
+/// step before, when the filter still allows it (the nearest point is no farther than that
+/// triangle). The bounds keep the BVH from scanning the whole fixed surface for triangles
+/// the normal filter rejects; they do not change which point is found.
+fn match_point(
+    fixed: &QuerySurface,
+    x: Vec3,
+    nrm: Vec3,
+    bit: super::regions::TriMask,
+    b: Bounds,
+    previous: Option<u32>,
+) -> Option<(Vec3, f32, u32)> {
+    let plain = Filter { bit, normal: None };
+    let h = if nrm == Vec3::ZERO {
+        fixed.closest(x, plain)?
+    } else if let Some(h) = fixed
+        .closest_within(x, plain, b.snap * 1.001)
+        .filter(|h| h.point.distance(x) <= b.snap)
+    {
+        h
+    } else {
+        let oriented = Filter {
+            bit,
+            normal: Some((nrm, b.cos)),
+        };
+        let warm = previous
+            .and_then(|t| fixed.distance_to(x, oriented, t))
+            .map_or(f32::INFINITY, |d| d * 1.0001 + 1e-6 * b.limit);
+        match fixed.closest_within(x, oriented, warm.min(b.limit * 1.001)) {
+            Some(h) => h,
+            None => return Some((x, f32::INFINITY, u32::MAX)),
+        }
+    };
+    if fixed.on_border(&h) {
+        return None;
+    }
+    Some((h.point, h.point.distance(x), h.triangle))
 }
