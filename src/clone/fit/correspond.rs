@@ -106,6 +106,7 @@ pub(crate) fn correspond(
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let (near, far) = (opts.fade.0 as f32 * scale, opts.fade.1 as f32 * scale);
     let snap = SNAP * scale;
+    let far_probe = far * 1.001;
     let probes = seam_probes(target, target_triangles, scale);
     let seam_slack = SEAM_SLACK * scale;
     target
@@ -114,29 +115,40 @@ pub(crate) fn correspond(
         .map(|(i, &p)| {
             let bit = query_bit(sides.get(i).copied().unwrap_or(Side::Other));
             let nrm = normals.get(i).copied().unwrap_or(Vec3::ZERO);
-            let any = Filter { bit, normal: None };
             // A point on the surface is its own match, whatever the normals at a crease say.
-            let plain = match probes.get(i).copied().flatten() {
-                Some(q) => {
-                    let plain = source.closest(p, any)?;
-                    // The probe's triangle, unless it lies clearly farther from the vertex
-                    // than the closest one (the seam opened during registration).
-                    source
-                        .closest(q, any)
-                        .and_then(|h| source.within(h.triangle, p))
-                        .filter(|h| h.point.distance(p) <= plain.point.distance(p) + seam_slack)
-                        .unwrap_or(plain)
-                }
-                None => source.closest(p, any)?,
-            };
-            let hit = if plain.point.distance(p) <= snap || nrm == Vec3::ZERO {
-                plain
+            // Every search is bounded: beyond `far` nothing matches, and a bounded search
+            // does not scan the whole source for triangles the filters reject.
+            let plain = Filter { bit, normal: None };
+            // A seam copy takes its own side's triangle (module docs), unless that lies
+            // clearly farther than the closest one (the seam opened during registration).
+            let seam = probes.get(i).copied().flatten().and_then(|q| {
+                let near_p = source.closest_within(p, plain, far_probe)?;
+                source
+                    .closest_within(q, plain, far_probe)
+                    .and_then(|h| source.within(h.triangle, p))
+                    .filter(|h| h.point.distance(p) <= near_p.point.distance(p) + seam_slack)
+            });
+            let hit = if let Some(h) = seam {
+                h
+            } else if nrm == Vec3::ZERO {
+                source.closest_within(p, plain, far_probe)?
+            } else if let Some(h) = source
+                .closest_within(p, plain, snap * 1.001)
+                .filter(|h| h.point.distance(p) <= snap)
+            {
+                h
             } else {
                 let oriented = Filter {
                     bit,
                     normal: Some((nrm, cos)),
                 };
-                source.closest(p, oriented).unwrap_or(plain)
+                match source.closest_within(p, oriented, far_probe) {
+                    Some(h) => h,
+                    // An oriented point beyond `far` fades to nothing; with no oriented
+                    // triangle at all the plain closest point stands in.
+                    None if source.any_allowed(oriented) => return None,
+                    None => source.closest_within(p, plain, far_probe)?,
+                }
             };
             let d = hit.point.distance(p);
             let fade = if d <= near {

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 use parry3d::math::Vector as PVec;
+use parry3d::query::PointQuery;
 use parry3d::shape::{CompositeShapeRef, TriMesh};
 
 use super::regions::TriMask;
@@ -95,6 +96,13 @@ impl QuerySurface {
 
     /// The closest point to `p` the filter allows.
     pub fn closest(&self, p: Vec3, filter: Filter) -> Option<Hit> {
+        self.closest_within(p, filter, f32::MAX)
+    }
+
+    /// The closest point to `p` the filter allows, if one lies nearer than `max_dist`. The
+    /// bound prunes the BVH search: a query whose nearby triangles the filter rejects stops
+    /// at `max_dist` instead of searching the whole surface.
+    pub fn closest_within(&self, p: Vec3, filter: Filter, max_dist: f32) -> Option<Hit> {
         let mesh = self.mesh.as_ref()?;
         if !p.is_finite() {
             return None;
@@ -105,7 +113,7 @@ impl QuerySurface {
         };
         let (tri, proj, _) = CompositeShapeRef(&view).project_local_point_and_get_location(
             PVec::new(p.x, p.y, p.z),
-            f32::MAX,
+            max_dist,
             false,
         )?;
         let point = Vec3::new(proj.point.x, proj.point.y, proj.point.z);
@@ -129,6 +137,26 @@ impl QuerySurface {
             weights,
             point: a * weights[0] + b * weights[1] + c * weights[2],
         })
+    }
+
+    /// The distance from `p` to triangle `tri` if the filter allows it: an upper bound of
+    /// [`closest`](Self::closest)'s distance, to bound that search (a warm start from the
+    /// previous match).
+    pub fn distance_to(&self, p: Vec3, filter: Filter, tri: u32) -> Option<f32> {
+        let mesh = self.mesh.as_ref()?;
+        if tri as usize >= self.triangles.len() || !self.allowed(filter, tri) {
+            return None;
+        }
+        Some(
+            mesh.triangle(tri)
+                .distance_to_local_point(PVec::new(p.x, p.y, p.z), false),
+        )
+    }
+
+    /// Whether any triangle of the surface passes `filter`, wherever it lies (a linear scan
+    /// that stops at the first one; the BVH cannot prune a search that finds nothing).
+    pub fn any_allowed(&self, filter: Filter) -> bool {
+        self.mesh.is_some() && (0..self.triangles.len() as u32).any(|i| self.allowed(filter, i))
     }
 
     /// Whether a hit lies on the surface's border (on a border edge of its triangle).

@@ -1,12 +1,13 @@
 //! The sparse linear system of one registration step (faer): `(A_reg·α + D) u = b`, with
 //! `A_reg` the fixed smoothness matrix of the surface and `D` a diagonal of data, landmark
 //! and damping weights that changes every step. The sparsity pattern and the symbolic
-//! Cholesky factorisation are built once; each step only refactors numerically.
+//! Cholesky factorisation are built once; each step only refactors numerically, in one
+//! thread ([`PAR`]).
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
-use faer::{Mat, Side};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, Mat, Par, Side};
 
 use crate::clone::{CloneError, FitSystemError};
 use crate::error::{Error, Result};
@@ -18,8 +19,14 @@ pub(crate) struct SmoothSystem {
     row_idx: Vec<u32>,
     /// `LᵀL + μ·Lg` values, aligned with `row_idx`.
     smooth: Vec<f64>,
-    symbolic: SymbolicLlt<u32>,
+    symbolic: SymbolicCholesky<u32>,
 }
+
+/// Parallelism of the factorisation and solves: none. On a surface of a few thousand
+/// vertices the supernodes are small, and faer's rayon split cost more than it saved (dense
+/// CANDIDE, 5 993 vertices, 2 cores: 10 ms sequential against 13 ms in parallel per
+/// factorisation, 17 against 30–57 ms with other work on the cores).
+const PAR: Par = Par::Seq;
 
 /// `(vertex, coefficient)` pairs of the uniform Laplacian row of every vertex:
 /// `u_i − mean(u_j, j ∈ N(i))` (an isolated vertex has an empty row).
@@ -111,9 +118,10 @@ impl SmoothSystem {
                 smooth[s] += membrane * nb.len() as f64;
             }
         }
-        let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr.clone(), None, row_idx.clone());
-        let symbolic = SymbolicLlt::try_new(sym.as_ref(), Side::Lower)
-            .map_err(|e| faer_error("symbolic factorisation", e))?;
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic =
+            factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
+                .map_err(|e| faer_error("symbolic factorisation", e))?;
         Ok(SmoothSystem {
             n,
             col_ptr,
@@ -134,18 +142,30 @@ impl SmoothSystem {
             // The diagonal is the first entry of each column (rows ≥ column, sorted).
             vals[self.col_ptr[j] as usize] += d;
         }
-        let sym = SymbolicSparseColMat::new_checked(
-            n,
-            n,
-            self.col_ptr.clone(),
-            None,
-            self.row_idx.clone(),
-        );
-        let mat = SparseColMat::new(sym, vals);
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat.as_ref(), Side::Lower)
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
+        let mat = SparseColMatRef::new(sym, &vals);
+        let par = PAR;
+        let mut factor = vec![0.0; self.symbolic.len_val()];
+        let scratch = self
+            .symbolic
+            .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+            .or(self.symbolic.solve_in_place_scratch::<f64>(3, par));
+        let mut buffer = MemBuffer::try_new(scratch).map_err(|e| faer_error("allocation", e))?;
+        let stack = MemStack::new(&mut buffer);
+        let llt = self
+            .symbolic
+            .factorize_numeric_llt(
+                &mut factor,
+                mat,
+                Side::Lower,
+                Default::default(),
+                par,
+                stack,
+                Default::default(),
+            )
             .map_err(|e| faer_error("Cholesky factorisation", e))?;
         let mut b = Mat::<f64>::from_fn(n, 3, |i, k| rhs[i][k]);
-        llt.solve_in_place(b.as_mut());
+        llt.solve_in_place_with_conj(Conj::No, b.as_mut(), par, stack);
         let out: Vec<[f64; 3]> = (0..n).map(|i| [b[(i, 0)], b[(i, 1)], b[(i, 2)]]).collect();
         if out.iter().flatten().any(|x| !x.is_finite()) {
             return Err(fail(FitSystemError::NonFinite));
