@@ -70,17 +70,7 @@ fn flat_bruno() -> FaceModel {
 
 /// The target file: `flat_bruno` with the extras spliced in.
 fn target_text() -> String {
-    let base = fbakit::face::vrml::write_face_string(&flat_bruno()).unwrap();
-    let header_end = base.find('\n').unwrap() + 1;
-    let mut text = format!(
-        "{}{HEADER_EXTRAS}{}",
-        &base[..header_end],
-        &base[header_end..]
-    );
-    let graph = text.find("faceSceneGraph [").expect("a face scene graph") + 16;
-    text.insert_str(graph, GRAPH_EXTRA);
-    text.push_str("ROUTE Clock.fraction_changed TO Spinner.set_fraction\n");
-    text
+    with_extras(&flat_bruno())
 }
 
 fn s(p: &Path) -> &str {

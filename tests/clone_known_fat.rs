@@ -21,6 +21,15 @@ use glam::Vec3;
 
 const METHODS: [Method; 3] = [Method::Fmc, Method::Rbf, Method::Fit];
 
+/// The shape change: CANDIDE-3's own shape units, mildly.
+const SHAPE: [(&str, f32); 5] = [
+    ("Mouth width", 0.4),
+    ("Nose z-extension", 0.5),
+    ("Head height", 0.3),
+    ("Eyes, width", 0.3),
+    ("Chin width", 0.4),
+];
+
 /// CANDIDE-3 with its FAT, shaped by `shape` units; `None` without the shared data.
 fn candide(shape: &[(&str, f32)]) -> Option<FaceModel> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/candide3");
@@ -79,14 +88,7 @@ fn cases() -> &'static [Case] {
         out.push(run("alma dense > sparse", &alma_mid, &alma));
         if let Some(c) = candide(&[]) {
             out.push(run("candide self", &c, &c));
-            let shaped = candide(&[
-                ("Mouth width", 0.4),
-                ("Nose z-extension", 0.5),
-                ("Head height", 0.3),
-                ("Eyes, width", 0.3),
-                ("Chin width", 0.4),
-            ])
-            .unwrap();
+            let shaped = candide(&SHAPE).unwrap();
             out.push(run("candide shape change", &c, &shaped));
             let big = ict_truth::head_b(&c, |p| p * 10.0 + Vec3::new(5.0, -3.0, 2.0));
             out.push(run("candide x10 + offset", &c, &big));
@@ -129,14 +131,7 @@ fn every_self_clone_is_exact_per_fap() {
 #[test]
 fn fit_by_registration_on_one_mesh_pairs() {
     let Some(c) = candide(&[]) else { return };
-    let shaped = candide(&[
-        ("Mouth width", 0.4),
-        ("Nose z-extension", 0.5),
-        ("Head height", 0.3),
-        ("Eyes, width", 0.3),
-        ("Chin width", 0.4),
-    ])
-    .unwrap();
+    let shaped = candide(&SHAPE).unwrap();
     let mut opts = CloneOptions::default();
     opts.fit.shared_topology = false;
     let r = clone_against_truth(&c, &shaped, &opts).unwrap().report;
@@ -155,10 +150,13 @@ fn single_change(case: &Case) -> bool {
     !case.name.contains("shaped")
 }
 
-/// `fit` on the known-FAT pairs that change one thing: median ≤ 5 %, every FAP ≤ 8 %.
+/// `fit` on the known-FAT pairs: median ≤ 5 % everywhere; every FAP ≤ 8 % where one thing
+/// changes. (Where shape and density change at once, CANDIDE dense → shaped and back, its
+/// worst FAPs are CANDIDE's eyelids, whose iris vertices share triangles with the lids and
+/// take a share of their motion, and one cheek FAP the guard repairs.)
 #[test]
 fn fit_meets_the_known_fat_targets() {
-    for case in cases().iter().filter(|c| single_change(c)) {
+    for case in cases() {
         let r = report(case, Method::Fit);
         assert!(
             r.median_all <= 5.0,
@@ -167,22 +165,10 @@ fn fit_meets_the_known_fat_targets() {
             r.median_all
         );
         let (key, worst) = r.worst.clone().unwrap_or_default();
-        assert!(worst <= 8.0, "{}: worst {key} {worst:.2} %", case.name);
-    }
-}
-
-/// Shape and density changed at once (CANDIDE dense → shaped and back): `fit`'s median stays
-/// low. (Its worst FAPs there are CANDIDE's eyelids, whose iris vertices share triangles with
-/// the lids and take a share of their motion, and one cheek FAP the guard repairs.)
-#[test]
-fn fit_median_on_combined_changes() {
-    for case in cases().iter().filter(|c| !single_change(c)) {
-        let r = report(case, Method::Fit);
         assert!(
-            r.median_all <= 5.0,
-            "{}: median {}",
-            case.name,
-            r.median_all
+            !single_change(case) || worst <= 8.0,
+            "{}: worst {key} {worst:.2} %",
+            case.name
         );
     }
 }

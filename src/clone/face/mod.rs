@@ -263,6 +263,7 @@ pub fn clone_face(
         &face,
         &tparts,
         &alignment,
+        &ssurf.surface.fapu,
         &tsurf.surface.fapu,
     );
     let rigid_targets: Vec<MorphTarget> = targets

@@ -18,13 +18,13 @@ use std::collections::{HashMap, HashSet};
 
 use glam::{DMat3, DVec3, Vec3};
 
+use super::part_motion::part_fapu_ratio;
 use super::{FaceParts, Part, Similarity};
 use crate::face::FaceModel;
 use crate::fat::morph::{MorphMesh, MorphTarget};
 use crate::fat::TableKey;
 use crate::fdp::Fapu;
 use crate::mesh::VertexIndex;
-use crate::spec::FapuKind;
 
 /// Parts whose deformation is transferred: the tongue and the eyeballs (pupil dilation).
 /// Teeth are rigid.
@@ -84,32 +84,9 @@ fn same_meshes(a: &FaceModel, am: &[usize], b: &FaceModel, bm: &[usize]) -> bool
         })
 }
 
-/// Target / source FAPU of `key`'s unit (MNS for high-level tables and angles).
-fn ratio(key: TableKey, sfapu: Option<&Fapu>, tfapu: &Fapu, frame: &Similarity) -> f64 {
-    let kind = match key {
-        TableKey::LowLevel(f) => f.info().fapu.unwrap_or(FapuKind::Mns),
-        _ => FapuKind::Mns,
-    };
-    let kind = if kind == FapuKind::Au {
-        FapuKind::Mns
-    } else {
-        kind
-    };
-    match sfapu {
-        Some(s) => {
-            let r = tfapu.unit(kind) / s.unit(kind);
-            if r.is_finite() && r > 0.0 {
-                r
-            } else {
-                frame.scale
-            }
-        }
-        None => frame.scale,
-    }
-}
-
 /// The deformations of `source`'s part meshes under `targets`, on `face`'s parts of the same
-/// role (`face` is the target after the rigid step; `tfapu` its FAPU in the aligned frame).
+/// role (`face` is the target after the rigid step; `sfapu` the source's FAPU, `tfapu` the
+/// target's in the aligned frame).
 pub(super) fn part_deformations(
     source: &FaceModel,
     sparts: &FaceParts,
@@ -117,6 +94,7 @@ pub(super) fn part_deformations(
     face: &FaceModel,
     tparts: &FaceParts,
     frame: &Similarity,
+    sfapu: &Fapu,
     tfapu: &Fapu,
 ) -> PartDeformations {
     let mut out = PartDeformations {
@@ -125,7 +103,6 @@ pub(super) fn part_deformations(
     };
     let sframes = source.frames();
     let tframes = face.frames();
-    let sfapu = source.fapu().ok();
     for part in DEFORMABLE {
         let (Some(sm), Some(tm)) = (sparts.parts.get(&part), tparts.parts.get(&part)) else {
             continue;
@@ -184,7 +161,7 @@ pub(super) fn part_deformations(
             if disp.is_empty() {
                 continue;
             }
-            let r = ratio(t.key, sfapu.as_ref(), tfapu, frame);
+            let r = part_fapu_ratio(t.key, sfapu, tfapu);
             let mut meshes = Vec::new();
             for (k, &mi) in tgt.meshes.iter().enumerate() {
                 let end = tgt.starts.get(k + 1).copied().unwrap_or(tgt.points.len());

@@ -14,6 +14,7 @@ use crate::clone::SurfaceMotion;
 use crate::face::FaceModel;
 use crate::fat::morph::MorphMesh;
 use crate::fat::TableKey;
+use crate::fdp::Fapu;
 use crate::mesh::VertexIndex;
 use crate::spec::FapuKind;
 
@@ -133,6 +134,12 @@ fn offset_at(m: &SurfaceMotion, v: u32) -> Vec3 {
 /// Target / source FAPU of the key's unit (MNS for high-level tables and angles: parts in
 /// the mouth).
 fn fapu_ratio(key: TableKey, s: &SkinSurface, t: &SkinSurface) -> f64 {
+    part_fapu_ratio(key, &s.surface.fapu, &t.surface.fapu)
+}
+
+/// Target / source FAPU of `key`'s unit for a part (MNS for high-level tables and angles:
+/// the parts are in the mouth or move with it); 1 when the source unit is unusable.
+pub(super) fn part_fapu_ratio(key: TableKey, s: &Fapu, t: &Fapu) -> f64 {
     let kind = match key {
         TableKey::LowLevel(f) => f.info().fapu.unwrap_or(FapuKind::Mns),
         _ => FapuKind::Mns,
@@ -142,9 +149,9 @@ fn fapu_ratio(key: TableKey, s: &SkinSurface, t: &SkinSurface) -> f64 {
     } else {
         kind
     };
-    let su = s.surface.fapu.unit(kind);
+    let su = s.unit(kind);
     if su > 0.0 && su.is_finite() {
-        t.surface.fapu.unit(kind) / su
+        t.unit(kind) / su
     } else {
         1.0
     }

@@ -117,6 +117,21 @@ fn remove_at(scene: &mut Scene, slot: Slot) {
     }
 }
 
+/// Appends `child` to the `children` of grouping node `parent`.
+fn append_child(scene: &mut Scene, parent: NodeId, child: NodeRef) {
+    let mut kids = scene
+        .node(parent)
+        .field("children")
+        .map(|v| v.node_refs())
+        .unwrap_or_default();
+    kids.push(child);
+    set_field(
+        &mut scene.nodes[parent.0],
+        "children",
+        FieldValue::MFNode(kids),
+    );
+}
+
 /// Inserts a new item right after the reference at `slot` (or appends at the top level).
 fn insert_after(scene: &mut Scene, slot: Slot, new: NodeRef) -> bool {
     match slot {
@@ -180,13 +195,7 @@ pub(super) fn insert_meshes(
             None => false,
         } || match tf.and_then(|t| transform_nodes.get(t).copied().flatten()) {
             Some(p) => {
-                let mut kids = scene
-                    .node(p)
-                    .field("children")
-                    .map(|v| v.node_refs())
-                    .unwrap_or_default();
-                kids.push(shape);
-                set_field(&mut scene.nodes[p.0], "children", FieldValue::MFNode(kids));
+                append_child(scene, p, shape);
                 true
             }
             None => false,
@@ -258,15 +267,7 @@ pub(super) fn insert_transforms(
         match anchor {
             Some(k) => replace_at(scene, all[&content[k]], new_ref),
             None => match parent_node {
-                Some(p) => {
-                    let mut kids = scene
-                        .node(p)
-                        .field("children")
-                        .map(|v| v.node_refs())
-                        .unwrap_or_default();
-                    kids.push(new_ref);
-                    set_field(&mut scene.nodes[p.0], "children", FieldValue::MFNode(kids));
-                }
+                Some(p) => append_child(scene, p, new_ref),
                 None => scene.statements.push(Statement::Node(new_ref)),
             },
         }
