@@ -257,14 +257,18 @@ pub fn clone_face(
     // Part meshes the source deforms (its tongue) bend the target's part of that role; the
     // rigid step sees only what is left.
     let deformed = part_deform::part_deformations(
-        source,
-        &sparts,
+        &part_deform::PartSide {
+            face: source,
+            parts: &sparts,
+            fapu: &ssurf.surface.fapu,
+        },
         &targets,
-        &face,
-        &tparts,
+        &part_deform::PartSide {
+            face: &face,
+            parts: &tparts,
+            fapu: &tsurf.surface.fapu,
+        },
         &alignment,
-        &ssurf.surface.fapu,
-        &tsurf.surface.fapu,
     );
     let rigid_targets: Vec<MorphTarget> = targets
         .iter()

@@ -84,19 +84,26 @@ fn same_meshes(a: &FaceModel, am: &[usize], b: &FaceModel, bm: &[usize]) -> bool
         })
 }
 
-/// The deformations of `source`'s part meshes under `targets`, on `face`'s parts of the same
-/// role (`face` is the target after the rigid step; `sfapu` the source's FAPU, `tfapu` the
-/// target's in the aligned frame).
+/// One face of a clone as this step sees it.
+pub(super) struct PartSide<'a> {
+    /// The face (the target after the rigid step).
+    pub face: &'a FaceModel,
+    /// Its parts.
+    pub parts: &'a FaceParts,
+    /// Its FAPU (the target's in the aligned frame).
+    pub fapu: &'a Fapu,
+}
+
+/// The deformations of the source's part meshes under `targets`, on the target's parts of
+/// the same role.
 pub(super) fn part_deformations(
-    source: &FaceModel,
-    sparts: &FaceParts,
+    source: &PartSide,
     targets: &[MorphTarget],
-    face: &FaceModel,
-    tparts: &FaceParts,
+    target: &PartSide,
     frame: &Similarity,
-    sfapu: &Fapu,
-    tfapu: &Fapu,
 ) -> PartDeformations {
+    let (sparts, tparts, sfapu, tfapu) = (source.parts, target.parts, source.fapu, target.fapu);
+    let (source, face) = (source.face, target.face);
     let mut out = PartDeformations {
         meshes: HashMap::new(),
         handled: HashSet::new(),
