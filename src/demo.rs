@@ -379,7 +379,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         }
         let anim = player.animation()?;
         let export = export_face(face, Some(&anim))?;
-        warnings.extend(export.warnings.into_iter().map(Diagnostic::warning));
+        warnings.extend(export.warnings);
         let file = format!("{name}-speech.glb");
         dir.write_file(&file, |p| export.document.write_glb(p))?;
         let what = match name {

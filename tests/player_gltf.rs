@@ -295,7 +295,7 @@ fn pivot_nodes_reproduce_vrml_centres() {
     skew.transforms[0].scale_orientation = Quat::from_rotation_y(0.4);
     let e = export_face(&skew, None).unwrap();
     assert_eq!(e.warnings.len(), 1, "{:?}", e.warnings);
-    assert!(e.warnings[0].contains("scaleOrientation"));
+    assert!(e.warnings[0].message.contains("scaleOrientation"));
 }
 
 #[test]

@@ -315,6 +315,9 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         warnings
     } else {
         write_face(&args.output, &outcome.face)?
+            .iter()
+            .map(ToString::to_string)
+            .collect()
     };
     pb.inc(1);
     let quality = if args.report {

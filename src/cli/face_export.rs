@@ -82,7 +82,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
             .flat_map(|m| m.primitives.first())
             .map(|p| p.targets.len())
             .sum(),
-        warnings: export.warnings,
+        warnings: export.warnings.iter().map(ToString::to_string).collect(),
         arkit: None,
     };
     if a.json {

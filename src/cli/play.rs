@@ -216,7 +216,7 @@ pub fn run(a: PlayArgs) -> Result<u8> {
             let anim = player.animation()?;
             bar.set_position(anim.len() as u64);
             let export = export_face_with_units(&face, Some(&anim), a.units)?;
-            warnings.extend(export.warnings);
+            warnings.extend(export.warnings.iter().map(ToString::to_string));
             match format {
                 PlayFormat::Glb => export.document.write_glb(&a.output)?,
                 _ => export.document.write_gltf(&a.output)?,

@@ -116,7 +116,7 @@ pub fn run(a: ViewArgs) -> Result<u8> {
     });
     let page = ViewerPage::new(&face, anim.as_ref())?;
     page.write(&a.output)?;
-    warnings.extend(page.warnings.iter().cloned());
+    warnings.extend(page.warnings.iter().map(ToString::to_string));
     let report = ViewReport {
         face: face.name.clone(),
         stream: a.stream.as_ref().map(|p| p.display().to_string()),

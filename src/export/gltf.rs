@@ -218,7 +218,7 @@ pub struct GltfExport {
     /// The document.
     pub document: GltfDocument,
     /// Things that could not be represented exactly (e.g. a `scaleOrientation`).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::error::Diagnostic>,
 }
 
 /// `face` as a glTF document; with `anim`, also its animation (see the module docs).
@@ -242,7 +242,7 @@ pub fn export_face_with_units(
 ) -> Result<GltfExport> {
     face.check_structure()?;
     let morphs = FaceMorphs::new(face)?;
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = Vec::new();
     let (k, unit_warning) = crate::face::units::metres_factor(face, units);
     warnings.extend(unit_warning);
     let mut scene = SceneBuilder::new(face.name.clone());
@@ -341,7 +341,10 @@ pub fn export_face_with_units(
     }
     Ok(GltfExport {
         document: scene.build()?,
-        warnings,
+        warnings: warnings
+            .into_iter()
+            .map(crate::error::Diagnostic::warning)
+            .collect(),
     })
 }
 

@@ -258,7 +258,7 @@ pub struct ViewerPage {
     /// Size of the embedded glb in bytes (before base64).
     pub glb_bytes: usize,
     /// What could not be shown exactly (exporter warnings, missing FAPU).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::error::Diagnostic>,
 }
 
 impl ViewerPage {
@@ -286,7 +286,7 @@ impl ViewerPage {
         let mut warnings = export.warnings;
         let model = ViewerModel::new(face, &export.document, animation)?;
         if let Some(note) = &model.fapu_note {
-            warnings.push(note.clone());
+            warnings.push(crate::error::Diagnostic::warning(note.clone()));
         }
         let glb = export.document.to_glb()?;
         let json = serde_json::to_string(&model)
