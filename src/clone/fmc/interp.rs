@@ -153,13 +153,47 @@ impl BoxGrid {
 
     /// Up to `count` boxes passing `keep`, nearest to `p` first (ties by index): rings of
     /// cells grow around `p` until no unvisited cell can hold a nearer box.
+    ///
+    /// Only the `count` best so far are kept (sorted, so the stopping test is one look), and
+    /// boxes met in several cells are skipped by a per-thread visit stamp: a point far outside
+    /// the grid (the back of a whole head) visits most of it, and a hash set and a sort per
+    /// ring made that most of fmc's time.
     fn nearest(&self, p: DVec2, count: usize, keep: impl Fn(u32) -> bool) -> Vec<u32> {
         if count == 0 || self.boxes.is_empty() {
             return Vec::new();
         }
+        thread_local! {
+            /// Per box, the visit number that last saw it; and the current visit number.
+            static STAMPS: std::cell::RefCell<(Vec<u32>, u32)> =
+                const { std::cell::RefCell::new((Vec::new(), 0)) };
+        }
+        STAMPS.with(|cell| {
+            let mut guard = cell.borrow_mut();
+            let (stamps, visit) = &mut *guard;
+            if stamps.len() < self.boxes.len() {
+                stamps.resize(self.boxes.len(), 0);
+            }
+            *visit = visit.wrapping_add(1);
+            if *visit == 0 {
+                stamps.iter_mut().for_each(|s| *s = 0);
+                *visit = 1;
+            }
+            self.nearest_stamped(p, count, keep, stamps, *visit)
+        })
+    }
+
+    fn nearest_stamped(
+        &self,
+        p: DVec2,
+        count: usize,
+        keep: impl Fn(u32) -> bool,
+        stamps: &mut [u32],
+        visit: u32,
+    ) -> Vec<u32> {
         let [ci, cj] = self.index(p);
-        let mut found: Vec<(f64, u32)> = Vec::new();
-        let mut seen = std::collections::HashSet::new();
+        // The best `count` so far, by (squared distance, index).
+        let mut best: Vec<(f64, u32)> = Vec::with_capacity(count + 1);
+        let before = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
         for r in 0.. {
             let (i0, i1) = (ci.saturating_sub(r), (ci + r).min(self.nx - 1));
             let (j0, j1) = (cj.saturating_sub(r), (cj + r).min(self.ny - 1));
@@ -170,8 +204,19 @@ impl BoxGrid {
                         continue;
                     }
                     for &k in self.cell_items(i, j) {
-                        if seen.insert(k) && keep(k) {
-                            found.push((box_distance2(self.boxes[k as usize], p), k));
+                        let stamp = &mut stamps[k as usize];
+                        if *stamp == visit {
+                            continue;
+                        }
+                        *stamp = visit;
+                        if !keep(k) {
+                            continue;
+                        }
+                        let item = (box_distance2(self.boxes[k as usize], p), k);
+                        if best.len() < count || before(&item, &best[count - 1]).is_lt() {
+                            let at = best.partition_point(|b| before(b, &item).is_lt());
+                            best.insert(at, item);
+                            best.truncate(count);
                         }
                     }
                 }
@@ -193,14 +238,13 @@ impl BoxGrid {
             if j1 + 1 < self.ny {
                 bound = bound.min((y(j1 + 1) - p.y).max(0.0));
             }
-            found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             let done =
-                bound.is_infinite() || found.len() >= count && found[count - 1].0 <= bound * bound;
+                bound.is_infinite() || best.len() >= count && best[count - 1].0 <= bound * bound;
             if done {
                 break;
             }
         }
-        found.into_iter().take(count).map(|f| f.1).collect()
+        best.into_iter().map(|f| f.1).collect()
     }
 }
 
