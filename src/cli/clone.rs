@@ -252,7 +252,7 @@ struct Output<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     quality: Option<Quality>,
     /// Warnings from writing the output file.
-    write_warnings: Vec<String>,
+    write_warnings: Vec<fbakit::error::Diagnostic>,
     #[serde(skip_serializing_if = "Option::is_none")]
     arkit: Option<fbakit::rig::arkit_export::ArkitExportReport>,
 }
@@ -315,9 +315,6 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         warnings
     } else {
         write_face(&args.output, &outcome.face)?
-            .iter()
-            .map(ToString::to_string)
-            .collect()
     };
     pb.inc(1);
     let quality = if args.report {

@@ -48,7 +48,7 @@ struct Report {
     output: String,
     meshes: usize,
     morph_targets: usize,
-    warnings: Vec<String>,
+    warnings: Vec<fbakit::error::Diagnostic>,
     #[serde(skip_serializing_if = "Option::is_none")]
     arkit: Option<fbakit::rig::arkit_export::ArkitExportReport>,
 }
@@ -82,7 +82,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
             .flat_map(|m| m.primitives.first())
             .map(|p| p.targets.len())
             .sum(),
-        warnings: export.warnings.iter().map(ToString::to_string).collect(),
+        warnings: export.warnings,
         arkit: None,
     };
     if a.json {

@@ -68,7 +68,7 @@ struct Report<'a> {
     absent: &'a [AbsentPoint],
     notes: &'a [String],
     fapu: Option<FapuDistances>,
-    warnings: Vec<String>,
+    warnings: Vec<fbakit::error::Diagnostic>,
 }
 
 pub fn run(cmd: FpCommand) -> Result<u8> {
@@ -137,7 +137,9 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
     let fapu = match Fapu::from_feature_points(&set) {
         Ok(f) => Some(f.distances),
         Err(e) => {
-            warnings.push(format!("FAP units: {e}"));
+            warnings.push(fbakit::error::Diagnostic::warning(format!(
+                "FAP units: {e}"
+            )));
             None
         }
     };

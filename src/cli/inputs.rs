@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use fbakit::error::Diagnostic;
 use fbakit::error::Result;
 use fbakit::face::{FaceModel, FaceReadOptions};
 use fbakit::fap::{read_stream_file, FapStream, ReadOptions};
@@ -14,16 +15,12 @@ pub fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
     Ok(fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp))?.0)
 }
 
-/// Reads a FAP stream, strictly or leniently, with its reader warnings as text.
-pub fn read_stream(path: &Path, strict: bool) -> Result<(FapStream, Vec<String>)> {
+/// Reads a FAP stream, strictly or leniently, with its reader warnings.
+pub fn read_stream(path: &Path, strict: bool) -> Result<(FapStream, Vec<Diagnostic>)> {
     let opts = if strict {
         ReadOptions::strict()
     } else {
         ReadOptions::lenient()
     };
-    let (stream, diagnostics) = read_stream_file(path, &opts)?;
-    Ok((
-        stream,
-        diagnostics.iter().map(ToString::to_string).collect(),
-    ))
+    read_stream_file(path, &opts)
 }

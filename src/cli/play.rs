@@ -137,7 +137,7 @@ struct PlayReport {
     duration_seconds: f64,
     files_written: usize,
     missing_tables: Vec<MissingRecord>,
-    warnings: Vec<String>,
+    warnings: Vec<fbakit::error::Diagnostic>,
 }
 
 /// Picks the output format from `--format` or OUT (through the one output rule,
@@ -216,7 +216,7 @@ pub fn run(a: PlayArgs) -> Result<u8> {
             let anim = player.animation()?;
             bar.set_position(anim.len() as u64);
             let export = export_face_with_units(&face, Some(&anim), a.units)?;
-            warnings.extend(export.warnings.iter().map(ToString::to_string));
+            warnings.extend(export.warnings);
             match format {
                 PlayFormat::Glb => export.document.write_glb(&a.output)?,
                 _ => export.document.write_gltf(&a.output)?,

@@ -64,7 +64,7 @@ pub struct RenderReport {
     bytes: u64,
     framed_on_feature_points: bool,
     missing_tables: Vec<(String, usize)>,
-    warnings: Vec<String>,
+    warnings: Vec<fbakit::error::Diagnostic>,
 }
 
 /// `main` restores the default SIGPIPE action (die) for `fbakit ... | head`; `render` feeds
@@ -135,7 +135,7 @@ pub fn write_video(
     stream: &FapStream,
     stream_name: &str,
     job: &VideoJob<'_>,
-    warnings: Vec<String>,
+    warnings: Vec<fbakit::error::Diagnostic>,
 ) -> Result<RenderReport> {
     ignore_sigpipe();
     // Refuse an absurd span (a stream numbered up to frame 9 999 999) before any output.

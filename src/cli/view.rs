@@ -51,7 +51,7 @@ struct ViewReport {
     fps: Option<f64>,
     duration_seconds: f64,
     missing_tables: Vec<String>,
-    warnings: Vec<String>,
+    warnings: Vec<fbakit::error::Diagnostic>,
 }
 
 /// Refuses an output that is not an `.html` / `.htm` file (so a typo never overwrites a face).
@@ -116,7 +116,7 @@ pub fn run(a: ViewArgs) -> Result<u8> {
     });
     let page = ViewerPage::new(&face, anim.as_ref())?;
     page.write(&a.output)?;
-    warnings.extend(page.warnings.iter().map(ToString::to_string));
+    warnings.extend(page.warnings);
     let report = ViewReport {
         face: face.name.clone(),
         stream: a.stream.as_ref().map(|p| p.display().to_string()),

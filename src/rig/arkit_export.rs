@@ -163,7 +163,7 @@ pub fn write_arkit_gltf(
     face: &FaceModel,
     path: &std::path::Path,
     units: Option<crate::face::units::LengthUnit>,
-) -> Result<(ArkitExportReport, Vec<String>)> {
+) -> Result<(ArkitExportReport, Vec<crate::error::Diagnostic>)> {
     if face.fat.tables.is_empty() {
         return Err(super::RigError::NoFat {
             face: face.name.clone(),
@@ -172,9 +172,11 @@ pub fn write_arkit_gltf(
     }
     let amplitudes = super::arkit_amplitudes::arkit_amplitudes();
     let (mut rig, report) = face_to_arkit_rig(face, &amplitudes)?;
-    let mut warnings = Vec::new();
     let (k, unit_warning) = crate::face::units::metres_factor(face, units);
-    warnings.extend(unit_warning);
+    let warnings = unit_warning
+        .into_iter()
+        .map(crate::error::Diagnostic::warning)
+        .collect();
     scale_rig(&mut rig, k);
     super::gltf_write::write_rig_gltf(&rig, path)?;
     Ok((report, warnings))
