@@ -211,7 +211,6 @@ fn convert(a: ConvertArgs) -> Result<u8> {
     fbakit::format::refuse_overwriting_input(&a.output, &[&a.input])?;
     let (stream, warnings) = read_stream_file(&a.input, &options(a.strict))?;
     write_stream_file(&a.output, &stream)?;
-    let warnings: Vec<String> = warnings.iter().map(ToString::to_string).collect();
     if a.json {
         print_json(&serde_json::json!({
             "input": a.input.display().to_string(),

@@ -169,7 +169,7 @@ pub fn to_arkit(a: ToArkitArgs) -> Result<u8> {
     OutputFormat::resolve(&a.output, &[OutputFormat::Csv], "`fap to-arkit` output")?;
     refuse_overwriting_input(&a.output, &[&a.stream, &a.rig.face, &a.rig.fp])?;
     let (stream, warnings) = read_stream_file(&a.stream, &ReadOptions::lenient())?;
-    super::print_warnings(&warnings.iter().map(ToString::to_string).collect::<Vec<_>>());
+    super::print_warnings(&warnings);
     let (rig, face, calibration) = load(&a.rig)?;
     let mut bridge = ArkitBridge::new(&rig, &face, &calibration)?;
     let (frames, report) = bridge.faps_to_weights(&stream)?;
