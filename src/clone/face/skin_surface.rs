@@ -111,7 +111,6 @@ pub fn build_skin_surface_like(
         _ => weld_outside_mouth(&positions, eps, mouth),
     };
     let (member_start, members) = duplicate_lists(&welded, surface_positions.len());
-
     let tris: Vec<[u32; 3]> = triangles
         .iter()
         .map(|t: &[u32; 3]| t.map(|v| welded[v as usize]))

@@ -185,9 +185,9 @@ pub fn clone_fit(
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
     let mut warnings: Vec<String> = Vec::new();
-    if opts.shared_topology && same_topology(source, target) {
+    let (corr, rotations) = if opts.shared_topology && same_topology(source, target) {
         let clock = Instant::now();
-        let corr: Vec<_> = (0..target.positions.len() as u32)
+        let corr = (0..target.positions.len() as u32)
             .map(|v| {
                 Some(correspond::Correspondence {
                     vertices: [v; 3],
@@ -198,16 +198,54 @@ pub fn clone_fit(
             .collect();
         stats.insert("fit_shared_topology".into(), 1.0);
         timings.push("correspond", clock.elapsed().as_secs_f64());
-        let clock = Instant::now();
-        let out = transfer::transfer(source, motions, target, &corr, opts.fapu_scale, None);
-        timings.push("transfer", clock.elapsed().as_secs_f64());
-        return Ok(SurfaceCloneResult {
-            motions: out,
-            timings,
-            stats,
-            warnings: Vec::new(),
-        });
-    }
+        (corr, None)
+    } else {
+        register_and_correspond(
+            source,
+            target,
+            opts,
+            &mut timings,
+            &mut stats,
+            &mut warnings,
+        )?
+    };
+    // 4. Transfer.
+    let clock = Instant::now();
+    let out = transfer::transfer(
+        source,
+        motions,
+        target,
+        &corr,
+        opts.fapu_scale,
+        rotations.as_deref(),
+    );
+    timings.push("transfer", clock.elapsed().as_secs_f64());
+    Ok(SurfaceCloneResult {
+        motions: out,
+        timings,
+        stats,
+        warnings: warnings
+            .into_iter()
+            .map(crate::error::Diagnostic::warning)
+            .collect(),
+    })
+}
+
+/// Steps 1–3 (module docs): sides, registration of the source onto the target, and each
+/// target vertex's place on the registered source; with the source vertices' local rotations
+/// when `opts.transfer` asks for them.
+#[allow(clippy::type_complexity)]
+fn register_and_correspond(
+    source: &CloneSurface,
+    target: &CloneSurface,
+    opts: &FitOptions,
+    timings: &mut StepTimings,
+    stats: &mut BTreeMap<String, f64>,
+    warnings: &mut Vec<String>,
+) -> Result<(
+    Vec<Option<correspond::Correspondence>>,
+    Option<Vec<glam::Mat3>>,
+)> {
     // 1. Sides.
     let clock = Instant::now();
     let adj = adjacency(source.positions.len(), &source.triangles);
@@ -307,28 +345,9 @@ pub fn clone_fit(
         ));
     }
     timings.push("correspond", clock.elapsed().as_secs_f64());
-    // 4. Transfer.
-    let clock = Instant::now();
     let rotations = (opts.transfer == FitTransfer::LocalFrame)
         .then(|| transfer::local_rotations(&source.positions, &reg.positions, &adj));
-    let out = transfer::transfer(
-        source,
-        motions,
-        target,
-        &corr,
-        opts.fapu_scale,
-        rotations.as_deref(),
-    );
-    timings.push("transfer", clock.elapsed().as_secs_f64());
-    Ok(SurfaceCloneResult {
-        motions: out,
-        timings,
-        stats,
-        warnings: warnings
-            .into_iter()
-            .map(crate::error::Diagnostic::warning)
-            .collect(),
-    })
+    Ok((corr, rotations))
 }
 
 #[cfg(test)]
