@@ -65,7 +65,7 @@ fn stream(frames: u64) -> FapStream {
 fn one_frame_all_faps(bencher: divan::Bencher) {
     let face = bruno();
     let s = stream(50);
-    let mut player = Player::new(&face, &s, PlayOptions::default()).unwrap();
+    let mut player = Player::new(&face, &s, &PlayOptions::default()).unwrap();
     let mut frame = player.new_frame();
     let mut n = 0;
     bencher.bench_local(|| {
@@ -80,7 +80,7 @@ fn ten_seconds_to_glb(bencher: divan::Bencher) {
     let face = bruno();
     let s = stream(250);
     bencher.bench_local(|| {
-        let player = Player::new(&face, &s, PlayOptions::default()).unwrap();
+        let player = Player::new(&face, &s, &PlayOptions::default()).unwrap();
         let anim = player.animation().unwrap();
         face_to_gltf(&face, Some(&anim)).unwrap().to_glb().unwrap()
     });

@@ -369,7 +369,7 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
     let mut played: Vec<(&str, &FaceModel)> = vec![("alma", &alma), ("bruno", &bruno)];
     played.extend(heads.iter().map(|(n, f)| (n.as_str(), f)));
     for &(name, face) in &played {
-        let player = Player::new(face, &stream, PlayOptions::default())?;
+        let player = Player::new(face, &stream, &PlayOptions::default())?;
         frames = player.frame_count();
         fps = player.fps();
         for (key, n) in player.missing_tables() {

@@ -295,6 +295,16 @@ pub enum Error {
     /// The demo application.
     #[error(transparent)]
     Demo(#[from] crate::demo::DemoError),
+    /// An error of a step that works on named files, with the file (or option) it concerns:
+    /// a layer's error that cannot know the file (a player limit, a degenerate feature-point
+    /// set, a face without skin) reads `playing speech.fap on alma.wrl: …`.
+    #[error("{context}: {source}")]
+    Context {
+        /// What was being done, naming the file or option (`reading stream x.fap`).
+        context: String,
+        /// The error itself; its exit code is kept.
+        source: Box<Error>,
+    },
 }
 
 impl Error {
@@ -303,6 +313,21 @@ impl Error {
         Error::Io {
             path: path.into(),
             source,
+        }
+    }
+
+    /// This error with `context` (naming the file or option it concerns) in front. An error
+    /// whose message already names the file (located parse errors, I/O errors) is returned
+    /// as it is, so messages never name a file twice.
+    pub fn context(self, context: impl Into<String>) -> Self {
+        match self {
+            Error::Io { .. } | Error::Parse(_) | Error::Output { .. } | Error::Context { .. } => {
+                self
+            }
+            e => Error::Context {
+                context: context.into(),
+                source: Box::new(e),
+            },
         }
     }
 
@@ -344,7 +369,20 @@ impl Error {
             Error::Export(e) => e.is_input_error(),
             Error::Render(e) => e.is_input_error(),
             Error::Demo(e) => e.is_input_error(),
+            Error::Context { source, .. } => source.is_input_error(),
         }
+    }
+}
+
+/// [`Error::context`] on results: `player.map_err(..)` without the closure noise.
+pub trait ResultExt<T> {
+    /// On error, puts the context `f()` (naming the file or option) in front of it.
+    fn with_context(self, f: impl FnOnce() -> String) -> Result<T>;
+}
+
+impl<T, E: Into<Error>> ResultExt<T> for std::result::Result<T, E> {
+    fn with_context(self, f: impl FnOnce() -> String) -> Result<T> {
+        self.map_err(|e| e.into().context(f()))
     }
 }
 

@@ -39,8 +39,8 @@
 //! use fbakit::prelude::*;
 //!
 //! let face = face::read("alma")?;
-//! let (stream, _warnings) = read_stream_file("samples/speech.fap".as_ref(), &ReadOptions::lenient())?;
-//! let mut player = Player::new(&face, &stream, PlayOptions::default())?;
+//! let (stream, _warnings) = read_stream_file("samples/speech.fap", &ReadOptions::lenient())?;
+//! let mut player = Player::new(&face, &stream, &PlayOptions::default())?;
 //! let mut frame = player.new_frame();
 //! let mut frames = 0;
 //! while player.next_frame(&mut frame) {
@@ -52,6 +52,10 @@
 //!
 //! Errors are one [`error::Error`] wrapping a typed enum per layer, so `?` works everywhere
 //! and callers can `match` on what went wrong (e.g. `Error::Face(face::FaceError::..)`).
+
+/// The vector and matrix types of fbakit's public API (`Vec3`, `Quat`, `Affine3A`), so
+/// users need no `glam` dependency of their own, nor a matching version.
+pub use glam;
 
 pub mod candide;
 pub mod clone;

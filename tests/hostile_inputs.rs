@@ -971,7 +971,7 @@ fn a_frame_sequence_stopped_midway_leaves_nothing() {
     )
     .unwrap();
     let mut player =
-        fbakit::player::Player::new(&face, &stream, fbakit::player::PlayOptions::default())
+        fbakit::player::Player::new(&face, &stream, &fbakit::player::PlayOptions::default())
             .unwrap();
     let lab = Lab::new();
     let out = lab.out("midway");

@@ -69,7 +69,7 @@ fn animation_weights_reproduce_played_positions() {
         (sample("speech.fap"), [0usize, 12, 30, 47, 70]),
         (sample("lowlevel.fap"), [3, 10, 24, 30, 49]),
     ] {
-        let mut player = Player::new(face, &stream, PlayOptions::default()).unwrap();
+        let mut player = Player::new(face, &stream, &PlayOptions::default()).unwrap();
         let anim = player.animation().unwrap();
         let doc = face_to_gltf(face, Some(&anim)).unwrap();
         let morphs = FaceMorphs::new(face).unwrap();
@@ -210,7 +210,7 @@ fn baked_interval_targets_follow_the_piecewise_rule() {
         frames: vec![f],
         ..FapStream::new("t", 25.0)
     };
-    let mut player = Player::new(&face, &stream, PlayOptions::default()).unwrap();
+    let mut player = Player::new(&face, &stream, &PlayOptions::default()).unwrap();
     let mut frame = player.new_frame();
     player.next_frame(&mut frame);
     for mi in 0..2 {
@@ -304,7 +304,7 @@ fn played_alma_passes_the_khronos_validator() {
     let dir = tempfile::tempdir().unwrap();
     let mut files = Vec::new();
     for (stream, ext) in [("speech.fap", "glb"), ("lowlevel.fap", "gltf")] {
-        let player = Player::new(face, &sample(stream), PlayOptions::default()).unwrap();
+        let player = Player::new(face, &sample(stream), &PlayOptions::default()).unwrap();
         let anim = player.animation().unwrap();
         let p = dir.path().join(format!("{stream}.{ext}"));
         face_to_gltf(face, Some(&anim)).unwrap().write(&p).unwrap();

@@ -20,7 +20,7 @@ fn speech_on_alma_first_frames() {
         fps: None,
         frames: Some(0..10),
     };
-    let mut player = Player::new(&face, &stream, opts).unwrap();
+    let mut player = Player::new(&face, &stream, &opts).unwrap();
     let mut frame = player.new_frame();
     let mut s = String::new();
     while player.next_frame(&mut frame) {

@@ -8,7 +8,7 @@ use fbakit::clone::eval::{
     GroundTruthReport,
 };
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
-use fbakit::error::{Error, Result};
+use fbakit::error::{Error, Result, ResultExt};
 use fbakit::export::write_face;
 use fbakit::face::{FaceFormat, FaceModel, FaceReadOptions};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
@@ -281,7 +281,13 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         align: !args.no_align,
         ..CloneOptions::default()
     };
-    let outcome = clone_face(&source, &target, &opts)?;
+    let outcome = clone_face(&source, &target, &opts).with_context(|| {
+        format!(
+            "cloning {} onto {}",
+            args.source.display(),
+            args.target.display()
+        )
+    })?;
     pb.inc(1);
     if args.strict && !outcome.report.failed_faps.is_empty() {
         pb.finish_and_clear();

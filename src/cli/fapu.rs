@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use fbakit::error::Result;
+use fbakit::error::{Result, ResultExt};
 use fbakit::fdp::{read_feature_points, Fapu, FapuSource};
 use fbakit::spec::{FapuKind, FAPU_DIVISOR};
 use serde::Serialize;
@@ -50,7 +50,13 @@ pub fn run(args: FapuArgs) -> Result<u8> {
             )?;
             (
                 FapuSource::FeaturePoints,
-                Fapu::measure(&face.feature_points)?,
+                Fapu::measure(&face.feature_points).with_context(|| {
+                    format!(
+                        "measuring the FAPUs of {} on {}",
+                        args.file.display(),
+                        mesh.display()
+                    )
+                })?,
             )
         }
         None => {
@@ -61,7 +67,8 @@ pub fn run(args: FapuArgs) -> Result<u8> {
                 }
                 .into());
             }
-            file.fapu()?
+            file.fapu()
+                .with_context(|| format!("measuring the FAPUs of {}", args.file.display()))?
         }
     };
     let units = FapuKind::ALL

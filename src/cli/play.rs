@@ -6,7 +6,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use fbakit::error::{Error, Result};
+use fbakit::error::{Error, Result, ResultExt};
 use fbakit::export::gltf::export_face_with_units;
 use fbakit::export::obj_sequence::ObjSequence;
 use fbakit::export::picture::{contact_sheet_for_player, turntable_sheet, FaceView};
@@ -191,11 +191,12 @@ pub fn run(a: PlayArgs) -> Result<u8> {
     let mut player = Player::new(
         &face,
         &stream,
-        PlayOptions {
+        &PlayOptions {
             fps: a.fps,
             frames: a.frames.clone(),
         },
-    )?;
+    )
+    .with_context(|| format!("playing {} on {}", a.stream.display(), a.face.display()))?;
     let span = player.frame_range();
     match format {
         PlayFormat::Glb | PlayFormat::Gltf => {

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use fbakit::error::{Error, Result};
+use fbakit::error::{Error, Result, ResultExt};
 use fbakit::export::movie::{movie_fps, render_movie, MovieOptions};
 use fbakit::export::video::{open_sink, VideoFormat, VideoSettings};
 
@@ -142,11 +142,12 @@ pub fn write_video(
     let span = fbakit::player::Player::new(
         face,
         stream,
-        fbakit::player::PlayOptions {
+        &fbakit::player::PlayOptions {
             fps: job.fps,
             frames: None,
         },
-    )?
+    )
+    .with_context(|| format!("playing stream {stream_name}"))?
     .frame_range();
     let image = fbakit::export::budget::image_bytes_per_frame(job.size.0, job.size.1);
     let per_frame = match job.format {

@@ -240,7 +240,7 @@ fn write_page(
 ) -> Result<serde_json::Value> {
     use fbakit::export::viewer::{ViewerAnimation, ViewerPage};
     use fbakit::player::{PlayOptions, Player};
-    let player = Player::new(face, stream, PlayOptions::default())?;
+    let player = Player::new(face, stream, &PlayOptions::default())?;
     let frames = player.animation()?;
     let anim = ViewerAnimation {
         frames: &frames,

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use fbakit::error::{Error, Result};
+use fbakit::error::{Error, Result, ResultExt};
 use fbakit::export::viewer::{ViewerAnimation, ViewerPage};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use fbakit::player::{PlayOptions, Player};
@@ -77,11 +77,12 @@ pub fn run(a: ViewArgs) -> Result<u8> {
             let player = Player::new(
                 &face,
                 &stream,
-                PlayOptions {
+                &PlayOptions {
                     fps: a.fps,
                     frames: a.frames.clone(),
                 },
-            )?;
+            )
+            .with_context(|| format!("playing {} on {}", path.display(), a.face.display()))?;
             if player.frame_count() > fbakit::export::viewer::MAX_FRAMES {
                 return Err(Error::Usage(format!(
                     "{}: {} frames, more than the {} the viewer embeds; play fewer with \

@@ -34,7 +34,11 @@ use crate::format::OutputFormat;
 /// Writes `face` in the face format `path` names ([`OutputFormat::FACES`]): VRML, gzip VRML
 /// or OBJ through [`crate::face::write()`], glTF (`.glb`, `.gltf`) with the FAT as morph
 /// targets through [`gltf::export_face`]. Returns what the format could not hold exactly.
-pub fn write_face(path: &Path, face: &FaceModel) -> Result<Vec<crate::error::Diagnostic>> {
+pub fn write_face(
+    path: impl AsRef<Path>,
+    face: &FaceModel,
+) -> Result<Vec<crate::error::Diagnostic>> {
+    let path = path.as_ref();
     match OutputFormat::resolve(path, OutputFormat::FACES, "a face file")? {
         OutputFormat::Glb | OutputFormat::Gltf => {
             let export = gltf::export_face(face, None)?;

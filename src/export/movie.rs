@@ -105,7 +105,7 @@ pub fn render_movie(
     let mut player = Player::new(
         face,
         stream,
-        PlayOptions {
+        &PlayOptions {
             fps: opts.fps,
             frames: None,
         },

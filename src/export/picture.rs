@@ -221,7 +221,7 @@ pub fn contact_sheet_rows(
     let mut labels = Vec::new();
     let mut columns = 1;
     for (name, face) in faces {
-        let mut player = Player::new(face, stream, play.clone())?;
+        let mut player = Player::new(face, stream, &play.clone())?;
         let (imgs, numbers) = played_cells(face, &mut player, n_frames, size)?;
         columns = columns.max(imgs.len() as u32);
         cells.extend(imgs);

@@ -42,6 +42,13 @@ impl FacePose {
             .map(move |&p| m.transform_point3(p))
     }
 
+    /// Face-frame positions of all meshes, per mesh and vertex.
+    pub fn all_world_positions(&self) -> Vec<Vec<Vec3>> {
+        let mut out = Vec::new();
+        self.world_positions_into(&mut out);
+        out
+    }
+
     /// Face-frame positions of all meshes, written into `out` (resized, buffers reused).
     pub fn world_positions_into(&self, out: &mut Vec<Vec<Vec3>>) {
         out.resize_with(self.positions.len(), Vec::new);

@@ -69,7 +69,11 @@ pub fn read(path: impl AsRef<Path>) -> Result<FaceModel> {
 
 /// [`read`] with options, returning what the reader noticed (diagnostics, feature-point
 /// matches, scene paths).
-pub fn read_with(path: &Path, opts: &FaceReadOptions) -> Result<(FaceModel, FaceReadReport)> {
+pub fn read_with(
+    path: impl AsRef<Path>,
+    opts: &FaceReadOptions,
+) -> Result<(FaceModel, FaceReadReport)> {
+    let path = path.as_ref();
     if !path.exists() {
         if let Some(bundled) = path.to_str().and_then(BundledFace::from_name) {
             let (mut face, mut report) = bundled.read()?;

@@ -20,7 +20,8 @@ pub const WRITABLE: &[OutputFormat] =
     &[OutputFormat::Vrml, OutputFormat::VrmlGz, OutputFormat::Obj];
 
 /// Writes a face in the format its extension names (see the module docs), atomically.
-pub fn write(path: &Path, face: &FaceModel) -> Result<()> {
+pub fn write(path: impl AsRef<Path>, face: &FaceModel) -> Result<()> {
+    let path = path.as_ref();
     match OutputFormat::resolve(path, WRITABLE, "a face file")? {
         OutputFormat::Vrml => super::vrml::write_face_file(path, face),
         OutputFormat::VrmlGz => {

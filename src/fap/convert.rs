@@ -15,20 +15,46 @@ pub fn is_json_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
+/// Reads a `.fap` or `.json` stream leniently (what most files in the wild need), the front
+/// door beside [`crate::face::read`]; [`read_with`] chooses the mode and returns the reader's
+/// warnings.
+///
+/// ```
+/// let stream = fbakit::fap::read("samples/speech.fap")?;
+/// assert!(stream.frame_rate > 0.0);
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
+pub fn read(path: impl AsRef<Path>) -> Result<FapStream> {
+    Ok(read_stream_file(path, &ReadOptions::lenient())?.0)
+}
+
+/// Reads a `.fap` or `.json` stream with `opts`, with the reader's warnings (the same as
+/// [`read_stream_file`]).
+pub fn read_with(
+    path: impl AsRef<Path>,
+    opts: &ReadOptions,
+) -> Result<(FapStream, Vec<Diagnostic>)> {
+    read_stream_file(path, opts)
+}
+
 /// Reads a `.fap` or `.json` stream. JSON input is checked like `.fap` input: frame rate and
 /// frame order are errors; negative unidirectional values are errors in strict mode and
 /// unlocated warnings in lenient mode.
 ///
 /// ```
 /// use fbakit::fap::{read_stream_file, ReadOptions};
-/// let (stream, warnings) = read_stream_file("samples/speech.fap".as_ref(), &ReadOptions::lenient())?;
+/// let (stream, warnings) = read_stream_file("samples/speech.fap", &ReadOptions::lenient())?;
 /// assert!(stream.frame_rate > 0.0);
 /// for w in &warnings {
 ///     eprintln!("{w}"); // located: file:line:column: warning: ...
 /// }
 /// # Ok::<(), fbakit::error::Error>(())
 /// ```
-pub fn read_stream_file(path: &Path, opts: &ReadOptions) -> Result<(FapStream, Vec<Diagnostic>)> {
+pub fn read_stream_file(
+    path: impl AsRef<Path>,
+    opts: &ReadOptions,
+) -> Result<(FapStream, Vec<Diagnostic>)> {
+    let path = path.as_ref();
     let text = crate::io::read_text(path)?;
     if !is_json_path(path) {
         return parse_fap(&text, path, opts);

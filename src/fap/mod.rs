@@ -21,7 +21,7 @@ mod summary;
 mod timeline;
 mod write;
 
-pub use convert::{is_json_path, read_stream_file, write_stream_file};
+pub use convert::{is_json_path, read, read_stream_file, read_with, write_stream_file};
 pub use error::FapError;
 pub use model::{
     ExpressionParams, FapFrame, FapMask, FapStream, VisemeParams, DEFAULT_VERSION,

@@ -184,6 +184,22 @@ impl Fapu {
     }
 }
 
+/// The six units, one per line: `IRISD 0.000123 (IRISD0 0.126)`; AU has no distance.
+impl std::fmt::Display for Fapu {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (i, k) in crate::spec::FapuKind::ALL.into_iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "{:<6} {:.6e}", k.abbreviation(), self.unit(k))?;
+            if let Some(d) = self.distance(k) {
+                write!(f, " ({}0 {d:.6})", k.abbreviation())?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// FAP units measured on feature points, with notes on how they were measured.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FapuMeasurement {

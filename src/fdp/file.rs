@@ -120,7 +120,8 @@ pub fn detect_format(path: &Path, text: &str) -> Option<FeaturePointFormat> {
 /// assert!(file.points.iter().count() > 0);
 /// # Ok::<(), fbakit::error::Error>(())
 /// ```
-pub fn read_feature_points(path: &Path) -> Result<FeaturePointFile> {
+pub fn read_feature_points(path: impl AsRef<Path>) -> Result<FeaturePointFile> {
+    let path = path.as_ref();
     let text = crate::io::read_text(path)?;
     parse_feature_points(&text, path)
 }

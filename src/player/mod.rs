@@ -78,6 +78,12 @@ pub struct PlayerFrame {
 }
 
 impl PlayerFrame {
+    /// Face-frame positions of every vertex of the pose, per mesh (see
+    /// [`FacePose::world_positions_into`] to reuse buffers).
+    pub fn world_positions(&self) -> Vec<Vec<glam::Vec3>> {
+        self.pose.all_world_positions()
+    }
+
     /// What a glTF animation needs from this frame (no vertex data).
     pub fn animation_frame(&self) -> AnimationFrame {
         AnimationFrame {
@@ -130,19 +136,19 @@ impl<'a> Player<'a> {
     /// use fbakit::player::{PlayOptions, Player, PlayerError};
     /// let face = fbakit::face::read("alma")?;
     /// let (stream, _) = fbakit::fap::read_stream_file(
-    ///     "samples/speech.fap".as_ref(),
+    ///     "samples/speech.fap",
     ///     &fbakit::fap::ReadOptions::lenient(),
     /// )?;
-    /// let mut player = Player::new(&face, &stream, PlayOptions::default())?;
+    /// let mut player = Player::new(&face, &stream, &PlayOptions::default())?;
     /// let mut frame = player.new_frame();
     /// while player.next_frame(&mut frame) {}
     /// // A frame range past the end is a typed error callers can match.
     /// let opts = PlayOptions { frames: Some(1_000_000..1_000_001), ..PlayOptions::default() };
-    /// let err = Player::new(&face, &stream, opts).err().unwrap();
+    /// let err = Player::new(&face, &stream, &opts).err().unwrap();
     /// assert!(matches!(err, Error::Player(PlayerError::EmptyFrameRange { .. })));
     /// # Ok::<(), Error>(())
     /// ```
-    pub fn new(face: &'a FaceModel, stream: &FapStream, opts: PlayOptions) -> Result<Player<'a>> {
+    pub fn new(face: &'a FaceModel, stream: &FapStream, opts: &PlayOptions) -> Result<Player<'a>> {
         face.check_structure()?;
         let evaluator = face.evaluator()?;
         if !(stream.frame_rate.is_finite()
@@ -170,7 +176,7 @@ impl<'a> Player<'a> {
                 })?,
             None => 0,
         };
-        let range = match opts.frames {
+        let range = match opts.frames.clone() {
             None => 0..total,
             Some(r) => {
                 if r.start >= r.end || r.start >= total {
@@ -281,6 +287,26 @@ impl<'a> Player<'a> {
             .transform_deltas
             .copy_from_slice(&self.output.transforms);
         self.face.pose_into(&self.output, &mut frame.pose);
+    }
+
+    /// Output frame `index` as a new frame (allocates; loops use [`Player::frame_at`] or
+    /// [`Player::next_frame`] with one reused frame). `frame.world_positions()` gives every
+    /// vertex of the pose in the face frame.
+    ///
+    /// ```
+    /// use fbakit::prelude::*;
+    /// let face = face::read("alma")?;
+    /// let stream = fbakit::fap::read("samples/speech.fap")?;
+    /// let mut player = Player::new(&face, &stream, &PlayOptions::default())?;
+    /// let frame = player.frame(10);
+    /// let world = frame.world_positions(); // per mesh, per vertex
+    /// assert_eq!(world.len(), face.meshes.len());
+    /// # Ok::<(), fbakit::error::Error>(())
+    /// ```
+    pub fn frame(&mut self, index: usize) -> PlayerFrame {
+        let mut frame = self.new_frame();
+        self.frame_at(index, &mut frame);
+        frame
     }
 
     /// Restarts at the first frame of the range.

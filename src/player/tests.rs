@@ -33,7 +33,7 @@ fn head_yaw_rotates_nose_tip_about_7_1() {
     let mut f = FapFrame::new(0);
     f.set(FapId::new(49).unwrap(), 20_000.0);
     let stream = stream_of(vec![f]);
-    let mut player = Player::new(face, &stream, PlayOptions::default()).unwrap();
+    let mut player = Player::new(face, &stream, &PlayOptions::default()).unwrap();
     let mut frame = player.new_frame();
     assert!(player.next_frame(&mut frame));
     assert!(!player.next_frame(&mut frame));
@@ -65,7 +65,7 @@ fn eyeball_yaw_turns_about_eye_centre() {
     let face = alma();
     let mut f = FapFrame::new(0);
     f.set(FapId::new(23).unwrap(), 30_000.0);
-    let mut player = Player::new(face, &stream_of(vec![f]), PlayOptions::default()).unwrap();
+    let mut player = Player::new(face, &stream_of(vec![f]), &PlayOptions::default()).unwrap();
     let mut frame = player.new_frame();
     player.next_frame(&mut frame);
     let ti = face.transform_index("eye_l_tf").unwrap();
@@ -90,7 +90,7 @@ fn hold_rule_and_missing_tables() {
     let mut b = FapFrame::new(3);
     b.set(FapId::new(19).unwrap(), 0.0);
     let stream = stream_of(vec![a, b]);
-    let mut player = Player::new(&face, &stream, PlayOptions::default()).unwrap();
+    let mut player = Player::new(&face, &stream, &PlayOptions::default()).unwrap();
     assert_eq!(player.frame_count(), 4);
     // open_jaw held at 200 over frames 0..=3: 4 frames without a table.
     assert_eq!(
@@ -120,7 +120,7 @@ fn frame_range_and_fps() {
         fps: Some(50.0),
         frames: Some(5..100),
     };
-    let mut player = Player::new(face, &stream, opts).unwrap();
+    let mut player = Player::new(face, &stream, &opts).unwrap();
     assert_eq!(player.frame_range(), 5..21);
     assert_eq!(player.fps(), 50.0);
     let mut frame = player.new_frame();
@@ -136,12 +136,12 @@ fn frame_range_and_fps() {
         fps: None,
         frames: Some(11..20),
     };
-    assert!(Player::new(face, &stream, bad).is_err());
+    assert!(Player::new(face, &stream, &bad).is_err());
     let bad_fps = PlayOptions {
         fps: Some(f64::NAN),
         frames: None,
     };
-    assert!(Player::new(face, &stream, bad_fps).is_err());
+    assert!(Player::new(face, &stream, &bad_fps).is_err());
 }
 
 #[test]
@@ -162,7 +162,7 @@ fn viseme_and_expression_activations() {
         init_face: false,
         def: false,
     }));
-    let mut player = Player::new(face, &stream_of(vec![a]), PlayOptions::default()).unwrap();
+    let mut player = Player::new(face, &stream_of(vec![a]), &PlayOptions::default()).unwrap();
     let mut frame = player.new_frame();
     player.next_frame(&mut frame);
     let n = frame.activations.len();
@@ -206,7 +206,7 @@ fn next_frame_reuses_buffers() {
     )
     .unwrap()
     .0;
-    let mut player = Player::new(face, &stream, PlayOptions::default()).unwrap();
+    let mut player = Player::new(face, &stream, &PlayOptions::default()).unwrap();
     let mut frame = PlayerFrame::default();
     assert!(player.next_frame(&mut frame));
     let ptrs = |f: &PlayerFrame| {
@@ -251,7 +251,7 @@ fn world_positions_match_face_frames_at_neutral() {
     let mut player = Player::new(
         face,
         &stream_of(vec![FapFrame::new(0)]),
-        PlayOptions::default(),
+        &PlayOptions::default(),
     )
     .unwrap();
     let mut frame = player.new_frame();
@@ -278,7 +278,7 @@ fn animation_frames_match_played_frames() {
     let mut b = FapFrame::new(4);
     b.set(FapId::new(50).unwrap(), -8_000.0);
     let stream = stream_of(vec![a, b]);
-    let mut player = Player::new(face, &stream, PlayOptions::default()).unwrap();
+    let mut player = Player::new(face, &stream, &PlayOptions::default()).unwrap();
     let anim = player.animation().unwrap();
     assert_eq!(anim.len(), 5);
     let mut frame = player.new_frame();

@@ -34,6 +34,12 @@ impl Method {
     }
 }
 
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Settings of [`clone_face`](super::clone_face).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CloneOptions {

@@ -61,6 +61,32 @@ pub struct CloneReport {
     pub failed_faps: Vec<FapFailure>,
 }
 
+/// The report as the CLI prints it: a summary line, the alignment, the warnings.
+impl std::fmt::Display for CloneReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "cloned {} morph targets ({} tables) with {} onto {} skin vertices in {:.3} s",
+            self.motions,
+            self.tables,
+            self.method,
+            self.surface_vertices[1],
+            self.timings.total()
+        )?;
+        write!(
+            f,
+            "alignment: scale {:.4}, rotation {:.2} deg, rms {:.4}",
+            self.alignment.scale,
+            self.alignment.angle_degrees(),
+            self.alignment_rms
+        )?;
+        for w in &self.warnings {
+            write!(f, "\n{w}")?;
+        }
+        Ok(())
+    }
+}
+
 /// The target with its new FAT, and the report.
 #[derive(Clone, Debug)]
 pub struct CloneOutcome {

@@ -19,7 +19,7 @@ fn speech_frames() -> &'static (Vec<AnimationFrame>, f64) {
     FRAMES.get_or_init(|| {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/speech.fap");
         let (stream, _) = read_stream_file(&path, &ReadOptions::lenient()).unwrap();
-        let player = Player::new(alma(), &stream, PlayOptions::default()).unwrap();
+        let player = Player::new(alma(), &stream, &PlayOptions::default()).unwrap();
         (player.animation().unwrap(), player.fps())
     })
 }
