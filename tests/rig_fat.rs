@@ -348,6 +348,11 @@ fn ict_rig_becomes_a_compliant_fat_face() {
     let rig = fbakit::rig::read_rig(&dir).unwrap();
     let points = ict_feature_points(&rig, &dir);
     let (face, report) = face_from_rig(&rig, Some(points), &FapMap::arkit()).unwrap();
+    // Its visemes look like speech (mouth figures in the face's own MNS0 and width).
+    let shapes = fbakit::face::mouth::viseme_shapes(&face).expect("lip points");
+    assert_eq!(shapes.len(), 14);
+    let bad = fbakit::face::mouth::viseme_problems(&shapes);
+    assert!(bad.is_empty(), "full ICT rig visemes: {bad:?}");
     for c in &report.calibrated {
         eprintln!(
             "{} {} {:?} {} {:.1} {}",

@@ -18,6 +18,7 @@ mod error;
 pub mod format;
 mod from_rig;
 pub mod morphs;
+pub mod mouth;
 pub mod parts;
 pub mod pose;
 pub mod read;
@@ -26,6 +27,7 @@ pub mod summary;
 pub mod units;
 pub mod validate;
 pub mod vertex_index;
+pub mod visemes;
 pub mod vrml;
 pub mod write;
 

@@ -336,6 +336,12 @@ pub fn face_from_rig(
         Some(face.evaluator()?)
     };
     let mut high = Vec::new();
+    // The nominal viseme vectors fitted to this face's lips: a rig's "push" or "stretch"
+    // shapes need not move the lips as a compliant face's would (`face::visemes`).
+    let fitted: std::collections::HashMap<Viseme, Vec<(FapId, f64)>> =
+        crate::face::visemes::fitted_visemes(&face)
+            .into_iter()
+            .collect();
     for key in keys {
         let named = map.row(key).and_then(|r| lookup.resolve(&r.positive));
         if let Some(terms) = named {
@@ -352,7 +358,10 @@ pub fn face_from_rig(
             continue;
         }
         let faps = match key {
-            TableKey::Viseme(v) => crate::synth::viseme_faps(v),
+            TableKey::Viseme(v) => fitted
+                .get(&v)
+                .cloned()
+                .unwrap_or_else(|| crate::synth::viseme_faps(v)),
             TableKey::Expression(e) => crate::synth::expression_faps(e),
             TableKey::LowLevel(_) => Vec::new(),
         };

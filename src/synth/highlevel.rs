@@ -217,8 +217,9 @@ pub(super) fn add_tables(face: &mut SynthFace) {
         .expect("synthetic low-level FAT binds to its face");
     let mut out = eval.output();
     let mut keys: Vec<(TableKey, Vec<(FapId, f64)>)> = Vec::new();
-    for v in Viseme::shapes() {
-        keys.push((TableKey::Viseme(v), viseme_faps(v)));
+    // The nominal vectors, fitted to this face's own lips (`face::visemes`).
+    for (v, faps) in crate::face::visemes::fitted_visemes(&face.to_face_model()) {
+        keys.push((TableKey::Viseme(v), faps));
     }
     for e in Expression::basic() {
         keys.push((TableKey::Expression(e), expression_faps(e)));
