@@ -31,6 +31,16 @@
 //! (an ARKit shape a rig splits in halves, ICT's `browInnerUp_L` + `_R`, is one unknown
 //! playing both).
 //!
+//! **Rotations.** Head and eye rotation columns ([`super::capture::ROTATIONS`]) are not
+//! fitted: they set FAPs 48–50 and 23–26 directly (replacing what the fit gave the eyeball
+//! FAPs). The other way, head rotation FAPs are left out of the posed frames (rigid motion
+//! no blend shape shows); the caller writes them, and the eyeball FAPs, as angles
+//! ([`super::capture::stream_rotations`]).
+//!
+//! **Any face with a FAT.** [`arkit_rig_of_face`] makes ARKit-named shapes from the face's
+//! own FAT (the bundled amplitude table) and [`ArkitBridge::for_fat_face`] pairs them with
+//! FAP sides from the same table, so both directions work without a rig.
+//!
 //! Feature points see a face sparsely, so shapes that move no feature point (or move them
 //! like another shape) cannot be recovered; the reports give the fit's residual.
 
@@ -39,7 +49,7 @@ use serde::Serialize;
 
 use super::arkit_names::{arkit_index, bind_rig, ARKIT_SHAPES};
 use super::bounded_ls::NormalEquations;
-use super::capture::{is_head_rotation_fap, rotation_index, Rotation, ROTATIONS};
+use super::capture::{is_head_rotation_fap, is_rotation_fap, rotation_index, Rotation, ROTATIONS};
 use super::fap_map::ShapeLookup;
 use super::fat_build::RigFatReport;
 use super::weights_csv::{WeightCsv, MAX_FRAME_NUMBER};
@@ -471,8 +481,10 @@ impl<'a> ArkitBridge<'a> {
             // Head rotation is rigid motion, carried by the rotation columns, never a shape.
             acts.retain(|a| !matches!(a.key, TableKey::LowLevel(f) if is_head_rotation_fap(f)));
             for a in &acts {
+                // Eyeball rotations travel in the rotation columns whatever the FAT has.
                 if a.value != 0.0
                     && a.key.slot().is_some()
+                    && !matches!(a.key, TableKey::LowLevel(f) if is_rotation_fap(f))
                     && face.fat.table(a.key).is_none()
                     && !unplayable.contains(&a.key)
                 {
