@@ -12,7 +12,16 @@ use fbakit::fap::{read_stream_file, FapStream, ReadOptions};
 /// Reads a face file, rig or bundled face; `fp` replaces its feature points (an OBJ needs
 /// them; a rig's shapes become a FAT with them).
 pub fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
-    Ok(fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp))?.0)
+    let (face, report) = fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp))?;
+    if let Some(fp) = fp {
+        // Points given by position were snapped to vertices: name the far snaps.
+        super::print_warnings(&fbakit::face::attach::snap_warnings(
+            &face,
+            &report.fp_matches,
+            fp,
+        ));
+    }
+    Ok(face)
 }
 
 /// Reads a FAP stream, strictly or leniently, with its reader warnings.
