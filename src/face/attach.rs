@@ -185,7 +185,7 @@ mod tests {
                 vertices: vec![1, 2],
             },
         ));
-        set.insert(FeaturePoint::at(fp("9.3"), Vec3::new(0.1, 0.9, 0.0)));
+        set.insert(FeaturePoint::at(fp("9.3"), Vec3::new(0.05, 0.95, 0.0)));
         let m = attach_feature_points(&mut face, set, &["sq.obj"]).unwrap();
         assert_eq!(
             face.feature_points.position(fp("2.1")),
@@ -193,7 +193,28 @@ mod tests {
         );
         assert_eq!(m.len(), 1);
         assert_eq!((m[0].id, m[0].vertex), (fp("9.3"), 3));
-        assert!((m[0].distance - 0.141_421).abs() < 1e-4);
+        assert!((m[0].distance - 0.070_711).abs() < 1e-4);
+        // A snap of more than 1 % of the face size (√2) is a warning naming the file.
+        let w = snap_warnings(&face, &m, std::path::Path::new("p.csv"));
+        assert_eq!(w.len(), 1);
+        assert!(w[0].message.starts_with("p.csv: feature point 9.3 snapped 0.0707 to vertex 3 of `sq` (5.0 % of the face size)"), "{}", w[0]);
+        // Beyond a tenth of the face size: refused.
+        let mut set = FeaturePointSet::new();
+        set.insert(FeaturePoint::at(fp("9.3"), Vec3::new(0.0, 0.0, 0.3)));
+        let e = attach_feature_points(&mut square(), set, &[]).unwrap_err();
+        assert!(e.to_string().contains("feature point 9.3 is 0.3"), "{e}");
+        // glTF primitive names: `Name/p` and `#m/p`.
+        let mut two = square();
+        two.meshes[0].name = "head.0".into();
+        let mut eye = two.meshes[0].clone();
+        eye.name = "mesh3.1".into();
+        two.meshes.push(eye);
+        assert_eq!(two.resolve_mesh_spec("head/0"), Some(0));
+        assert_eq!(two.resolve_mesh_spec("head.0"), Some(0));
+        assert_eq!(two.resolve_mesh_spec("#3/1"), Some(1));
+        assert_eq!(two.resolve_mesh_spec("head/1"), None);
+        assert_eq!(two.resolve_mesh_spec("#x/1"), None);
+        assert_eq!(two.resolve_mesh_spec("head/"), None);
         assert_eq!(face.fp_vertex(fp("9.3")), Some((0, 3)));
         assert_eq!(face.fp_vertex(fp("2.1")), Some((0, 1)));
 
