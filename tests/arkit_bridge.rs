@@ -230,7 +230,10 @@ fn weights_round_trip_through_a_fap_stream() {
     assert!(yaw.shapes.is_empty() && yaw.ignored.is_empty());
     assert_eq!(yaw.fap.as_deref(), Some("head_yaw"));
     let head_yaw = FapId::from_name("head_yaw").unwrap();
-    assert!(stream.frames.iter().all(|f| f.value(head_yaw) == Some(5000.0)));
+    assert!(stream
+        .frames
+        .iter()
+        .all(|f| f.value(head_yaw) == Some(5000.0)));
     let brow = report
         .columns
         .iter()

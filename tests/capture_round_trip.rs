@@ -34,7 +34,13 @@ fn pearson(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The moving shapes and their weight at frame `i` of 90.
-const SHAPES: [&str; 5] = ["jawOpen", "eyeBlinkLeft", "mouthSmileRight", "browInnerUp", "mouthFunnel"];
+const SHAPES: [&str; 5] = [
+    "jawOpen",
+    "eyeBlinkLeft",
+    "mouthSmileRight",
+    "browInnerUp",
+    "mouthFunnel",
+];
 
 fn shape_weight(k: usize, i: usize) -> f64 {
     let t = i as f64 / 89.0;
@@ -96,7 +102,13 @@ fn round_trip(dir: &Path, face_args: &[&str]) -> String {
         .iter()
         .map(|v| v.as_str().unwrap())
         .collect();
-    for f in ["head_yaw", "head_pitch", "head_roll", "yaw_l_eyeball", "pitch_r_eyeball"] {
+    for f in [
+        "head_yaw",
+        "head_pitch",
+        "head_roll",
+        "yaw_l_eyeball",
+        "pitch_r_eyeball",
+    ] {
         assert!(faps.contains(&f), "{f} missing from {faps:?}");
     }
     let roll = report["columns"]
@@ -130,7 +142,10 @@ fn check_rotations(back: &str) -> fbakit::rig::weights_csv::WeightCsv {
     assert!(header.starts_with("Timecode,BlendShapeCount,EyeBlinkLeft,EyeLookDownLeft,"));
     assert!(header.ends_with(",TongueOut,HeadYaw,HeadPitch,HeadRoll,LeftEyeYaw,LeftEyePitch,LeftEyeRoll,RightEyeYaw,RightEyePitch,RightEyeRoll"));
     assert_eq!(header.split(',').count(), 63);
-    assert!(back.lines().skip(1).all(|l| l.split(',').nth(1) == Some("61")));
+    assert!(back
+        .lines()
+        .skip(1)
+        .all(|l| l.split(',').nth(1) == Some("61")));
     let w = parse_capture(back, Path::new("back.csv"), None).unwrap();
     assert_eq!(w.fps, 60.0);
     assert_eq!(w.rows.len(), 90);
@@ -148,7 +163,10 @@ fn check_rotations(back: &str) -> fbakit::rig::weights_csv::WeightCsv {
             .zip(&got)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
-        eprintln!("{:<14} r = {corr:.6}, worst |Δ| {worst:.2e} rad", rot.column);
+        eprintln!(
+            "{:<14} r = {corr:.6}, worst |Δ| {worst:.2e} rad",
+            rot.column
+        );
         assert!(corr >= 0.95, "{}: r = {corr}", rot.column);
         // Whole AU both ways: within 1e-5 rad (plus the CSV's 5 decimals).
         assert!(worst <= 2e-5, "{}: {worst}", rot.column);
@@ -214,7 +232,11 @@ fn mediapipe_captures_play_on_a_face_with_a_fat() {
     let d = dir.path();
     let mut jsonl = String::new();
     let mut csv = String::from("timestamp_ms,_neutral");
-    let names: Vec<&str> = ARKIT_SHAPES.iter().copied().filter(|n| *n != "tongueOut").collect();
+    let names: Vec<&str> = ARKIT_SHAPES
+        .iter()
+        .copied()
+        .filter(|n| *n != "tongueOut")
+        .collect();
     for n in &names {
         csv.push(',');
         csv.push_str(n);
@@ -225,7 +247,11 @@ fn mediapipe_captures_play_on_a_face_with_a_fat() {
         let scores: Vec<String> = names
             .iter()
             .map(|n| {
-                let w = if *n == "jawOpen" { shape_weight(0, i * 2) } else { 0.0 };
+                let w = if *n == "jawOpen" {
+                    shape_weight(0, i * 2)
+                } else {
+                    0.0
+                };
                 format!("\"{n}\": {w:.4}")
             })
             .collect();
@@ -235,7 +261,11 @@ fn mediapipe_captures_play_on_a_face_with_a_fat() {
         ));
         csv.push_str(&format!("{ms},0.5"));
         for n in &names {
-            let w = if *n == "jawOpen" { shape_weight(0, i * 2) } else { 0.0 };
+            let w = if *n == "jawOpen" {
+                shape_weight(0, i * 2)
+            } else {
+                0.0
+            };
             csv.push_str(&format!(",{w:.4}"));
         }
         csv.push('\n');
@@ -321,7 +351,15 @@ fn bad_capture_files_exit_2_with_one_line_and_write_nothing() {
     }
     // A face without a FAT and no --fp: the file and the way out are named.
     let obj = put("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    let o = fbakit(&["fap", "to-arkit", "samples/speech.fap", "--face", &obj, "-o", d.join("w.csv").to_str().unwrap()]);
+    let o = fbakit(&[
+        "fap",
+        "to-arkit",
+        "samples/speech.fap",
+        "--face",
+        &obj,
+        "-o",
+        d.join("w.csv").to_str().unwrap(),
+    ]);
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");

@@ -35,7 +35,12 @@ fn positions_from_face_info_bind_like_the_vertex_ids() {
     let csv = dir.path().join("ict-positions.csv");
     let mut body = String::from("fp,x,y,z\n");
     for (fp, p) in positions {
-        let p: Vec<f64> = p.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let p: Vec<f64> = p
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
         body.push_str(&format!("{fp},{},{},{}\n", p[0], p[1], p[2]));
     }
     std::fs::write(&csv, body).unwrap();
@@ -77,7 +82,9 @@ fn two_primitive_glb(dir: &Path, named: bool) -> PathBuf {
         .iter()
         .map(|p| *p * 0.1 + Vec3::new(0.2, 0.2, 0.6))
         .collect();
-    let eye = s.add_mesh(MeshData::new("eye", eye, cube_triangles())).unwrap();
+    let eye = s
+        .add_mesh(MeshData::new("eye", eye, cube_triangles()))
+        .unwrap();
     s.add_node(NodeData::new("avatar").with_mesh(skin)).unwrap();
     s.add_node(NodeData::new("spare").with_mesh(eye)).unwrap();
     let mut doc = s.build().unwrap();
@@ -115,7 +122,10 @@ fn mesh_column_names_glb_primitives() {
             assert_eq!(names, ["mesh0.0", "mesh0.1"]);
             ("#0/0", "#0/1")
         };
-        let csv = format!("fp,vertices,mesh\n2.1,0,{skin}\n3.5,6,{eye}\n9.3,5,{}\n", face.meshes[1].name);
+        let csv = format!(
+            "fp,vertices,mesh\n2.1,0,{skin}\n3.5,6,{eye}\n9.3,5,{}\n",
+            face.meshes[1].name
+        );
         let table = fbakit::fdp::csv::parse_csv(&csv, Path::new("fp.csv")).unwrap();
         fbakit::face::attach::attach_feature_points(&mut face, table.to_set(), &[]).unwrap();
         let id = |s: &str| s.parse().unwrap();
@@ -142,19 +152,33 @@ fn bad_feature_points_exit_2_with_one_line_naming_the_file() {
     };
     let cases = [
         (
-            put("unknown.csv", "fp,vertices,mesh\n2.1,0,avatar/0\n3.5,1,hat/1\n"),
+            put(
+                "unknown.csv",
+                "fp,vertices,mesh\n2.1,0,avatar/0\n3.5,1,hat/1\n",
+            ),
             glb,
-            vec!["unknown.csv", "3.5 names mesh `hat/1`", "avatar.0, avatar.1"],
+            vec![
+                "unknown.csv",
+                "3.5 names mesh `hat/1`",
+                "avatar.0, avatar.1",
+            ],
         ),
         (
-            put("range.csv", "fp,vertices,mesh\n2.1,0,avatar/0\n3.5,20,avatar/1\n"),
+            put(
+                "range.csv",
+                "fp,vertices,mesh\n2.1,0,avatar/0\n3.5,20,avatar/1\n",
+            ),
             glb,
             vec!["range.csv", "20"],
         ),
         (
             put("far.csv", "fp,x,y,z\n2.1,0.5,0.5,0.5\n3.5,40,0,0\n"),
             glb,
-            vec!["far.csv", "feature point 3.5", "more than a tenth of the face size"],
+            vec![
+                "far.csv",
+                "feature point 3.5",
+                "more than a tenth of the face size",
+            ],
         ),
         (
             put("far-ict.csv", "fp,x,y,z\n2.1,0,-1000,0\n"),
@@ -175,17 +199,34 @@ fn bad_feature_points_exit_2_with_one_line_naming_the_file() {
     let ids = put("ids.json", "[0, 1, 2]");
     let out = d.join("fp.csv");
     let o = fbakit(&[
-        "fp", "from-landmarks", glb, "--ibug68", &ids, "-o", out.to_str().unwrap(),
+        "fp",
+        "from-landmarks",
+        glb,
+        "--ibug68",
+        &ids,
+        "-o",
+        out.to_str().unwrap(),
     ]);
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--mesh NAME"), "{err}");
     let o = fbakit(&[
-        "fp", "from-landmarks", glb, "--mesh", "hat", "--ibug68", &ids, "-o", out.to_str().unwrap(),
+        "fp",
+        "from-landmarks",
+        glb,
+        "--mesh",
+        "hat",
+        "--ibug68",
+        &ids,
+        "-o",
+        out.to_str().unwrap(),
     ]);
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("no mesh `hat` (its meshes: avatar.0, avatar.1)"), "{err}");
+    assert!(
+        err.contains("no mesh `hat` (its meshes: avatar.0, avatar.1)"),
+        "{err}"
+    );
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(!out.exists());
 }
@@ -203,7 +244,10 @@ fn near_snaps_warn_with_their_distance() {
     let o = fbakit(&["face", "info", "ict", "--fp", csv.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
-    assert!(err.contains("moved.csv: feature point 2.1 snapped"), "{err}");
+    assert!(
+        err.contains("moved.csv: feature point 2.1 snapped"),
+        "{err}"
+    );
     assert!(err.contains("% of the face size"), "{err}");
 }
 
@@ -228,8 +272,12 @@ fn landmarks_on_one_mesh_of_several_read_back_on_the_same_file() {
         .iter()
         .map(|p| *p * 5.0 + Vec3::new(0.0, 20.0, 0.0))
         .collect();
-    let hat = s.add_mesh(MeshData::new("hat", hat, cube_triangles())).unwrap();
-    let root = s.add_node(NodeData::new("Head").with_mesh(head_mesh)).unwrap();
+    let hat = s
+        .add_mesh(MeshData::new("hat", hat, cube_triangles()))
+        .unwrap();
+    let root = s
+        .add_node(NodeData::new("Head").with_mesh(head_mesh))
+        .unwrap();
     s.add_node(NodeData::new("Hat").with_parent(root).with_mesh(hat))
         .unwrap();
     let glb = d.join("avatar.glb");
@@ -248,8 +296,14 @@ fn landmarks_on_one_mesh_of_several_read_back_on_the_same_file() {
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let table = std::fs::read_to_string(&fp).unwrap();
-    assert!(table.starts_with("fp,vertices,mesh,combine,description\n"), "{table}");
-    assert!(table.lines().skip(1).all(|l| l.split(',').nth(2) == Some("Head")));
+    assert!(
+        table.starts_with("fp,vertices,mesh,combine,description\n"),
+        "{table}"
+    );
+    assert!(table
+        .lines()
+        .skip(1)
+        .all(|l| l.split(',').nth(2) == Some("Head")));
     // Read back on the same file: every point bound to the head, FAP units measurable.
     let face = read_with_fp(glb.to_str().unwrap(), &fp);
     assert!(face.feature_points.len() > 40);

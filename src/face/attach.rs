@@ -8,9 +8,9 @@
 
 use super::vrml::FeaturePointMatch;
 use super::FaceModel;
+use crate::error::Diagnostic;
 use crate::error::Result;
 use crate::face::vertex_index::FaceVertexIndex;
-use crate::error::Diagnostic;
 use crate::fdp::FeaturePointSet;
 
 /// Largest snap distance, as a fraction of the face size, for a point given by position.

@@ -362,7 +362,11 @@ pub fn to_csv_string(table: &FeaturePointTable) -> Result<String> {
                 None => rec.extend([String::new(), String::new(), String::new()]),
             }
         }
-        let combine = if r.position.is_some() { "" } else { r.combine.word() };
+        let combine = if r.position.is_some() {
+            ""
+        } else {
+            r.combine.word()
+        };
         rec.push(combine.to_string());
         rec.push(r.description.clone().unwrap_or_default());
         w.write_record(&rec).map_err(enc)?;
@@ -482,7 +486,12 @@ mod tests {
         let set = t.to_set();
         let p = set.get("3.5".parse().unwrap()).unwrap();
         assert!(p.binding.is_none() && p.position.is_some());
-        let b = set.get("9.3".parse().unwrap()).unwrap().binding.clone().unwrap();
+        let b = set
+            .get("9.3".parse().unwrap())
+            .unwrap()
+            .binding
+            .clone()
+            .unwrap();
         assert_eq!(b.mesh.as_deref(), Some("#3/0"));
         // Written and read back the same.
         assert_eq!(parse(&to_csv_string(&t).unwrap()).unwrap(), t);
@@ -490,11 +499,26 @@ mod tests {
         let t = parse("fp,x,y,z\n2.1,0,1,2\n").unwrap();
         assert_eq!(t.rows[0].position, Some(Vec3::new(0.0, 1.0, 2.0)));
         for (text, want) in [
-            ("fp,x,y,z\n2.1,0,,2\n", "t.csv:2:3: expected a finite coordinate"),
-            ("fp,x,y,z\n2.1,0,NaN,2\n", "t.csv:2:3: expected a finite coordinate"),
-            ("fp,vertices,x,y,z\n2.1,3,0,1,2\n", "t.csv:2:2: expected vertex ids or a position"),
-            ("fp,x,y,z,combine\n2.1,0,1,2,mean\n", "t.csv:2:5: expected `single`"),
-            ("fp,x,y\n2.1,0,1\n", "t.csv:1:1: expected a header with columns"),
+            (
+                "fp,x,y,z\n2.1,0,,2\n",
+                "t.csv:2:3: expected a finite coordinate",
+            ),
+            (
+                "fp,x,y,z\n2.1,0,NaN,2\n",
+                "t.csv:2:3: expected a finite coordinate",
+            ),
+            (
+                "fp,vertices,x,y,z\n2.1,3,0,1,2\n",
+                "t.csv:2:2: expected vertex ids or a position",
+            ),
+            (
+                "fp,x,y,z,combine\n2.1,0,1,2,mean\n",
+                "t.csv:2:5: expected `single`",
+            ),
+            (
+                "fp,x,y\n2.1,0,1\n",
+                "t.csv:1:1: expected a header with columns",
+            ),
         ] {
             let e = parse(text).unwrap_err().to_string();
             assert!(e.starts_with(want), "{text:?}: {e}");

@@ -188,7 +188,11 @@ impl<'a> ArkitBridge<'a> {
     }
 
     /// The bridge with the given FAP sides (FAP, value at a side's full extent).
-    fn with_sides(rig: &'a Rig, face: &'a FaceModel, calibrated: Vec<(FapId, f64)>) -> Result<Self> {
+    fn with_sides(
+        rig: &'a Rig,
+        face: &'a FaceModel,
+        calibrated: Vec<(FapId, f64)>,
+    ) -> Result<Self> {
         if face.meshes.len() != rig.meshes.len()
             || face
                 .meshes

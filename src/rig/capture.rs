@@ -166,7 +166,12 @@ pub enum CaptureFormat {
 
 /// The format of `text` by its content (module docs).
 pub fn detect_capture(text: &str) -> CaptureFormat {
-    match text.trim_start_matches('\u{feff}').trim_start().as_bytes().first() {
+    match text
+        .trim_start_matches('\u{feff}')
+        .trim_start()
+        .as_bytes()
+        .first()
+    {
         Some(b'{' | b'[') => CaptureFormat::MediaPipeJsonLines,
         _ => CaptureFormat::Csv,
     }
@@ -313,7 +318,10 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
                     continue;
                 }
                 if name.is_empty() {
-                    return Err(err(key_at("blendshapes"), "a shape name in `blendshapes`".into()));
+                    return Err(err(
+                        key_at("blendshapes"),
+                        "a shape name in `blendshapes`".into(),
+                    ));
                 }
                 if columns.len() == MAX_COLUMNS {
                     return Err(err(key_at(name), format!("at most {MAX_COLUMNS} shapes")));
@@ -355,7 +363,10 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
                 ));
             };
             if !row[c].is_nan() {
-                return Err(err(key_at(name), format!("one score per shape (`{name}` repeats)")));
+                return Err(err(
+                    key_at(name),
+                    format!("one score per shape (`{name}` repeats)"),
+                ));
             }
             let rotation = rotation_index(name).is_some();
             row[c] = if rotation {
@@ -379,10 +390,7 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
         if let Some(c) = row.iter().position(|v| v.is_nan()) {
             return Err(err(
                 key_at("blendshapes"),
-                format!(
-                    "`blendshapes.{}` as on line {first_line}",
-                    columns[c].name
-                ),
+                format!("`blendshapes.{}` as on line {first_line}", columns[c].name),
             ));
         }
         starts.push(key_at("timestamp_ms"));
@@ -545,7 +553,10 @@ mod tests {
 
     #[test]
     fn detection_by_content() {
-        assert_eq!(detect_capture("\u{feff} \n{\"a\":1}"), CaptureFormat::MediaPipeJsonLines);
+        assert_eq!(
+            detect_capture("\u{feff} \n{\"a\":1}"),
+            CaptureFormat::MediaPipeJsonLines
+        );
         assert_eq!(detect_capture("Timecode,JawOpen\n"), CaptureFormat::Csv);
         assert_eq!(detect_capture(""), CaptureFormat::Csv);
     }
@@ -572,9 +583,9 @@ mod tests {
         assert_eq!(w.rows[2].weights[blink], 0.25);
         assert_eq!(w.warnings.len(), 1);
         assert!(
-            w.warnings[0]
-                .message
-                .contains("mp.jsonl: 1 score outside 0..1 clamped (first at line 3, `blendshapes.jawOpen`)"),
+            w.warnings[0].message.contains(
+                "mp.jsonl: 1 score outside 0..1 clamped (first at line 3, `blendshapes.jawOpen`)"
+            ),
             "{}",
             w.warnings[0]
         );
@@ -598,38 +609,68 @@ mod tests {
     #[test]
     fn hostile_json_lines_are_located_errors() {
         let ok = "{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.1}}\n";
-        let broken = message(&format!("{ok}{{\"timestamp_ms\": 5, \"blendshapes\": {{\"jawOpen\": }}}}\n"));
+        let broken = message(&format!(
+            "{ok}{{\"timestamp_ms\": 5, \"blendshapes\": {{\"jawOpen\": }}}}\n"
+        ));
         assert!(broken.starts_with("mp.jsonl:2:"), "{broken}");
         assert!(broken.contains("one JSON object per line"), "{broken}");
-        let missing = message(&format!("{ok}{{\"timestamp_ms\": 5, \"blendshapes\": {{}}}}\n"));
+        let missing = message(&format!(
+            "{ok}{{\"timestamp_ms\": 5, \"blendshapes\": {{}}}}\n"
+        ));
         assert!(missing.contains("mp.jsonl:2:"), "{missing}");
-        assert!(missing.contains("`blendshapes.jawOpen` as on line 1"), "{missing}");
+        assert!(
+            missing.contains("`blendshapes.jawOpen` as on line 1"),
+            "{missing}"
+        );
         let new = message(&format!(
             "{ok}{{\"timestamp_ms\": 5, \"blendshapes\": {{\"jawOpen\": 0, \"mouthClose\": 0}}}}\n"
         ));
-        assert!(new.contains("mp.jsonl:2:51: expected only the shapes of line 1"), "{new}");
+        assert!(
+            new.contains("mp.jsonl:2:51: expected only the shapes of line 1"),
+            "{new}"
+        );
         let nan = message("{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": \"x\"}}\n");
-        assert!(nan.contains("mp.jsonl:1:37: expected `blendshapes.jawOpen`: a finite score"), "{nan}");
+        assert!(
+            nan.contains("mp.jsonl:1:37: expected `blendshapes.jawOpen`: a finite score"),
+            "{nan}"
+        );
         let time = message("{\"timestamp\": 0, \"blendshapes\": {\"jawOpen\": 0}}\n");
-        assert!(time.contains("mp.jsonl:1:1: expected `timestamp_ms`"), "{time}");
-        let back = message(&format!("{{\"timestamp_ms\": 50, \"blendshapes\": {{\"jawOpen\": 0.1}}}}\n{ok}"));
-        assert!(back.contains("mp.jsonl:2:2: expected `timestamp_ms`: a time no earlier"), "{back}");
+        assert!(
+            time.contains("mp.jsonl:1:1: expected `timestamp_ms`"),
+            "{time}"
+        );
+        let back = message(&format!(
+            "{{\"timestamp_ms\": 50, \"blendshapes\": {{\"jawOpen\": 0.1}}}}\n{ok}"
+        ));
+        assert!(
+            back.contains("mp.jsonl:2:2: expected `timestamp_ms`: a time no earlier"),
+            "{back}"
+        );
         assert!(message("[1, 2]\n").contains("mp.jsonl:1:1: expected a JSON object"));
-        assert!(message("{\"timestamp_ms\": 0, \"blendshapes\": 3}").contains("`blendshapes`: an object"));
+        assert!(message("{\"timestamp_ms\": 0, \"blendshapes\": 3}")
+            .contains("`blendshapes`: an object"));
         let deep = format!("{{\"a\": {}{}}}", "[".repeat(10_000), "]".repeat(10_000));
         assert!(jsonl(&deep).is_err());
-        for junk in ["{", "{}", "{\"timestamp_ms\": 1e400}", "\u{feff}{\n", "{\"blendshapes\": []}"] {
+        for junk in [
+            "{",
+            "{}",
+            "{\"timestamp_ms\": 1e400}",
+            "\u{feff}{\n",
+            "{\"blendshapes\": []}",
+        ] {
             assert!(jsonl(junk).is_err(), "{junk}");
         }
     }
 
     #[test]
     fn live_link_layout_is_written_and_reads_back() {
-        let shapes: Vec<Vec<f32>> = (0..70).map(|i| {
-            let mut w = vec![0.0; 52];
-            w[17] = i as f32 / 70.0;
-            w
-        }).collect();
+        let shapes: Vec<Vec<f32>> = (0..70)
+            .map(|i| {
+                let mut w = vec![0.0; 52];
+                w[17] = i as f32 / 70.0;
+                w
+            })
+            .collect();
         let rotations: Vec<[f64; 9]> = (0..70)
             .map(|i| [0.01 * i as f64, -0.2, 0.0, 0.1, -0.1, 0.3, 0.0, 0.0, 0.0])
             .collect();
@@ -651,7 +692,9 @@ mod tests {
         assert!((w.rows[35].weights[17] - 0.5).abs() < 1e-5);
         // Degrees by mistake are refused.
         let degrees = text.replacen(",-0.2,", ",-20,", 1);
-        let e = parse_capture(&degrees, Path::new("llf.csv"), None).unwrap_err().to_string();
+        let e = parse_capture(&degrees, Path::new("llf.csv"), None)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("expected an angle in radians"), "{e}");
         assert_eq!(format_decimals(-0.000001), "0");
         assert_eq!(format_decimals(-0.25), "-0.25");
@@ -659,12 +702,14 @@ mod tests {
 
     #[test]
     fn random_lines_never_panic() {
-        let alphabet: Vec<char> = "{}[]\":,0123456789.-e timestamp_msblendshapescategoryNamescore\n"
-            .chars()
-            .collect();
+        let alphabet: Vec<char> =
+            "{}[]\":,0123456789.-e timestamp_msblendshapescategoryNamescore\n"
+                .chars()
+                .collect();
         let mut seed = 11u64;
         for len in 0..2000usize {
-            let mut t = String::from("{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.5}}\n");
+            let mut t =
+                String::from("{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.5}}\n");
             for _ in 0..(len % 89) {
                 seed = seed
                     .wrapping_mul(6364136223846793005)

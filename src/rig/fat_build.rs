@@ -145,8 +145,7 @@ pub fn face_from_rig(
     };
     let fapu = match feature_points {
         Some(points) => {
-            report.fp_matches =
-                crate::face::attach::attach_feature_points(&mut face, points, &[])?;
+            report.fp_matches = crate::face::attach::attach_feature_points(&mut face, points, &[])?;
             let fapu = Fapu::from_feature_points(&face.feature_points)?;
             report.fapu = Some(fapu.distances);
             Some(fapu)

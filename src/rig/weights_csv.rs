@@ -386,7 +386,8 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
             if clamped == 1 { "" } else { "s" }
         )));
     }
-    let locate = |k: usize, expected: String| err(field_offset(text, stamps[k].1, time_col), expected);
+    let locate =
+        |k: usize, expected: String| err(field_offset(text, stamps[k].1, time_col), expected);
     let rows = stamps
         .iter()
         .zip(weights)
