@@ -93,6 +93,11 @@ pub struct ToArkitArgs {
 /// without feature points the face is read with its own FAT and the rig made from it.
 fn load(a: &RigArgs) -> Result<(Rig, FaceModel, Option<RigFatReport>)> {
     let Some(fp_path) = &a.fp else {
+        if a.map != "arkit" {
+            return Err(fbakit::error::Error::Usage(
+                "--map is the mapping table of a rig: it needs --fp FP".into(),
+            ));
+        }
         let face = super::inputs::read_face(&a.face, None)?;
         if face.fat.tables.is_empty() {
             return Err(RigError::FaceWithoutFat {
