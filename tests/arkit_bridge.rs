@@ -221,12 +221,19 @@ fn weights_round_trip_through_a_fap_stream() {
         "{}",
         report.relative_residual
     );
+    // The head yaw column sets head_yaw (0.05 rad = 5000 AU), no shape.
     let yaw = report
         .columns
         .iter()
         .find(|c| c.column == "HeadYaw")
         .unwrap();
-    assert!(yaw.shapes.is_empty() && !yaw.ignored.is_empty());
+    assert!(yaw.shapes.is_empty() && yaw.ignored.is_empty());
+    assert_eq!(yaw.fap.as_deref(), Some("head_yaw"));
+    let head_yaw = FapId::from_name("head_yaw").unwrap();
+    assert!(stream
+        .frames
+        .iter()
+        .all(|f| f.value(head_yaw) == Some(5000.0)));
     let brow = report
         .columns
         .iter()
@@ -574,8 +581,9 @@ fn cli_round_trip_on_ict() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let back = std::fs::read_to_string(&weights).unwrap();
     let header = back.lines().next().unwrap();
-    assert!(header.starts_with("Timecode,EyeBlinkLeft,EyeLookDownLeft,"));
-    assert_eq!(header.split(',').count(), 53);
+    assert!(header.starts_with("Timecode,BlendShapeCount,EyeBlinkLeft,EyeLookDownLeft,"));
+    assert!(header.ends_with(",TongueOut,HeadYaw,HeadPitch,HeadRoll,LeftEyeYaw,LeftEyePitch,LeftEyeRoll,RightEyeYaw,RightEyePitch,RightEyeRoll"));
+    assert_eq!(header.split(',').count(), 63);
     assert_eq!(back.lines().count(), 21);
     // The written CSV reads back (60 fps given: 20 frames never cross a second).
     let w = parse_weights_csv(&back, &weights, Some(60.0)).unwrap();
@@ -586,6 +594,9 @@ fn cli_round_trip_on_ict() {
         (got - 1.0).abs() < ROUND_TRIP_TOLERANCE,
         "JawOpen at the clamped row: {got}"
     );
+    // The constant head yaw of the capture comes back in radians.
+    let yaw = w.columns.iter().position(|c| c.name == "HeadYaw").unwrap();
+    assert!(w.rows.iter().all(|r| (r.weights[yaw] - 0.05).abs() < 1e-6));
 }
 
 #[test]
@@ -661,10 +672,12 @@ fn full_live_link_face_header_resolves_on_ict() {
         .filter(|c| !c.ignored.is_empty())
         .map(|c| (c.column.as_str(), c.ignored.as_str()))
         .collect();
-    // ICT has every ARKit shape but tongueOut; the nine rotations are not blend shapes.
+    // ICT has every ARKit shape but tongueOut; rotations that stay 0 and eye roll carry
+    // nothing.
     assert_eq!(ignored.len(), 10, "{ignored:?}");
     assert!(ignored.contains(&("TongueOut", "ARKit shape the rig does not have")));
-    assert!(ignored.contains(&("HeadYaw", "not a blend shape of the rig")));
+    assert!(ignored.contains(&("HeadYaw", "rotation 0 on every row")));
+    assert!(ignored.contains(&("LeftEyeRoll", "eye roll has no FAP")));
     // All-zero weights give the neutral: every FAP 0.
     assert!(stream.frames[0].values().iter().all(|v| *v == 0.0));
 }

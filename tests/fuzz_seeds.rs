@@ -101,7 +101,7 @@ fn landmark_ids_seeds() {
 fn weights_csv_seeds() {
     for seed in seeds("weights_csv") {
         let text = std::fs::read_to_string(&seed).unwrap();
-        fbakit::rig::weights_csv::parse_weights_csv(&text, &seed, None)
+        fbakit::rig::capture::parse_capture(&text, &seed, None)
             .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
     }
     replay("weights_csv", |d| {
@@ -109,8 +109,8 @@ fn weights_csv_seeds() {
             return;
         };
         let file = Path::new("fuzz.csv");
-        let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, None);
-        let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, Some(30.0));
+        let _ = fbakit::rig::capture::parse_capture(text, file, None);
+        let _ = fbakit::rig::capture::parse_capture(text, file, Some(30.0));
     });
 }
 

@@ -1,5 +1,6 @@
-//! ARKit weight CSVs (Live Link Face and plain): any text must give weights or a located
-//! error, with and without a frame rate given.
+//! Capture files through their one front door (`rig::capture::parse_capture`): Live Link Face
+//! and plain weight CSVs, MediaPipe CSV and JSON lines. Any text must give weights or a
+//! located error, with and without a frame rate given.
 #![no_main]
 
 use std::path::Path;
@@ -11,6 +12,6 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let file = Path::new("fuzz.csv");
-    let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, None);
-    let _ = fbakit::rig::weights_csv::parse_weights_csv(text, file, Some(30.0));
+    let _ = fbakit::rig::capture::parse_capture(text, file, None);
+    let _ = fbakit::rig::capture::parse_capture(text, file, Some(30.0));
 });

@@ -10,7 +10,7 @@ use fbakit::clone::eval::{
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
 use fbakit::error::{Error, Result, ResultExt};
 use fbakit::export::write_face;
-use fbakit::face::{FaceFormat, FaceModel, FaceReadOptions};
+use fbakit::face::{FaceFormat, FaceModel};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -221,7 +221,7 @@ fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
             path.display()
         )));
     }
-    Ok(fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp))?.0)
+    super::inputs::read_face(path, fp)
 }
 
 fn bar(steps: u64) -> ProgressBar {

@@ -201,6 +201,13 @@ fn info(a: InfoArgs) -> Result<u8> {
         &a.file,
         &FaceReadOptions::with_feature_points(a.fp.as_deref()),
     )?;
+    if let Some(fp) = &a.fp {
+        print_warnings(&fbakit::face::attach::snap_warnings(
+            &face,
+            &report.fp_matches,
+            fp,
+        ));
+    }
     let mut summary = summarize(&face, Some(&report));
     if a.units.is_some() {
         summary.units = fbakit::face::units::unit_of(&face, a.units);

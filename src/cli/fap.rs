@@ -26,24 +26,31 @@ pub enum FapCommand {
     #[command(after_help = "Examples:\n  fbakit fap convert joy.fap joy.json\n  \
                             fbakit fap convert joy.json joy-canonical.fap --strict")]
     Convert(ConvertArgs),
-    /// ARKit blend-shape weights (a Live Link Face CSV) → a FAP stream, through a rig and the
-    /// FAT built from it: each frame poses the rig's feature points with the weights and
-    /// solves a bounded least-squares fit for the FAP values (positive and negative parts
-    /// each 0..2× the calibrated range, small Tikhonov term). Head and eye rotation columns
-    /// are reported as ignored; weights outside 0..1 are clamped with one warning.
+    /// Face-capture weights → a FAP stream: a Live Link Face CSV (or the bare 52-column CSV,
+    /// MediaPipe CSV or JSON lines; detected by content), through a rig and the FAT built from
+    /// it (--fp), or through any face's own FAT: each frame poses the feature points with the
+    /// weights and solves a bounded least-squares fit for the FAP values (positive and negative
+    /// parts each 0..2× the calibrated range, small Tikhonov term). Head and eye rotations
+    /// (radians) become FAPs 48-50 and 23-26 in angle units (1e-5 rad); eye roll has no FAP.
+    /// Weights outside 0..1 are clamped with one warning.
     #[command(
         name = "from-arkit",
-        after_help = "Example:\n  fbakit fp from-landmarks ict/generic_neutral_mesh.obj --ibug68 ict/vertex_indices.json -o ict-fp.csv\n  \
-                      fbakit fap from-arkit capture.csv --face ict/ --fp ict-fp.csv -o capture.fap"
+        after_help = "Examples:\n  fbakit fp from-landmarks ict/generic_neutral_mesh.obj --ibug68 ict/vertex_indices.json -o ict-fp.csv\n  \
+                      fbakit fap from-arkit capture.csv --face ict/ --fp ict-fp.csv -o capture.fap\n  \
+                      fbakit fap from-arkit mediapipe.jsonl --face bruno -o capture.fap"
     )]
     FromArkit(super::fap_arkit::FromArkitArgs),
-    /// A FAP stream → ARKit blend-shape weights (CSV: Timecode, then the 52 ARKit shapes at
-    /// the stream's frame rate): the stream is played on the FAT built from the rig and each
-    /// frame's feature-point motion is fitted by the rig's shapes, 0 ≤ w ≤ 1 (bounded least
-    /// squares, small Tikhonov term). Shapes the rig lacks are written as 0.
+    /// A FAP stream → ARKit weights in Live Link Face's CSV layout (Timecode,
+    /// BlendShapeCount, the 52 shapes, the 9 head/eye rotations in radians from FAPs 48-50
+    /// and 23-26) at the stream's frame rate: the stream is played on the face's FAT (built
+    /// from a rig with --fp, or the face's own) and each frame's feature-point motion is
+    /// fitted by the ARKit shapes, 0 ≤ w ≤ 1 (bounded least squares, small Tikhonov term).
+    /// Shapes the face lacks are written as 0.
     #[command(
         name = "to-arkit",
-        after_help = "Example:\n  fbakit fap to-arkit samples/speech.fap --face ict/ --fp ict-fp.csv -o speech-arkit.csv"
+        after_help = "Examples:\n  fbakit fap to-arkit samples/speech.fap --face ict/ --fp ict-fp.csv -o speech-arkit.csv\n  \
+                      fbakit clone alma head.obj --fp-target head-fp.csv -o head.wrl\n  \
+                      fbakit fap to-arkit samples/speech.fap --face head.wrl -o speech-arkit.csv"
     )]
     ToArkit(super::fap_arkit::ToArkitArgs),
 }

@@ -40,7 +40,8 @@ pub enum FpCommand {
 #[derive(Debug, clap::Args)]
 #[command(group(clap::ArgGroup::new("scheme").required(true).args(["ibug68", "mediapipe468"])))]
 pub struct FromLandmarksArgs {
-    /// The mesh (.obj, or a one-mesh .wrl / .wrl.gz face) the landmark ids index.
+    /// The mesh (.obj, .glb/.gltf, or a .wrl / .wrl.gz face) the landmark ids index (with
+    /// --mesh when the file has several meshes).
     pub mesh: PathBuf,
     /// The 68 iBUG landmark vertex ids: ICT-FaceKit's vertex_indices.json (key
     /// idx_to_landmark_verts), a JSON array, or a CSV / text list of vertex ids.
@@ -50,6 +51,12 @@ pub struct FromLandmarksArgs {
     /// vertex order is the landmark order (MediaPipe's canonical face).
     #[arg(long, value_name = "IDS", num_args = 0..=1)]
     pub mediapipe468: Option<Option<PathBuf>>,
+    /// The mesh the landmark ids index, in a file of several meshes: its name as `fbakit face
+    /// info` lists it, `Name/1` for primitive 1 of glTF mesh or node `Name`, `#3/1` by glTF
+    /// mesh index. The output's bindings name it, so `clone --fp-target` reads them back on
+    /// the same file.
+    #[arg(long = "mesh", value_name = "NAME")]
+    pub mesh_name: Option<String>,
     /// Output feature-point file: .csv or .xml.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
@@ -106,12 +113,32 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
         (None, None) => unreachable!("clap requires one scheme"),
     };
     let face = fbakit::face::read(&args.mesh)?;
-    let [only] = face.meshes.as_slice() else {
-        return Err(FdpError::LandmarksNeedOneMesh {
-            file: args.mesh.clone(),
-            meshes: face.meshes.len(),
+    // The mesh the landmark ids index: the only one, or the one --mesh names (its name then
+    // goes into the output, so `clone` binds the points to it on the same file).
+    let (only, named) = match (&args.mesh_name, face.meshes.as_slice()) {
+        (Some(spec), meshes) => {
+            let Some(i) = face.resolve_mesh_spec(spec) else {
+                return Err(FdpError::UnknownLandmarkMesh {
+                    file: args.mesh.clone(),
+                    mesh: spec.clone(),
+                    meshes: meshes
+                        .iter()
+                        .map(|m| m.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                }
+                .into());
+            };
+            (&meshes[i], meshes.len() > 1)
         }
-        .into());
+        (None, [only]) => (only, false),
+        (None, meshes) => {
+            return Err(FdpError::LandmarksNeedOneMesh {
+                file: args.mesh.clone(),
+                meshes: meshes.len(),
+            }
+            .into())
+        }
     };
     let mesh = &only.mesh;
     let (ids, ids_name) = match &ids_path {
@@ -132,7 +159,19 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
     ids.check(scheme.landmark_count(), mesh.positions.len(), &ids_name)?;
     let found = feature_points_from_landmarks(mesh, scheme, &ids.ids)
         .map_err(|e| fbakit::face::FaceError::in_file(&args.mesh, e))?;
-    let set = found.feature_point_set();
+    let mut set = found.feature_point_set();
+    let mut table = found.table();
+    if named {
+        for r in &mut table.rows {
+            r.mesh = Some(only.name.clone());
+        }
+        let ids: Vec<_> = set.iter().map(|p| p.id).collect();
+        for id in ids {
+            if let Some(b) = set.get_mut(id).and_then(|p| p.binding.as_mut()) {
+                b.mesh = Some(only.name.clone());
+            }
+        }
+    }
     let mut warnings = Vec::new();
     let fapu = match Fapu::from_feature_points(&set) {
         Ok(f) => Some(f.distances),
@@ -144,7 +183,7 @@ fn from_landmarks(args: FromLandmarksArgs) -> Result<u8> {
         }
     };
     match format {
-        OutFormat::Csv => fbakit::fdp::csv::write_csv_file(&args.output, &found.table())?,
+        OutFormat::Csv => fbakit::fdp::csv::write_csv_file(&args.output, &table)?,
         // Xface names the mesh a point is on; the mesh file's name is what `--fp` matches.
         OutFormat::Fdp => fbakit::fdp::xface::write_xface_file(
             &args.output,

@@ -12,26 +12,36 @@ use fbakit::fap::{read_stream_file, FapStream, ReadOptions};
 /// Reads a face file, rig or bundled face; `fp` replaces its feature points (an OBJ needs
 /// them; a rig's shapes become a FAT with them).
 pub fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
-    match fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp)) {
-        Ok((face, _)) => Ok(face),
-        // Some layers cannot know the file (FAPUs of a degenerate feature-point set): name
-        // the files unless the message already does.
-        Err(e) => {
-            let message = e.to_string();
-            let named = |p: &Path| message.contains(&p.display().to_string());
-            if named(path) || fp.is_some_and(named) {
-                return Err(e);
+    let (face, report) =
+        match fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(fp)) {
+            Ok(read) => read,
+            // Some layers cannot know the file (FAPUs of a degenerate feature-point set):
+            // name the files unless the message already does.
+            Err(e) => {
+                let message = e.to_string();
+                let named = |p: &Path| message.contains(&p.display().to_string());
+                if named(path) || fp.is_some_and(named) {
+                    return Err(e);
+                }
+                return Err(match fp {
+                    Some(fp) => e.context(format!(
+                        "reading {} with feature points {}",
+                        path.display(),
+                        fp.display()
+                    )),
+                    None => e.context(format!("reading {}", path.display())),
+                });
             }
-            Err(match fp {
-                Some(fp) => e.context(format!(
-                    "reading {} with feature points {}",
-                    path.display(),
-                    fp.display()
-                )),
-                None => e.context(format!("reading {}", path.display())),
-            })
-        }
+        };
+    if let Some(fp) = fp {
+        // Points given by position were snapped to vertices: name the far snaps.
+        super::print_warnings(&fbakit::face::attach::snap_warnings(
+            &face,
+            &report.fp_matches,
+            fp,
+        ));
     }
+    Ok(face)
 }
 
 /// Reads a FAP stream, strictly or leniently, with its reader warnings.

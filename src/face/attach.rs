@@ -1,11 +1,70 @@
 //! Putting feature points from a separate file on a face's meshes: bound points on their
 //! vertices, position-only points on the nearest vertex.
+//!
+//! A binding's mesh may be named as the face names it, or for a glTF face by
+//! [`FaceModel::resolve_mesh_spec`]'s rule (`Name/1`, `#3/1`). A position farther than
+//! [`MAX_SNAP_FRACTION`] of the face size (the diagonal of its neutral bounding box) from
+//! every vertex is refused; [`snap_warnings`] names the snaps beyond [`WARN_SNAP_FRACTION`].
 
 use super::vrml::FeaturePointMatch;
 use super::FaceModel;
+use crate::error::Diagnostic;
 use crate::error::Result;
 use crate::face::vertex_index::FaceVertexIndex;
 use crate::fdp::FeaturePointSet;
+
+/// Largest snap distance, as a fraction of the face size, for a point given by position.
+pub const MAX_SNAP_FRACTION: f32 = 0.1;
+
+/// Snap distance (fraction of the face size) from which a snap is worth a warning.
+pub const WARN_SNAP_FRACTION: f32 = 0.01;
+
+/// The diagonal of the face's neutral bounding box (face frame; 0 for an empty face).
+pub fn face_size(face: &FaceModel) -> f32 {
+    let mut lo = glam::Vec3::splat(f32::INFINITY);
+    let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+    for mesh in face.neutral_world_positions() {
+        for p in mesh {
+            if p.is_finite() {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    if lo.x <= hi.x {
+        (hi - lo).length()
+    } else {
+        0.0
+    }
+}
+
+/// One warning per snap of `matches` farther than [`WARN_SNAP_FRACTION`] of the face size,
+/// naming the file the points came from (`source`), the point, the vertex and the distance.
+pub fn snap_warnings(
+    face: &FaceModel,
+    matches: &[super::vrml::FeaturePointMatch],
+    source: &std::path::Path,
+) -> Vec<Diagnostic> {
+    if matches.is_empty() {
+        return Vec::new();
+    }
+    let size = face_size(face);
+    matches
+        .iter()
+        .filter(|m| size > 0.0 && m.distance > WARN_SNAP_FRACTION * size)
+        .map(|m| {
+            Diagnostic::warning(format!(
+                "{}: feature point {} snapped {:.4} to vertex {} of `{}` ({:.1} % of the face size)",
+                source.display(),
+                m.id,
+                m.distance,
+                m.vertex,
+                m.mesh,
+                100.0 * m.distance / size
+            ))
+        })
+        .collect()
+}
 
 /// Puts `points` on `face`: bound points are placed on their vertices, position-only points
 /// are bound to the nearest vertex (returned with the distance). On a single-mesh face a
@@ -26,12 +85,17 @@ pub fn attach_feature_points(
         let Some(b) = p.binding.as_mut() else {
             continue;
         };
+        let resolved = b
+            .mesh
+            .as_deref()
+            .and_then(|m| face.resolve_mesh_spec(m))
+            .map(|i| face.meshes[i].name.clone());
         match (&single, b.mesh.as_deref()) {
             (Some(only), None) => b.mesh = Some(only.clone()),
             (Some(only), Some(m)) if m == only || aliases.contains(&m) => {
                 b.mesh = Some(only.clone())
             }
-            (_, Some(m)) if face.mesh_index(m).is_some() => {}
+            (_, Some(_)) if resolved.is_some() => b.mesh = resolved,
             (_, m) => bad.push(format!(
                 "{id} names mesh {}",
                 m.map_or("<none>".to_string(), |m| format!("`{m}`"))
@@ -58,6 +122,7 @@ pub fn attach_feature_points(
         .filter(|p| p.binding.is_none())
         .filter_map(|p| Some((p.id, p.position?)))
         .collect();
+    let limit = MAX_SNAP_FRACTION * face_size(face);
     for (id, pos) in unbound {
         if !pos.is_finite() {
             return Err(super::FaceError::NonFiniteFeaturePoint { id }.into());
@@ -65,6 +130,14 @@ pub fn attach_feature_points(
         let Some((binding, found)) = index.bind(face, id, pos) else {
             continue;
         };
+        if found.distance > limit {
+            return Err(super::FaceError::FeaturePointFarFromMesh {
+                id,
+                distance: found.distance,
+                limit,
+            }
+            .into());
+        }
         if let Some(p) = face.feature_points.get_mut(id) {
             p.binding = Some(binding);
         }
@@ -112,7 +185,7 @@ mod tests {
                 vertices: vec![1, 2],
             },
         ));
-        set.insert(FeaturePoint::at(fp("9.3"), Vec3::new(0.1, 0.9, 0.0)));
+        set.insert(FeaturePoint::at(fp("9.3"), Vec3::new(0.05, 0.95, 0.0)));
         let m = attach_feature_points(&mut face, set, &["sq.obj"]).unwrap();
         assert_eq!(
             face.feature_points.position(fp("2.1")),
@@ -120,7 +193,28 @@ mod tests {
         );
         assert_eq!(m.len(), 1);
         assert_eq!((m[0].id, m[0].vertex), (fp("9.3"), 3));
-        assert!((m[0].distance - 0.141_421).abs() < 1e-4);
+        assert!((m[0].distance - 0.070_711).abs() < 1e-4);
+        // A snap of more than 1 % of the face size (√2) is a warning naming the file.
+        let w = snap_warnings(&face, &m, std::path::Path::new("p.csv"));
+        assert_eq!(w.len(), 1);
+        assert!(w[0].message.starts_with("p.csv: feature point 9.3 snapped 0.0707 to vertex 3 of `sq` (5.0 % of the face size)"), "{}", w[0]);
+        // Beyond a tenth of the face size: refused.
+        let mut set = FeaturePointSet::new();
+        set.insert(FeaturePoint::at(fp("9.3"), Vec3::new(0.0, 0.0, 0.3)));
+        let e = attach_feature_points(&mut square(), set, &[]).unwrap_err();
+        assert!(e.to_string().contains("feature point 9.3 is 0.3"), "{e}");
+        // glTF primitive names: `Name/p` and `#m/p`.
+        let mut two = square();
+        two.meshes[0].name = "head.0".into();
+        let mut eye = two.meshes[0].clone();
+        eye.name = "mesh3.1".into();
+        two.meshes.push(eye);
+        assert_eq!(two.resolve_mesh_spec("head/0"), Some(0));
+        assert_eq!(two.resolve_mesh_spec("head.0"), Some(0));
+        assert_eq!(two.resolve_mesh_spec("#3/1"), Some(1));
+        assert_eq!(two.resolve_mesh_spec("head/1"), None);
+        assert_eq!(two.resolve_mesh_spec("#x/1"), None);
+        assert_eq!(two.resolve_mesh_spec("head/"), None);
         assert_eq!(face.fp_vertex(fp("9.3")), Some((0, 3)));
         assert_eq!(face.fp_vertex(fp("2.1")), Some((0, 1)));
 

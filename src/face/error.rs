@@ -95,6 +95,16 @@ pub enum FaceError {
         /// The face's mesh names, comma-separated.
         meshes: String,
     },
+    /// A feature point given by position is far from every vertex of the face.
+    #[error("feature point {id} is {distance} from the nearest vertex, more than a tenth of the face size ({limit}); are the positions in the face file's frame and units (`fbakit face info`)?")]
+    FeaturePointFarFromMesh {
+        /// The point.
+        id: crate::spec::FeaturePointId,
+        /// Distance to the nearest vertex.
+        distance: f32,
+        /// The largest distance accepted.
+        limit: f32,
+    },
     /// A feature point's position holds NaN or infinity.
     #[error("feature point {id} has a non-finite position")]
     NonFiniteFeaturePoint {

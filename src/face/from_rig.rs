@@ -47,8 +47,15 @@ pub(crate) fn rig_face(
         return Ok((face, report));
     };
     let points = crate::fdp::read_feature_points(fp)?.points;
-    let (mut face, fat) = face_from_rig(rig, Some(points), &FapMap::arkit())?;
+    // Problems of the points (unknown meshes, far positions, degenerate FAP units) name
+    // the feature-point file; the rig's own keep theirs.
+    let (mut face, mut fat) =
+        face_from_rig(rig, Some(points), &FapMap::arkit()).map_err(|e| match e {
+            crate::error::Error::Rig(_) => e,
+            e => super::FaceError::in_file(fp, e).into(),
+        })?;
     face.name = super::format::face_name(path);
+    report.fp_matches = std::mem::take(&mut fat.fp_matches);
     if !fat.unmapped.is_empty() {
         let keys: Vec<&str> = fat.unmapped.iter().map(|u| u.key.as_str()).collect();
         report.diagnostics.push(note(format!(

@@ -207,6 +207,26 @@ impl FaceModel {
         self.meshes.iter().position(|m| m.name == name)
     }
 
+    /// Index of the mesh a feature-point file names: a mesh name as the face has it, or
+    /// for a face read from glTF (whose meshes are named after their node, else their glTF
+    /// mesh, else `mesh{index}`, with `.{primitive}` when the mesh has several primitives)
+    /// `Name/p` for primitive `p` of the node or mesh `Name`, and `#m/p` for primitive `p`
+    /// of glTF mesh `m` when it and its node are unnamed. Names a glTF file repeats get a
+    /// `_2`, `_3` suffix on the face and are named that way.
+    pub fn resolve_mesh_spec(&self, spec: &str) -> Option<usize> {
+        if let Some(i) = self.mesh_index(spec) {
+            return Some(i);
+        }
+        let (base, p) = spec.rsplit_once('/')?;
+        let p: usize = p.trim().parse().ok()?;
+        let base = match base.strip_prefix('#') {
+            Some(m) => format!("mesh{}", m.trim().parse::<usize>().ok()?),
+            None => base.to_string(),
+        };
+        self.mesh_index(&format!("{base}.{p}"))
+            .or_else(|| (p == 0).then(|| self.mesh_index(&base)).flatten())
+    }
+
     /// Index of the transform named `name`.
     pub fn transform_index(&self, name: &str) -> Option<usize> {
         self.transforms.iter().position(|t| t.name == name)

@@ -37,6 +37,9 @@ pub struct FeaturePointSummary {
     pub missing: Vec<String>,
     /// Present points bound to mesh vertices.
     pub bound: usize,
+    /// Each present point's position in the face frame (the file's world frame and units),
+    /// by label: what a feature-point CSV's `fp,x,y,z` rows take.
+    pub positions: BTreeMap<String, [f32; 3]>,
 }
 
 /// The FAP units, or why they cannot be measured.
@@ -180,6 +183,11 @@ pub fn summarize(face: &FaceModel, report: Option<&FaceReadReport>) -> FaceSumma
             .iter()
             .filter(|p| p.binding.is_some())
             .count(),
+        positions: face
+            .feature_points
+            .iter()
+            .filter_map(|p| Some((p.id.to_string(), p.position?.to_array())))
+            .collect(),
     };
     let fapu = match face.fapu() {
         Ok(f) => FapuSummary {

@@ -5,7 +5,18 @@
 //! two or more vertices, `absent` = the mesh has no such point; optional, inferred from the
 //! vertex count when the column or the cell is missing), `description` (optional free text).
 //! This is the layout of the CANDIDE-3 table in `shared/data/candide3/feature-points.csv`.
-//! The table has no mesh column: bindings it produces name no mesh.
+//!
+//! Two optional extensions make it fit any target:
+//!
+//! - **`mesh`**: the mesh the row's vertex ids are on, for multi-mesh files: a mesh (or node)
+//!   name as the face names its meshes, `Name/1` for primitive 1 of a glTF mesh or node
+//!   `Name`, `#3/1` for primitive 1 of glTF mesh 3 where names are missing or repeated (see
+//!   [`crate::face::FaceModel::resolve_mesh_spec`]). An empty cell (or no column) names no
+//!   mesh, which only a one-mesh face accepts.
+//! - **`x`, `y`, `z`**: a position instead of vertex ids (in the file's world frame and units,
+//!   as `fbakit face info` reports them); the point is snapped to the nearest vertex when
+//!   attached to a face, and the snap distance reported. A row gives ids or a position,
+//!   never both; `combine` is then empty or `single`.
 
 use std::fmt;
 use std::path::Path;
@@ -15,6 +26,7 @@ use serde::Serialize;
 use crate::error::{EncodeError, Error, Location, ParseError, Result};
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
 use crate::spec::FeaturePointId;
+use glam::Vec3;
 
 /// How a row's vertices make the point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -54,12 +66,18 @@ impl fmt::Display for Combine {
 }
 
 /// One row of the table.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FeaturePointRow {
     /// The point.
     pub fp: FeaturePointId,
-    /// 0-based vertex indices (empty for `absent`).
+    /// 0-based vertex indices (empty for `absent` and for a position row).
     pub vertices: Vec<u32>,
+    /// The mesh the vertices are on (module docs; `None`: the only mesh).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    /// A position to snap to the nearest vertex instead of vertex ids.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position: Option<Vec3>,
     /// How the vertices make the point.
     pub combine: Combine,
     /// Free text (`None` when the file has no description column or the cell is empty).
@@ -67,28 +85,45 @@ pub struct FeaturePointRow {
 }
 
 /// A whole table, rows in file order.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct FeaturePointTable {
     /// The rows, including `absent` ones.
     pub rows: Vec<FeaturePointRow>,
 }
 
 impl FeaturePointTable {
-    /// The bound points (absent rows are left out).
+    /// The bound points and the points given by position (absent rows are left out).
     pub fn to_set(&self) -> FeaturePointSet {
         self.rows
             .iter()
-            .filter(|r| !r.vertices.is_empty())
-            .map(|r| {
-                FeaturePoint::bound(
-                    r.fp,
-                    VertexBinding {
-                        mesh: None,
-                        vertices: r.vertices.clone(),
-                    },
-                )
+            .filter_map(|r| {
+                if let Some(p) = r.position {
+                    return Some(FeaturePoint::at(r.fp, p));
+                }
+                (!r.vertices.is_empty()).then(|| {
+                    FeaturePoint::bound(
+                        r.fp,
+                        VertexBinding {
+                            mesh: r.mesh.clone(),
+                            vertices: r.vertices.clone(),
+                        },
+                    )
+                })
             })
             .collect()
+    }
+
+    /// As [`FeaturePointTable::from_set`], keeping each binding's mesh name in the `mesh`
+    /// column (for a face of several meshes, so the table reads back on the same file).
+    pub fn from_set_with_meshes(set: &FeaturePointSet) -> FeaturePointTable {
+        let mut t = Self::from_set(set);
+        for r in &mut t.rows {
+            r.mesh = set
+                .get(r.fp)
+                .and_then(|p| p.binding.as_ref())
+                .and_then(|b| b.mesh.clone());
+        }
+        t
     }
 
     /// A table of the points of `set` that have a vertex binding (mesh names are dropped:
@@ -101,6 +136,8 @@ impl FeaturePointTable {
                 Some(FeaturePointRow {
                     fp: p.id,
                     vertices: b.vertices.clone(),
+                    mesh: None,
+                    position: None,
                     combine: Combine::for_count(b.vertices.len()),
                     description: None,
                 })
@@ -140,15 +177,20 @@ pub fn parse_csv(text: &str, file: &Path) -> Result<FeaturePointTable> {
     };
     let headers = reader.headers().map_err(csv_error)?.clone();
     let col = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
-    let (Some(c_fp), Some(c_vertices)) = (col("fp"), col("vertices")) else {
+    let xyz = match (col("x"), col("y"), col("z")) {
+        (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+        _ => None,
+    };
+    let (Some(c_fp), true) = (col("fp"), col("vertices").is_some() || xyz.is_some()) else {
         return Err(at(
             1,
             1,
-            "a header with columns fp,vertices[,combine][,description]",
+            "a header with columns fp,vertices[,mesh][,combine][,description] or fp,x,y,z",
             Some(headers.iter().collect::<Vec<_>>().join(",")),
         ));
     };
-    let (c_combine, c_description) = (col("combine"), col("description"));
+    let c_vertices = col("vertices");
+    let (c_combine, c_description, c_mesh) = (col("combine"), col("description"), col("mesh"));
 
     let mut rows: Vec<FeaturePointRow> = Vec::new();
     let mut seen = std::collections::BTreeMap::new();
@@ -177,20 +219,76 @@ pub fn parse_csv(text: &str, file: &Path) -> Result<FeaturePointTable> {
             ));
         }
         let mut vertices = Vec::new();
-        let vtext = field(c_vertices);
+        let c_ids = c_vertices.unwrap_or(c_fp);
+        let vtext = c_vertices.map(field).unwrap_or("");
         if !vtext.is_empty() {
             for v in vtext.split(';') {
                 let v = v.trim();
                 let idx: u32 = v.parse().map_err(|_| {
                     at(
                         line,
-                        c_vertices + 1,
+                        c_ids + 1,
                         "0-based vertex indices separated by `;`",
                         Some(v.to_string()),
                     )
                 })?;
                 vertices.push(idx);
             }
+        }
+        let mesh = c_mesh
+            .map(field)
+            .filter(|m| !m.is_empty())
+            .map(str::to_string);
+        let description = c_description
+            .map(field)
+            .filter(|d| !d.is_empty())
+            .map(str::to_string);
+        let cells = xyz.map(|c| c.map(field));
+        if let Some(cells) = cells.filter(|c| c.iter().any(|t| !t.is_empty())) {
+            let cols = xyz.unwrap_or([0; 3]);
+            if !vertices.is_empty() {
+                return Err(at(
+                    line,
+                    c_ids + 1,
+                    "vertex ids or a position x,y,z, not both",
+                    Some(vtext.to_string()),
+                ));
+            }
+            let mut p = [0.0f32; 3];
+            for k in 0..3 {
+                p[k] = cells[k]
+                    .parse::<f32>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| {
+                        at(
+                            line,
+                            cols[k] + 1,
+                            "a finite coordinate (x, y and z all given)",
+                            Some(cells[k].to_string()),
+                        )
+                    })?;
+            }
+            match c_combine.map(field).unwrap_or("") {
+                "" | "single" => {}
+                other => {
+                    return Err(at(
+                        line,
+                        c_combine.unwrap_or(0) + 1,
+                        "`single` (or nothing) for a position",
+                        Some(other.to_string()),
+                    ))
+                }
+            }
+            rows.push(FeaturePointRow {
+                fp,
+                vertices,
+                mesh,
+                position: Some(Vec3::from(p)),
+                combine: Combine::Single,
+                description,
+            });
+            continue;
         }
         let combine = match c_combine.map(field).unwrap_or("") {
             "" => Combine::for_count(vertices.len()),
@@ -219,18 +317,16 @@ pub fn parse_csv(text: &str, file: &Path) -> Result<FeaturePointTable> {
             };
             return Err(at(
                 line,
-                c_vertices + 1,
+                c_ids + 1,
                 need,
                 Some(format!("{} vertices", vertices.len())),
             ));
         }
-        let description = c_description
-            .map(field)
-            .filter(|d| !d.is_empty())
-            .map(str::to_string);
         rows.push(FeaturePointRow {
             fp,
             vertices,
+            mesh,
+            position: None,
             combine,
             description,
         });
@@ -238,21 +334,42 @@ pub fn parse_csv(text: &str, file: &Path) -> Result<FeaturePointTable> {
     Ok(FeaturePointTable { rows })
 }
 
-/// Writes the table as CSV text (always with all four columns).
+/// Writes the table as CSV text (always `fp,vertices,combine,description`; `mesh` and
+/// `x,y,z` when a row needs them).
 pub fn to_csv_string(table: &FeaturePointTable) -> Result<String> {
     let mut w = ::csv::WriterBuilder::new().from_writer(Vec::new());
     let enc = |e: ::csv::Error| EncodeError::new("CSV", e);
-    w.write_record(["fp", "vertices", "combine", "description"])
-        .map_err(enc)?;
+    let with_mesh = table.rows.iter().any(|r| r.mesh.is_some());
+    let with_xyz = table.rows.iter().any(|r| r.position.is_some());
+    let mut header = vec!["fp", "vertices"];
+    if with_mesh {
+        header.push("mesh");
+    }
+    if with_xyz {
+        header.extend(["x", "y", "z"]);
+    }
+    header.extend(["combine", "description"]);
+    w.write_record(&header).map_err(enc)?;
     for r in &table.rows {
         let vertices: Vec<String> = r.vertices.iter().map(u32::to_string).collect();
-        w.write_record([
-            r.fp.to_string().as_str(),
-            vertices.join(";").as_str(),
-            r.combine.word(),
-            r.description.as_deref().unwrap_or(""),
-        ])
-        .map_err(enc)?;
+        let mut rec = vec![r.fp.to_string(), vertices.join(";")];
+        if with_mesh {
+            rec.push(r.mesh.clone().unwrap_or_default());
+        }
+        if with_xyz {
+            match r.position {
+                Some(p) => rec.extend([p.x, p.y, p.z].map(|v| v.to_string())),
+                None => rec.extend([String::new(), String::new(), String::new()]),
+            }
+        }
+        let combine = if r.position.is_some() {
+            ""
+        } else {
+            r.combine.word()
+        };
+        rec.push(combine.to_string());
+        rec.push(r.description.clone().unwrap_or_default());
+        w.write_record(&rec).map_err(enc)?;
     }
     let bytes = w.into_inner().map_err(|e| EncodeError::new("CSV", e))?;
     String::from_utf8(bytes).map_err(|e| EncodeError::new("CSV", e).into())
@@ -355,6 +472,60 @@ mod tests {
     }
 
     #[test]
+    fn positions_and_mesh_names() {
+        let t = parse(
+            "fp,vertices,mesh,x,y,z,combine\n\
+             2.1,10,Body/1,,,,\n\
+             3.5,,,1.5,-2,3e1,single\n\
+             9.3,4;5,#3/0,,,,mean\n",
+        )
+        .unwrap();
+        assert_eq!(t.rows[0].mesh.as_deref(), Some("Body/1"));
+        assert_eq!(t.rows[1].position, Some(Vec3::new(1.5, -2.0, 30.0)));
+        assert!(t.rows[1].vertices.is_empty());
+        let set = t.to_set();
+        let p = set.get("3.5".parse().unwrap()).unwrap();
+        assert!(p.binding.is_none() && p.position.is_some());
+        let b = set
+            .get("9.3".parse().unwrap())
+            .unwrap()
+            .binding
+            .clone()
+            .unwrap();
+        assert_eq!(b.mesh.as_deref(), Some("#3/0"));
+        // Written and read back the same.
+        assert_eq!(parse(&to_csv_string(&t).unwrap()).unwrap(), t);
+        // Positions alone, no vertices column.
+        let t = parse("fp,x,y,z\n2.1,0,1,2\n").unwrap();
+        assert_eq!(t.rows[0].position, Some(Vec3::new(0.0, 1.0, 2.0)));
+        for (text, want) in [
+            (
+                "fp,x,y,z\n2.1,0,,2\n",
+                "t.csv:2:3: expected a finite coordinate",
+            ),
+            (
+                "fp,x,y,z\n2.1,0,NaN,2\n",
+                "t.csv:2:3: expected a finite coordinate",
+            ),
+            (
+                "fp,vertices,x,y,z\n2.1,3,0,1,2\n",
+                "t.csv:2:2: expected vertex ids or a position",
+            ),
+            (
+                "fp,x,y,z,combine\n2.1,0,1,2,mean\n",
+                "t.csv:2:5: expected `single`",
+            ),
+            (
+                "fp,x,y\n2.1,0,1\n",
+                "t.csv:1:1: expected a header with columns",
+            ),
+        ] {
+            let e = parse(text).unwrap_err().to_string();
+            assert!(e.starts_with(want), "{text:?}: {e}");
+        }
+    }
+
+    #[test]
     fn writer_round_trips_quotes_and_commas() {
         let t =
             parse("fp,vertices,combine,description\n3.5,1;2,mean,\"a, \"\"b\"\"\"\n9.1,,absent,\n")
@@ -372,6 +543,8 @@ mod tests {
             .prop_map(|(o, vertices, description)| FeaturePointRow {
                 fp: FeaturePointId::from_ordinal(o).unwrap(),
                 combine: Combine::for_count(vertices.len()),
+                mesh: None,
+                position: None,
                 vertices,
                 // Cells are trimmed when read, so only trimmed non-empty text survives.
                 description: description

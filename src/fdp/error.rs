@@ -107,8 +107,18 @@ pub enum FdpError {
         /// The position as written.
         position: String,
     },
+    /// `--mesh` names no mesh of the face.
+    #[error("{}: no mesh `{mesh}` (its meshes: {meshes})", file.display())]
+    UnknownLandmarkMesh {
+        /// The face file.
+        file: PathBuf,
+        /// The name given.
+        mesh: String,
+        /// The face's mesh names, comma-separated.
+        meshes: String,
+    },
     /// Landmark ids index one mesh, but the face has several.
-    #[error("{}: landmark ids index one mesh, but this face has {meshes} meshes", file.display())]
+    #[error("{}: landmark ids index one mesh, but this face has {meshes} meshes; name it with --mesh NAME", file.display())]
     LandmarksNeedOneMesh {
         /// The face file.
         file: PathBuf,

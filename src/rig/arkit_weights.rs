@@ -31,6 +31,16 @@
 //! (an ARKit shape a rig splits in halves, ICT's `browInnerUp_L` + `_R`, is one unknown
 //! playing both).
 //!
+//! **Rotations.** Head and eye rotation columns ([`super::capture::ROTATIONS`]) are not
+//! fitted: they set FAPs 48–50 and 23–26 directly (replacing what the fit gave the eyeball
+//! FAPs). The other way, head rotation FAPs are left out of the posed frames (rigid motion
+//! no blend shape shows); the caller writes them, and the eyeball FAPs, as angles
+//! ([`super::capture::stream_rotations`]).
+//!
+//! **Any face with a FAT.** [`arkit_rig_of_face`] makes ARKit-named shapes from the face's
+//! own FAT (the bundled amplitude table) and [`ArkitBridge::for_fat_face`] pairs them with
+//! FAP sides from the same table, so both directions work without a rig.
+//!
 //! Feature points see a face sparsely, so shapes that move no feature point (or move them
 //! like another shape) cannot be recovered; the reports give the fit's residual.
 
@@ -39,6 +49,7 @@ use serde::Serialize;
 
 use super::arkit_names::{arkit_index, bind_rig, ARKIT_SHAPES};
 use super::bounded_ls::NormalEquations;
+use super::capture::{is_head_rotation_fap, is_rotation_fap, rotation_index, Rotation, ROTATIONS};
 use super::fap_map::ShapeLookup;
 use super::fat_build::RigFatReport;
 use super::weights_csv::{WeightCsv, MAX_FRAME_NUMBER};
@@ -92,8 +103,11 @@ pub struct ArkitBridge<'a> {
 pub struct ColumnUse {
     /// The header as written.
     pub column: String,
-    /// The rig shapes it drives (empty: ignored).
+    /// The rig shapes it drives (empty: ignored, or a rotation).
     pub shapes: Vec<String>,
+    /// The FAP a rotation column sets directly ([`super::capture::ROTATIONS`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fap: Option<String>,
     /// Why it is ignored (empty when used).
     pub ignored: String,
 }
@@ -141,6 +155,44 @@ impl<'a> ArkitBridge<'a> {
     /// The bridge between `rig` and `face`, the face [`super::fat_build::face_from_rig`] built
     /// from it (same meshes, in order) with its `report`.
     pub fn new(rig: &'a Rig, face: &'a FaceModel, report: &RigFatReport) -> Result<Self> {
+        let sides = report
+            .calibrated
+            .iter()
+            .filter_map(|c| Some((FapId::from_name(&c.fap)?, c.value)))
+            .collect();
+        Self::with_sides(rig, face, sides)
+    }
+
+    /// The bridge between a face with a FAT and the rig [`arkit_rig_of_face`] made of it: the
+    /// FAP sides are those of the bundled amplitude table the face has tables for, each at
+    /// the largest value an ARKit shape gives it (its positive and negative part apart).
+    pub fn for_fat_face(rig: &'a Rig, face: &'a FaceModel) -> Result<Self> {
+        let mut sides: Vec<(FapId, f64)> = Vec::new();
+        for a in super::arkit_amplitudes::arkit_amplitudes() {
+            if face.fat.table(TableKey::LowLevel(a.fap)).is_none() || a.value == 0.0 {
+                continue;
+            }
+            match sides
+                .iter_mut()
+                .find(|(f, v)| *f == a.fap && (*v > 0.0) == (a.value > 0.0))
+            {
+                Some((_, v)) => {
+                    if a.value.abs() > v.abs() {
+                        *v = a.value;
+                    }
+                }
+                None => sides.push((a.fap, a.value)),
+            }
+        }
+        Self::with_sides(rig, face, sides)
+    }
+
+    /// The bridge with the given FAP sides (FAP, value at a side's full extent).
+    fn with_sides(
+        rig: &'a Rig,
+        face: &'a FaceModel,
+        calibrated: Vec<(FapId, f64)>,
+    ) -> Result<Self> {
         if face.meshes.len() != rig.meshes.len()
             || face
                 .meshes
@@ -154,11 +206,7 @@ impl<'a> ArkitBridge<'a> {
             }
             .into());
         }
-        let probes: Vec<(FeaturePointId, usize, u32)> = face
-            .feature_points
-            .iter()
-            .filter_map(|p| face.fp_vertex(p.id).map(|(m, v)| (p.id, m, v)))
-            .collect();
+        let probes = probe_vertices(face);
         if probes.is_empty() {
             return Err(super::RigError::NoBoundFeaturePoints {
                 face: face.name.clone(),
@@ -172,24 +220,18 @@ impl<'a> ArkitBridge<'a> {
 
         let mut sides = Vec::new();
         let mut side_columns = Vec::new();
-        for c in &report.calibrated {
-            let Some(fap) = FapId::from_name(&c.fap) else {
-                continue;
-            };
-            if !(c.value.is_finite() && c.value != 0.0) {
+        for (fap, value) in calibrated {
+            if !(value.is_finite() && value != 0.0) {
                 continue;
             }
             let act = [Activation {
                 key: TableKey::LowLevel(fap),
-                value: c.value,
+                value,
             }];
             let moved =
                 probe_positions(face, &probes, &mut evaluator, &mut output, &mut pose, &act);
             side_columns.push(diff(&moved, &neutral));
-            sides.push(SideUnknown {
-                fap,
-                value: c.value,
-            });
+            sides.push(SideUnknown { fap, value });
         }
         let side_eq = NormalEquations::new(
             &side_columns,
@@ -238,12 +280,31 @@ impl<'a> ArkitBridge<'a> {
     }
 
     /// What each weight column drives: an ARKit name plays its bound rig shapes, another
-    /// name a rig shape of that name; anything else (head and eye rotations) is ignored.
+    /// name a rig shape of that name; a head or eye rotation sets its FAP (eye roll, which
+    /// has none, and rotations that are 0 on every row are ignored); anything else is ignored.
     pub fn resolve_columns(&self, csv: &WeightCsv) -> Vec<(ColumnUse, Vec<usize>)> {
         let lookup = ShapeLookup::new(self.rig);
         csv.columns
             .iter()
-            .map(|c| {
+            .enumerate()
+            .map(|(k, c)| {
+                if let Some(r) = rotation_index(&c.name).map(|i| ROTATIONS[i]) {
+                    let moves = csv.rows.iter().any(|row| row.weights[k] != 0.0);
+                    let (fap, ignored) = match r.fap_id() {
+                        None => (None, "eye roll has no FAP"),
+                        Some(_) if !moves => (None, "rotation 0 on every row"),
+                        Some(f) => (Some(f.name().to_string()), ""),
+                    };
+                    return (
+                        ColumnUse {
+                            column: c.name.clone(),
+                            shapes: Vec::new(),
+                            fap,
+                            ignored: ignored.into(),
+                        },
+                        Vec::new(),
+                    );
+                }
                 let (shapes, ignored) = match arkit_index(&c.name) {
                     Some(i) if !self.bindings[i].is_empty() => (self.bindings[i].clone(), ""),
                     Some(_) => (Vec::new(), "ARKit shape the rig does not have"),
@@ -260,6 +321,7 @@ impl<'a> ArkitBridge<'a> {
                     ColumnUse {
                         column: c.name.clone(),
                         shapes: names,
+                        fap: None,
                         ignored: ignored.into(),
                     },
                     shapes,
@@ -299,13 +361,24 @@ impl<'a> ArkitBridge<'a> {
         (values, res, norm)
     }
 
-    /// ARKit weight curves → a FAP stream named `name` (module docs).
+    /// ARKit weight curves → a FAP stream named `name` (module docs); head and eye rotation
+    /// columns set their FAPs directly, replacing what the fit gave those FAPs.
     pub fn weights_to_faps(
         &self,
         csv: &WeightCsv,
         name: &str,
     ) -> Result<(FapStream, FromArkitReport)> {
         let columns = self.resolve_columns(csv);
+        // (column index, rotation) of the rotation columns that set a FAP.
+        let rotations: Vec<(usize, Rotation, FapId)> = columns
+            .iter()
+            .enumerate()
+            .filter(|(_, (c, _))| c.fap.is_some())
+            .filter_map(|(k, (c, _))| {
+                let r = ROTATIONS[rotation_index(&c.column)?];
+                Some((k, r, r.fap_id()?))
+            })
+            .collect();
         let mut stream = FapStream::new(name, csv.fps);
         let (mut res, mut norm) = (0.0, 0.0);
         let mut faps: Vec<FapId> = Vec::new();
@@ -322,11 +395,20 @@ impl<'a> ArkitBridge<'a> {
             norm += n;
             let mut frame = FapFrame::new(row.frame);
             for (fap, v) in values {
+                if rotations.iter().any(|r| r.2 == fap) {
+                    continue;
+                }
                 if !faps.contains(&fap) {
                     faps.push(fap);
                 }
                 // Whole FAPU, and no `-0` in the file.
                 frame.set(fap, v.round() + 0.0);
+            }
+            for &(k, r, fap) in &rotations {
+                if !faps.contains(&fap) {
+                    faps.push(fap);
+                }
+                frame.set(fap, r.to_fap(f64::from(row.weights[k])));
             }
             stream.frames.push(frame);
         }
@@ -400,9 +482,13 @@ impl<'a> ArkitBridge<'a> {
         let (mut res, mut norm) = (0.0, 0.0);
         for n in 0..=last {
             frame_activations(timeline.at_frame(n), &mut acts);
+            // Head rotation is rigid motion, carried by the rotation columns, never a shape.
+            acts.retain(|a| !matches!(a.key, TableKey::LowLevel(f) if is_head_rotation_fap(f)));
             for a in &acts {
+                // Eyeball rotations travel in the rotation columns whatever the FAT has.
                 if a.value != 0.0
                     && a.key.slot().is_some()
+                    && !matches!(a.key, TableKey::LowLevel(f) if is_rotation_fap(f))
                     && face.fat.table(a.key).is_none()
                     && !unplayable.contains(&a.key)
                 {
@@ -441,6 +527,46 @@ impl<'a> ArkitBridge<'a> {
         };
         Ok((frames, report))
     }
+}
+
+/// The feature points compared and their vertices: the bound vertex, or for a point known
+/// by position only (a face file's feature points) the nearest vertex of the neutral face.
+fn probe_vertices(face: &FaceModel) -> Vec<(FeaturePointId, usize, u32)> {
+    let mut world: Option<Vec<Vec<Vec3>>> = None;
+    face.feature_points
+        .iter()
+        .filter_map(|p| {
+            if let Some((m, v)) = face.fp_vertex(p.id) {
+                return Some((p.id, m, v));
+            }
+            let at = p.position?;
+            let world = world.get_or_insert_with(|| face.neutral_world_positions());
+            let mut best: Option<(f32, usize, u32)> = None;
+            for (m, positions) in world.iter().enumerate() {
+                for (v, q) in positions.iter().enumerate() {
+                    let d = q.distance_squared(at);
+                    if best.is_none_or(|b| d < b.0) {
+                        best = Some((d, m, v as u32));
+                    }
+                }
+            }
+            best.map(|(_, m, v)| (p.id, m, v))
+        })
+        .collect()
+}
+
+/// A face with a FAT as a rig of ARKit-named shapes (the bundled amplitudes,
+/// [`super::arkit_export::face_to_arkit_rig`]), so the bridge solves FAP → ARKit on the
+/// face's own FAT: `ArkitBridge::new(&rig, face, &RigFatReport::default())`.
+pub fn arkit_rig_of_face(face: &FaceModel) -> Result<Rig> {
+    if face.fat.tables.is_empty() {
+        return Err(super::RigError::NoFat {
+            face: face.name.clone(),
+        }
+        .into());
+    }
+    let amplitudes = super::arkit_amplitudes::arkit_amplitudes();
+    Ok(super::arkit_export::face_to_arkit_rig(face, &amplitudes)?.0)
 }
 
 /// World positions of the probes (flattened x, y, z) with `acts` evaluated on the FAT.

@@ -204,6 +204,12 @@ pub enum RigError {
         /// The face.
         face: String,
     },
+    /// A face read without feature points for the ARKit bridge has no FAT.
+    #[error("{}: the face has no FAT; give --fp FP for a blendshape rig, or a face with a FAT", file.display())]
+    FaceWithoutFat {
+        /// The face file (or bundled name).
+        file: PathBuf,
+    },
     /// A face that was not built from the rig it is paired with.
     #[error("face `{face}` is not the face of rig `{rig}` (meshes differ)")]
     FaceNotOfRig {

@@ -100,6 +100,9 @@ pub struct RigFatReport {
     pub unmapped: Vec<Unmapped>,
     /// Rig shapes no table uses.
     pub unused_shapes: Vec<String>,
+    /// Feature points given by position, snapped to their nearest vertex.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub fp_matches: Vec<crate::face::vrml::FeaturePointMatch>,
 }
 
 /// Motion of `(mesh, vertex)` pairs.
@@ -142,7 +145,7 @@ pub fn face_from_rig(
     };
     let fapu = match feature_points {
         Some(points) => {
-            crate::face::attach::attach_feature_points(&mut face, points, &[])?;
+            report.fp_matches = crate::face::attach::attach_feature_points(&mut face, points, &[])?;
             let fapu = Fapu::from_feature_points(&face.feature_points)?;
             report.fapu = Some(fapu.distances);
             Some(fapu)

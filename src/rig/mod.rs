@@ -26,6 +26,7 @@ pub mod arkit_export;
 pub mod arkit_names;
 pub mod arkit_weights;
 pub mod bounded_ls;
+pub mod capture;
 mod error;
 pub mod fap_map;
 pub mod fat_build;

@@ -15,9 +15,17 @@
 //! caller's or `1 / median(Δt)`; a row landing on the previous row's frame replaces it (and
 //! is counted in a warning), time running backwards is an error.
 //!
+//! A column `timestamp_ms` gives milliseconds (MediaPipe FaceLandmarker's blend-shape scores
+//! written as CSV: `timestamp_ms,_neutral,browDownLeft,...`; the `_neutral` score is not a
+//! shape and is skipped like `BlendShapeCount`). Millisecond stamps are whole numbers, so the
+//! detected rate snaps to a common video rate whose frame period is within 1 ms of the median
+//! step (33, 33, 34 ms → 30 fps).
+//!
 //! **Weights** are finite numbers; values outside 0..1 are clamped, with one warning naming
-//! the count and the first place. Unknown columns are kept by name; the caller decides what
-//! they mean (ARKit shapes, rig shapes, or ignored head/eye rotations).
+//! the count and the first place. The nine Live Link Face rotation columns (`HeadYaw`, ...,
+//! [`super::capture::ROTATIONS`]) are angles in radians instead: kept as they are, refused
+//! beyond ±2π (degrees written by mistake). Other unknown columns are kept by name; the
+//! caller decides what they mean (ARKit shapes, rig shapes, or ignored).
 //!
 //! Errors name the file and `line:column` of the offending field and what was expected; the
 //! reader never panics, and allocates in proportion to the text (never from counts inside it).
@@ -34,6 +42,9 @@ pub const MAX_COLUMNS: usize = 1024;
 /// Highest frame number a row may land on (about 46 hours at 60 fps).
 pub const MAX_FRAME_NUMBER: u64 = 10_000_000;
 
+/// Largest angle (radians) a rotation column may hold.
+pub const MAX_ROTATION: f64 = std::f64::consts::TAU;
+
 /// What the time column holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -42,6 +53,8 @@ pub enum TimeColumn {
     Timecode,
     /// Plain seconds.
     Seconds,
+    /// Milliseconds (`timestamp_ms`, MediaPipe).
+    Milliseconds,
 }
 
 /// A weight column of the file.
@@ -53,14 +66,15 @@ pub struct WeightColumn {
     pub column: usize,
 }
 
-/// One row: its frame number and a weight per [`WeightCsv::columns`] entry.
+/// One row: its frame number and a value per [`WeightCsv::columns`] entry (a weight, or an
+/// angle in radians for the rotation columns).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct WeightRow {
     /// Frame number at [`WeightCsv::fps`], 0 for the first row.
     pub frame: u64,
     /// 1-based line in the file.
     pub line: usize,
-    /// Weights, clamped to 0..1.
+    /// Weights, clamped to 0..1 (rotation columns: radians, as read).
     pub weights: Vec<f32>,
 }
 
@@ -73,7 +87,7 @@ pub struct WeightCsv {
     pub fps: f64,
     /// Whether `fps` was detected from the times (false: given by the caller).
     pub fps_detected: bool,
-    /// The weight columns (time and `BlendShapeCount` excluded).
+    /// The weight columns (time, `BlendShapeCount` and `_neutral` excluded).
     pub columns: Vec<WeightColumn>,
     /// The rows, frame numbers increasing.
     pub rows: Vec<WeightRow>,
@@ -136,9 +150,9 @@ fn split_line(line: &str, start: usize) -> Vec<Field<'_>> {
 
 /// A parsed time: whole seconds and, for timecodes, the frame (with fraction) within it.
 #[derive(Clone, Copy, Debug)]
-struct Stamp {
-    seconds: f64,
-    frames: f64,
+pub(crate) struct Stamp {
+    pub(crate) seconds: f64,
+    pub(crate) frames: f64,
 }
 
 fn parse_timecode(s: &str) -> Option<Stamp> {
@@ -209,6 +223,8 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
         ));
     }
     let mut time: Option<(usize, TimeColumn)> = None;
+    // Per field: the rotation columns keep their angles (not clamped).
+    let mut rotation = vec![false; header.len()];
     let mut skip = vec![false; header.len()];
     let mut columns: Vec<WeightColumn> = Vec::new();
     let mut seen = std::collections::HashMap::new();
@@ -220,6 +236,7 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
         let kind = match lower.as_str() {
             "timecode" => Some(TimeColumn::Timecode),
             "time" | "seconds" => Some(TimeColumn::Seconds),
+            "timestamp_ms" => Some(TimeColumn::Milliseconds),
             _ => None,
         };
         if let Some(kind) = kind {
@@ -230,7 +247,7 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
             skip[i] = true;
             continue;
         }
-        if lower == "blendshapecount" {
+        if lower == "blendshapecount" || lower == "_neutral" {
             skip[i] = true;
             continue;
         }
@@ -241,6 +258,7 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
                 format!("one column per shape (`{}` repeats column {prev})", f.text),
             ));
         }
+        rotation[i] = super::capture::rotation_index(f.text).is_some();
         columns.push(WeightColumn {
             name: f.text.to_string(),
             column: i + 1,
@@ -249,7 +267,7 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
     let Some((time_col, time_kind)) = time else {
         return Err(err(
             hstart,
-            "a `Timecode` column (or `time` / `seconds`) in the header".into(),
+            "a `Timecode` column (or `time` / `seconds` / `timestamp_ms`) in the header".into(),
         ));
     };
 
@@ -279,13 +297,17 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
         let tf = &fields[time_col];
         let stamp = match time_kind {
             TimeColumn::Timecode => parse_timecode(tf.text),
-            TimeColumn::Seconds => tf
+            TimeColumn::Seconds | TimeColumn::Milliseconds => tf
                 .text
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite() && v.abs() < 1e9)
                 .map(|s| Stamp {
-                    seconds: s,
+                    seconds: if time_kind == TimeColumn::Milliseconds {
+                        s / 1000.0
+                    } else {
+                        s
+                    },
                     frames: 0.0,
                 }),
         };
@@ -295,6 +317,7 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
                 match time_kind {
                     TimeColumn::Timecode => "a timecode HH:MM:SS:FF or HH:MM:SS:FF.fff".into(),
                     TimeColumn::Seconds => "a time in seconds".into(),
+                    TimeColumn::Milliseconds => "a time in milliseconds".into(),
                 },
             ));
         };
@@ -312,12 +335,31 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
                     err(
                         f.offset,
                         format!(
-                            "a finite weight (a number, 0..1) in field {} `{}`",
+                            "a finite {} in field {} `{}`",
+                            if rotation[i] {
+                                "angle (a number, radians)"
+                            } else {
+                                "weight (a number, 0..1)"
+                            },
                             i + 1,
                             header[i].text
                         ),
                     )
                 })?;
+            if rotation[i] {
+                if v.abs() > MAX_ROTATION {
+                    return Err(err(
+                        f.offset,
+                        format!(
+                            "an angle in radians (-2π..2π) in field {} `{}`",
+                            i + 1,
+                            header[i].text
+                        ),
+                    ));
+                }
+                row.push(v as f32);
+                continue;
+            }
             if !(0.0..=1.0).contains(&v) {
                 clamped += 1;
                 if first_clamp.is_none() {
@@ -336,15 +378,56 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
         ));
     }
 
+    let mut warnings = Vec::new();
+    if let Some((line, col, name)) = first_clamp {
+        warnings.push(Diagnostic::warning(format!(
+            "{}: {clamped} weight{} outside 0..1 clamped (first at line {line}, column {col} `{name}`)",
+            file.display(),
+            if clamped == 1 { "" } else { "s" }
+        )));
+    }
+    let locate =
+        |k: usize, expected: String| err(field_offset(text, stamps[k].1, time_col), expected);
+    let rows = stamps
+        .iter()
+        .zip(weights)
+        .map(|(&(stamp, _), (line, weights))| RawRow {
+            stamp,
+            line,
+            weights,
+        })
+        .collect();
+    assemble(file, time_kind, fps, columns, rows, &locate, warnings)
+}
+
+/// One row as read: its time, 1-based line and values.
+pub(crate) struct RawRow {
+    pub(crate) stamp: Stamp,
+    pub(crate) line: usize,
+    pub(crate) weights: Vec<f32>,
+}
+
+/// Rows with their times → frames at the caller's or the detected rate (the rules of the
+/// module docs), shared by the CSV and JSON-lines readers; `locate(k, expected)` is the
+/// located error at row `k`'s time.
+pub(crate) fn assemble(
+    file: &Path,
+    time_kind: TimeColumn,
+    fps: Option<f64>,
+    columns: Vec<WeightColumn>,
+    raw: Vec<RawRow>,
+    locate: &dyn Fn(usize, String) -> crate::error::Error,
+    mut warnings: Vec<Diagnostic>,
+) -> Result<WeightCsv> {
     // Time must not run backwards (checked on the stamps, before any rate is needed).
-    for k in 1..stamps.len() {
-        let (a, b) = (stamps[k - 1].0, stamps[k].0);
+    for k in 1..raw.len() {
+        let (a, b) = (raw[k - 1].stamp, raw[k].stamp);
         if (b.seconds, b.frames) < (a.seconds, a.frames) {
-            return Err(err(
-                field_offset(text, stamps[k].1, time_col),
+            return Err(locate(
+                k,
                 format!(
                     "a time no earlier than the previous row's (line {})",
-                    weights[k - 1].0
+                    raw[k - 1].line
                 ),
             ));
         }
@@ -352,22 +435,28 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
 
     // Times in seconds from the first row.
     let (times, fps_value, detected) = match time_kind {
-        TimeColumn::Seconds => {
-            let t: Vec<f64> = stamps.iter().map(|(s, _)| s.seconds).collect();
+        TimeColumn::Seconds | TimeColumn::Milliseconds => {
+            let t: Vec<f64> = raw.iter().map(|r| r.stamp.seconds).collect();
+            let detect = if time_kind == TimeColumn::Milliseconds {
+                rate_from_milliseconds
+            } else {
+                rate_from_times
+            };
             let rate = match fps {
                 Some(f) => f,
-                None => rate_from_times(&t).ok_or_else(|| super::RigError::UndetectableRate {
+                None => detect(&t).ok_or_else(|| super::RigError::UndetectableRate {
                     file: file.to_path_buf(),
                 })?,
             };
             (t, rate, fps.is_none())
         }
         TimeColumn::Timecode => {
-            let rolls = stamps.windows(2).any(|w| w[1].0.seconds > w[0].0.seconds);
+            let rolls = raw
+                .windows(2)
+                .any(|w| w[1].stamp.seconds > w[0].stamp.seconds);
             let tc_rate = if rolls {
-                stamps
-                    .iter()
-                    .map(|(s, _)| s.frames.floor())
+                raw.iter()
+                    .map(|r| r.stamp.frames.floor())
                     .fold(0.0, f64::max)
                     + 1.0
             } else {
@@ -375,9 +464,9 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
                     file: file.to_path_buf(),
                 })?
             };
-            let t: Vec<f64> = stamps
+            let t: Vec<f64> = raw
                 .iter()
-                .map(|(s, _)| s.seconds + s.frames / tc_rate)
+                .map(|r| r.stamp.seconds + r.stamp.frames / tc_rate)
                 .collect();
             let rate = match fps {
                 Some(f) => f,
@@ -387,36 +476,28 @@ pub fn parse_weights_csv(text: &str, file: &Path, fps: Option<f64>) -> Result<We
         }
     };
     let t0 = times[0];
-    let mut rows: Vec<WeightRow> = Vec::with_capacity(weights.len());
+    let mut rows: Vec<WeightRow> = Vec::with_capacity(raw.len());
     let mut replaced = 0usize;
-    for (k, ((line, w), t)) in weights.into_iter().zip(&times).enumerate() {
+    for (k, (r, t)) in raw.into_iter().zip(&times).enumerate() {
         let n = ((t - t0) * fps_value).round();
         if !(0.0..=MAX_FRAME_NUMBER as f64).contains(&n) {
-            return Err(err(
-                field_offset(text, stamps[k].1, time_col),
+            return Err(locate(
+                k,
                 format!("a time within {MAX_FRAME_NUMBER} frames of the first row"),
             ));
         }
         let frame = n as u64;
-        if let Some(last) = rows.last_mut().filter(|r| r.frame == frame) {
+        if let Some(last) = rows.last_mut().filter(|x| x.frame == frame) {
             replaced += 1;
-            last.line = line;
-            last.weights = w;
+            last.line = r.line;
+            last.weights = r.weights;
             continue;
         }
         rows.push(WeightRow {
             frame,
-            line,
-            weights: w,
+            line: r.line,
+            weights: r.weights,
         });
-    }
-    let mut warnings = Vec::new();
-    if let Some((line, col, name)) = first_clamp {
-        warnings.push(Diagnostic::warning(format!(
-            "{}: {clamped} weight{} outside 0..1 clamped (first at line {line}, column {col} `{name}`)",
-            file.display(),
-            if clamped == 1 { "" } else { "s" }
-        )));
     }
     if replaced > 0 {
         warnings.push(Diagnostic::warning(format!(
@@ -462,6 +543,31 @@ fn rate_from_times(t: &[f64]) -> Option<f64> {
     } else {
         (rate * 1000.0).round() / 1000.0
     })
+}
+
+/// Common video and capture rates a millisecond-stamped capture snaps to.
+const COMMON_RATES: [f64; 10] = [15.0, 24.0, 25.0, 30.0, 48.0, 50.0, 60.0, 90.0, 120.0, 240.0];
+
+/// The rate of millisecond stamps (as seconds): a [`COMMON_RATES`] entry whose frame period
+/// is within 1 ms (the stamps' resolution) of the median step, else [`rate_from_times`].
+fn rate_from_milliseconds(t: &[f64]) -> Option<f64> {
+    let mut d: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 1e-9)
+        .collect();
+    if d.is_empty() {
+        return None;
+    }
+    d.sort_by(f64::total_cmp);
+    let median = d[d.len() / 2];
+    COMMON_RATES
+        .iter()
+        .map(|&r| (r, (1.0 / r - median).abs()))
+        .filter(|&(_, e)| e <= 0.001)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(r, _)| r)
+        .or_else(|| rate_from_times(t))
 }
 
 /// The timecode of frame `n` at `fps`: `HH:MM:SS:FF.fff` (frames within the second, with

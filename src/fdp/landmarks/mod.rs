@@ -184,6 +184,8 @@ impl LandmarkFeaturePoints {
                 .map(|p| FeaturePointRow {
                     fp: p.id,
                     vertices: p.vertices.clone(),
+                    mesh: None,
+                    position: None,
                     combine: if p.vertices.len() == 1 {
                         Combine::Single
                     } else {
