@@ -29,6 +29,9 @@ pub mod bounded_ls;
 mod error;
 pub mod fap_map;
 pub mod fat_build;
+mod gltf_accessor;
+#[cfg(test)]
+mod gltf_encodings_tests;
 pub mod gltf_read;
 pub mod gltf_write;
 pub mod obj_folder;
