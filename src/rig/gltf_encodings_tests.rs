@@ -416,9 +416,10 @@ fn the_decode_pass_leaves_plain_gltf() {
     let glb = ::gltf::Glb::from_slice(&bytes).unwrap();
     let mut json: Value = serde_json::from_slice(&glb.json).unwrap();
     let mut buffers = vec![glb.bin.unwrap().into_owned(), Vec::new()];
-    let warnings =
+    let report =
         crate::gltf::decode::decode_document(&mut json, &mut buffers, Path::new("m.glb")).unwrap();
-    assert_eq!(warnings.len(), 1);
+    assert!(report.changed);
+    assert_eq!(report.warnings.len(), 1);
     assert!(json.get("extensionsUsed").is_none());
     assert!(json.get("extensionsRequired").is_none());
     assert!(json["bufferViews"][0].get("extensions").is_none());

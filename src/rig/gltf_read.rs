@@ -144,28 +144,31 @@ fn sceneless_roots<'a>(
 fn open_decoded(bytes: &[u8], file: &Path) -> Result<(Document, Vec<Vec<u8>>, Vec<Diagnostic>)> {
     let (json_bytes, bin) = if bytes.starts_with(b"glTF") {
         let glb = ::gltf::Glb::from_slice(bytes).map_err(|e| gltf_error(file, e))?;
-        (glb.json.into_owned(), glb.bin.map(|b| b.into_owned()))
+        (glb.json, glb.bin.map(|b| b.into_owned()))
     } else {
-        (bytes.to_vec(), None)
+        (std::borrow::Cow::Borrowed(bytes), None)
     };
-    let mut json: Value =
-        serde_json::from_slice(&json_bytes).map_err(|e| RigError::UnreadableGltf {
-            file: file.to_path_buf(),
-            message: format!("JSON: {e}"),
-        })?;
-    let mut buffers = load_buffers(&json, bin, file)?;
-    let warnings = crate::gltf::decode::decode_document(&mut json, &mut buffers, file)?;
-    // Back through text: the crate keeps `extras` as raw JSON, which only its text parser makes.
-    let text = serde_json::to_vec(&json).map_err(|e| RigError::UnreadableGltf {
+    let unreadable = |e: serde_json::Error| RigError::UnreadableGltf {
         file: file.to_path_buf(),
         message: format!("JSON: {e}"),
-    })?;
-    let root = ::gltf::json::deserialize::from_slice(&text)
-        .map_err(|e| gltf_error(file, ::gltf::Error::Deserialize(e)))?;
+    };
+    let mut json: Value = serde_json::from_slice(&json_bytes).map_err(unreadable)?;
+    let mut buffers = load_buffers(&json, bin, file)?;
+    let report = crate::gltf::decode::decode_document(&mut json, &mut buffers, file)?;
+    // The crate parses text (it keeps `extras` as raw JSON, which only its text parser makes):
+    // the original, or the decoded document written out.
+    let root = if report.changed {
+        let text = serde_json::to_vec(&json).map_err(unreadable)?;
+        ::gltf::json::deserialize::from_slice(&text)
+    } else {
+        drop(json);
+        ::gltf::json::deserialize::from_slice(&json_bytes)
+    }
+    .map_err(|e| gltf_error(file, ::gltf::Error::Deserialize(e)))?;
     Ok((
         Document::from_json_without_validation(root),
         buffers,
-        warnings,
+        report.warnings,
     ))
 }
 

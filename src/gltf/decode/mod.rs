@@ -49,23 +49,37 @@ const HARMLESS_REQUIRED: &[&str] = &[
     "KHR_xmp_json_ld",
 ];
 
+/// What [`decode_document`] did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct DecodeReport {
+    /// One warning per decoded (or ignored optional) extension.
+    pub warnings: Vec<Diagnostic>,
+    /// Whether the JSON or the buffers were changed (a reader may parse the original text
+    /// when not).
+    pub changed: bool,
+}
+
 /// Decodes the compressed data of the document `json` (whose buffers, in order, are `buffers`;
 /// placeholders may be empty for meshopt fallback buffers, see [`is_meshopt_fallback`]) in
-/// place, and refuses documents that require an extension fbakit cannot decode. Returns the
-/// warnings (one per decoded extension). `file` names the document in errors and warnings.
+/// place, and refuses documents that require an extension fbakit cannot decode. `file` names
+/// the document in errors and warnings.
 pub fn decode_document(
     json: &mut Value,
     buffers: &mut [Vec<u8>],
     file: &Path,
-) -> Result<Vec<Diagnostic>> {
+) -> Result<DecodeReport> {
     if !json.is_object() {
         return Err(decode_error(file, "", "the document is not a JSON object"));
     }
     check_required(json, file)?;
-    let mut warnings = Vec::new();
-    warnings.extend(draco::check(json, file)?);
-    warnings.extend(meshopt::decode(json, buffers, file)?);
-    Ok(warnings)
+    let mut report = DecodeReport {
+        warnings: draco::check(json, file)?,
+        changed: false,
+    };
+    let decoded = meshopt::decode(json, buffers, file)?;
+    report.changed |= !decoded.is_empty();
+    report.warnings.extend(decoded);
+    Ok(report)
 }
 
 /// True when buffer `b` (a `buffers[i]` JSON object) is an `EXT_meshopt_compression` fallback:

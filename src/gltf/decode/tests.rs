@@ -50,7 +50,9 @@ fn optional_draco_reads_the_fallback_or_refuses_without_one() {
         })
     };
     let mut doc_with = doc(Some(0));
-    let w = decode_document(&mut doc_with, &mut [], Path::new("in.glb")).unwrap();
+    let r = decode_document(&mut doc_with, &mut [], Path::new("in.glb")).unwrap();
+    assert!(!r.changed);
+    let w = r.warnings;
     assert_eq!(w.len(), 1);
     assert!(w[0].message.contains("uncompressed accessors are read"));
     assert!(run(doc(None), &mut [])
