@@ -1,4 +1,7 @@
-//! glTF container and scene problems.
+//! glTF container and scene problems, and problems decoding a read document's compressed or
+//! extended data (`gltf::decode`).
+
+use std::path::PathBuf;
 
 /// A glTF problem. Every variant is bad input (exit code 2): a scene the builder rejects
 /// comes from the caller's data, a bad GLB from the file read.
@@ -23,6 +26,28 @@ pub enum GltfError {
     /// (`mesh `face`: non-finite UV`).
     #[error("{0}")]
     Scene(String),
+    /// A read document requires an extension fbakit cannot decode (`KHR_draco_mesh_compression`,
+    /// an unknown one); `how` says how to get a file without it.
+    #[error("{}: requires the glTF extension `{extension}`, which fbakit cannot decode; {how}", file.display())]
+    UnsupportedExtension {
+        /// The file.
+        file: PathBuf,
+        /// The extension's name.
+        extension: String,
+        /// What to do instead (a command that rewrites the file without it).
+        how: String,
+    },
+    /// Compressed or extended data of a read document is malformed, at JSON path `at`
+    /// (`bufferViews[3].extensions.EXT_meshopt_compression`).
+    #[error("{}: {at}: {what}", file.display())]
+    Decode {
+        /// The file.
+        file: PathBuf,
+        /// The JSON path.
+        at: String,
+        /// What is wrong.
+        what: String,
+    },
 }
 
 impl GltfError {

@@ -20,6 +20,10 @@
 //!   aligned) or as `.gltf` with the buffer embedded as a base64 data URI (one self-contained
 //!   file; prefer `.glb` for large faces, it is a quarter smaller and faster to load).
 //!
+//! Reading is the `gltf` crate's (in [`crate::rig::gltf_read`]); [`decode`] first turns a read
+//! document's compressed data (`EXT_meshopt_compression`) into plain glTF and refuses required
+//! extensions fbakit cannot decode.
+//!
 //! ## Layout choices
 //! - One buffer; every buffer view starts at a multiple of 4 bytes and none has a `byteStride`
 //!   (all data is tightly packed). Vertex data views carry `target` `ARRAY_BUFFER`, index views
@@ -70,6 +74,7 @@
 
 mod builder;
 pub mod container;
+pub mod decode;
 mod document;
 mod error;
 pub mod json;

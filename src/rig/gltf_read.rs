@@ -6,7 +6,14 @@
 //! morph deltas). Morph targets are named by `mesh.extras.targetNames` (the convention
 //! Blender and three.js write; a primitive's own `extras.targetNames` is accepted too);
 //! targets of the same name on several meshes are one [`BlendShape`]. Default weights come
-//! from `node.weights`, else `mesh.weights`. Sparse accessors are read through the crate.
+//! from `node.weights`, else `mesh.weights`. A file with meshes but no scene is read whole
+//! (every root node), with a warning.
+//!
+//! Files as other tools write them: compressed data (`EXT_meshopt_compression`) is decoded
+//! first by [`crate::gltf::decode::decode_document`], which also refuses required extensions
+//! fbakit cannot decode (`KHR_draco_mesh_compression`); accessors are read by `gltf_accessor`
+//! (interleaved views, sparse accessors, `KHR_mesh_quantization` integer attributes, 8/16/32-bit
+//! indices).
 //!
 //! The reader is bounded and never trusts counts: before the crate touches an accessor, its
 //! type, count and byte ranges are checked against the buffers actually loaded, so a hostile
@@ -17,12 +24,12 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use ::gltf::accessor::{DataType, Dimensions};
-use ::gltf::buffer::Source;
 use ::gltf::mesh::{Mode, Semantic};
-use ::gltf::{Accessor, Document, Gltf};
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use ::gltf::Document;
+use glam::{Mat3, Mat4, Vec3};
+use serde_json::Value;
 
+use super::gltf_accessor::{AccessorData, Want};
 use super::{BlendShape, Rig, RigError, RigMesh, ShapeDelta, MAX_RIG_SHAPES, MAX_RIG_VERTICES};
 use crate::error::{Diagnostic, Error, Result};
 use crate::mesh::{FaceGroup, Mesh, Polygons};
@@ -46,31 +53,34 @@ pub fn read_gltf(path: &Path) -> Result<Rig> {
 /// Reads a glTF rig from memory; `path` names the file in errors and locates external buffers.
 pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
     check_glb_header(bytes, path)?;
-    let gltf = Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(path, e))?;
-    check_attribute_indices(&gltf.document, path)?;
-    validate(&gltf.document, path)?;
-    let buffers = load_buffers(&gltf, path)?;
+    let (gltf, buffers, warnings) = open_decoded(bytes, path)?;
+    check_attribute_indices(&gltf, path)?;
+    validate(&gltf, path)?;
     let mut reader = Reader {
         file: path,
-        doc: &gltf.document,
+        doc: &gltf,
         buffers: &buffers,
+        data: AccessorData {
+            file: path,
+            buffers: &buffers,
+        },
         rig: Rig {
             name: super::rig_name(path),
             meshes: Vec::new(),
             shapes: Vec::new(),
-            warnings: Vec::new(),
+            warnings,
         },
         shape_by_name: HashMap::new(),
         vertices: 0,
         mesh_names: HashMap::new(),
     };
     reader.check_views()?;
-    let scene = gltf
-        .default_scene()
-        .or_else(|| gltf.scenes().next())
-        .ok_or_else(|| located(path, "scenes", "no scene to read"))?;
+    let roots = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => sceneless_roots(&gltf, path, &mut reader.rig.warnings)?,
+    };
     let mut stack: Vec<(::gltf::Node, Mat4, usize)> =
-        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     stack.reverse();
     let mut seen = vec![false; gltf.nodes().len()];
     while let Some((node, parent, depth)) = stack.pop() {
@@ -102,6 +112,64 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
     }
     reader.rig.check()?;
     Ok(reader.rig)
+}
+
+/// The roots of a document without a scene: every node that is no other's child, with a
+/// warning (viewers show nothing, but the meshes are the user's).
+fn sceneless_roots<'a>(
+    doc: &'a Document,
+    file: &Path,
+    warnings: &mut Vec<Diagnostic>,
+) -> Result<Vec<::gltf::Node<'a>>> {
+    let mut child = vec![false; doc.nodes().len()];
+    for n in doc.nodes() {
+        for c in n.children() {
+            child[c.index()] = true;
+        }
+    }
+    let roots: Vec<_> = doc.nodes().filter(|n| !child[n.index()]).collect();
+    if doc.meshes().len() == 0 || roots.is_empty() {
+        return Err(located(file, "scenes", "no scene and no nodes to read"));
+    }
+    warnings.push(Diagnostic::warning(format!(
+        "{}: the file has no scene; reading the meshes of all {} root node(s)",
+        file.display(),
+        roots.len()
+    )));
+    Ok(roots)
+}
+
+/// The document of `bytes` (`.glb` or `.gltf` JSON) with its buffers loaded and compressed
+/// data decoded ([`crate::gltf::decode::decode_document`]), and the decoder's warnings.
+fn open_decoded(bytes: &[u8], file: &Path) -> Result<(Document, Vec<Vec<u8>>, Vec<Diagnostic>)> {
+    let (json_bytes, bin) = if bytes.starts_with(b"glTF") {
+        let glb = ::gltf::Glb::from_slice(bytes).map_err(|e| gltf_error(file, e))?;
+        (glb.json, glb.bin.map(|b| b.into_owned()))
+    } else {
+        (std::borrow::Cow::Borrowed(bytes), None)
+    };
+    let unreadable = |e: serde_json::Error| RigError::UnreadableGltf {
+        file: file.to_path_buf(),
+        message: format!("JSON: {e}"),
+    };
+    let mut json: Value = serde_json::from_slice(&json_bytes).map_err(unreadable)?;
+    let mut buffers = load_buffers(&json, bin, file)?;
+    let report = crate::gltf::decode::decode_document(&mut json, &mut buffers, file)?;
+    // The crate parses text (it keeps `extras` as raw JSON, which only its text parser makes):
+    // the original, or the decoded document written out.
+    let root = if report.changed {
+        let text = serde_json::to_vec(&json).map_err(unreadable)?;
+        ::gltf::json::deserialize::from_slice(&text)
+    } else {
+        drop(json);
+        ::gltf::json::deserialize::from_slice(&json_bytes)
+    }
+    .map_err(|e| gltf_error(file, ::gltf::Error::Deserialize(e)))?;
+    Ok((
+        Document::from_json_without_validation(root),
+        buffers,
+        report.warnings,
+    ))
 }
 
 /// A GLB header whose total length is below the header's own 12 bytes: the `gltf` crate
@@ -160,9 +228,9 @@ fn located(file: &Path, at: &str, what: impl std::fmt::Display) -> Error {
     .into()
 }
 
-/// The `gltf` crate's validation, less two findings that valid files trigger: accessors
+/// The `gltf` crate's validation, less three findings that valid files trigger: accessors
 /// without `min`/`max` (only required for positions, unused here) and accessors without a
-/// `bufferView` (allowed by the glTF spec: they read as zeros, see [`Reader::check_accessor`]).
+/// `bufferView` (allowed by the glTF spec: they read as zeros, see `AccessorData::check`).
 fn validate(doc: &Document, file: &Path) -> Result<()> {
     use ::gltf::json::validation::{Error as V, Validate};
     let mut errors = Vec::new();
@@ -172,10 +240,12 @@ fn validate(doc: &Document, file: &Path) -> Result<()> {
         &mut |path, error| {
             let p = path();
             let s = p.as_str();
-            let benign = error == V::Missing
+            let benign = (error == V::Missing
                 && (s.ends_with(".min")
                     || s.ends_with(".max")
-                    || (s.starts_with("accessors[") && s.ends_with("].bufferView")));
+                    || (s.starts_with("accessors[") && s.ends_with("].bufferView"))))
+                // Required extensions were vetted by the decode pass (the crate knows none).
+                || (error == V::Unsupported && s.starts_with("extensionsRequired["));
             if !benign {
                 errors.push((p, error));
             }
@@ -220,25 +290,53 @@ fn gltf_error(file: &Path, e: ::gltf::Error) -> Error {
     }
 }
 
-/// The bytes of every buffer, checked against the declared `byteLength`.
-fn load_buffers(gltf: &Gltf, file: &Path) -> Result<Vec<Vec<u8>>> {
-    let mut out = Vec::new();
-    for b in gltf.buffers() {
-        let at = format!("buffers[{}]", b.index());
-        let data = match b.source() {
-            Source::Bin => gltf
-                .blob
-                .clone()
-                .ok_or_else(|| located(file, &at, "refers to a GLB binary chunk the file lacks"))?,
-            Source::Uri(uri) => buffer_from_uri(file, &at, uri)?,
+/// The bytes of every buffer of the document `json`, checked against the declared
+/// `byteLength`; a buffer without a URI is the GLB's binary chunk `bin`. Meshopt fallback
+/// buffers are left empty: their bytes come from decoding.
+fn load_buffers(json: &Value, mut bin: Option<Vec<u8>>, file: &Path) -> Result<Vec<Vec<u8>>> {
+    let list = match json.get("buffers") {
+        None => return Ok(Vec::new()),
+        Some(Value::Array(list)) => list,
+        Some(_) => return Err(located(file, "buffers", "must be an array")),
+    };
+    let mut out = Vec::with_capacity(list.len().min(1024));
+    let mut bin_users = list
+        .iter()
+        .filter(|b| b.get("uri").is_none() && !crate::gltf::decode::is_meshopt_fallback(b))
+        .count();
+    for (i, b) in list.iter().enumerate() {
+        let at = format!("buffers[{i}]");
+        let length = b
+            .get("byteLength")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| located(file, &at, "byteLength must be a non-negative integer"))?;
+        if crate::gltf::decode::is_meshopt_fallback(b) {
+            out.push(Vec::new());
+            continue;
+        }
+        let data = match b.get("uri") {
+            None => {
+                // Only buffer 0 should lack a URI; more are given the chunk too (as the crate
+                // did), the last of them taking it.
+                bin_users -= 1;
+                let chunk = if bin_users == 0 {
+                    bin.take()
+                } else {
+                    bin.clone()
+                };
+                chunk.ok_or_else(|| {
+                    located(file, &at, "refers to a GLB binary chunk the file lacks")
+                })?
+            }
+            Some(Value::String(uri)) => buffer_from_uri(file, &at, uri)?,
+            Some(_) => return Err(located(file, &format!("{at}.uri"), "must be a string")),
         };
-        if data.len() < b.length() {
+        if (data.len() as u64) < length {
             return Err(located(
                 file,
                 &at,
                 format!(
-                    "byteLength is {} but the data has {} bytes",
-                    b.length(),
+                    "byteLength is {length} but the data has {} bytes",
                     data.len()
                 ),
             ));
@@ -292,21 +390,11 @@ struct Reader<'a> {
     file: &'a Path,
     doc: &'a Document,
     buffers: &'a [Vec<u8>],
+    data: AccessorData<'a>,
     rig: Rig,
     shape_by_name: HashMap<String, usize>,
     vertices: usize,
     mesh_names: HashMap<String, usize>,
-}
-
-/// The element an accessor must hold for the crate's typed readers.
-#[derive(Clone, Copy)]
-enum Want {
-    /// `VEC3` of `f32` (positions, normals, morph deltas).
-    Vec3F32,
-    /// `VEC2` of `f32`, or normalised `u8`/`u16` (texture coordinates).
-    TexCoord,
-    /// `SCALAR` `u8`/`u16`/`u32` (indices).
-    Index,
 }
 
 impl Reader<'_> {
@@ -331,122 +419,6 @@ impl Reader<'_> {
                     "byteStride must lie in 4..=252",
                 ));
             }
-        }
-        Ok(())
-    }
-
-    /// Checks type, count and byte ranges of `acc` (at JSON path `at`) so the crate's
-    /// iterators stay in bounds; `count` is the element count required, if any.
-    fn check_accessor(
-        &self,
-        acc: &Accessor,
-        at: &str,
-        want: Want,
-        count: Option<usize>,
-    ) -> Result<()> {
-        let at = format!("{at} (accessors[{}])", acc.index());
-        let ok_type = match want {
-            Want::Vec3F32 => {
-                acc.dimensions() == Dimensions::Vec3 && acc.data_type() == DataType::F32
-            }
-            Want::TexCoord => {
-                acc.dimensions() == Dimensions::Vec2
-                    && match acc.data_type() {
-                        DataType::F32 => true,
-                        DataType::U8 | DataType::U16 => acc.normalized(),
-                        _ => false,
-                    }
-            }
-            Want::Index => {
-                acc.dimensions() == Dimensions::Scalar
-                    && matches!(
-                        acc.data_type(),
-                        DataType::U8 | DataType::U16 | DataType::U32
-                    )
-            }
-        };
-        if !ok_type {
-            let wanted = match want {
-                Want::Vec3F32 => "VEC3 of FLOAT",
-                Want::TexCoord => "VEC2 of FLOAT (or normalised unsigned byte/short)",
-                Want::Index => "SCALAR unsigned byte/short/int",
-            };
-            return Err(self.err(
-                &at,
-                format!(
-                    "expected {wanted}, found {:?} of {:?}",
-                    acc.dimensions(),
-                    acc.data_type()
-                ),
-            ));
-        }
-        let n = acc.count();
-        if n == 0 || n > MAX_ACCESSOR_COUNT {
-            return Err(self.err(&at, format!("count {n} outside 1..={MAX_ACCESSOR_COUNT}")));
-        }
-        if let Some(c) = count {
-            if n != c {
-                return Err(self.err(&at, format!("count {n}, expected {c} (one per vertex)")));
-            }
-        }
-        let elem = acc.size();
-        if let Some(view) = acc.view() {
-            self.check_range(&at, view.length(), view.stride(), acc.offset(), n, elem)?;
-        }
-        if let Some(sparse) = acc.sparse() {
-            let k = sparse.count();
-            if k == 0 || k > n {
-                return Err(self.err(
-                    &format!("{at}.sparse"),
-                    format!("count {k} outside 1..={n}"),
-                ));
-            }
-            let idx = sparse.indices();
-            let isize = idx.index_type().size();
-            self.check_range(
-                &format!("{at}.sparse.indices"),
-                idx.view().length(),
-                idx.view().stride(),
-                idx.offset(),
-                k,
-                isize,
-            )?;
-            let vals = sparse.values();
-            self.check_range(
-                &format!("{at}.sparse.values"),
-                vals.view().length(),
-                vals.view().stride(),
-                vals.offset(),
-                k,
-                elem,
-            )?;
-        }
-        Ok(())
-    }
-
-    /// `count` elements of `elem` bytes every `stride` bytes from `offset` fit in `len` bytes.
-    fn check_range(
-        &self,
-        at: &str,
-        len: usize,
-        stride: Option<usize>,
-        offset: usize,
-        count: usize,
-        elem: usize,
-    ) -> Result<()> {
-        let stride = stride.unwrap_or(elem);
-        if stride < elem {
-            return Err(self.err(
-                at,
-                format!("byteStride {stride} is below the element size {elem}"),
-            ));
-        }
-        let end = stride
-            .checked_mul(count - 1)
-            .and_then(|x| x.checked_add(elem))
-            .and_then(|x| x.checked_add(offset));
-        if end.is_none_or(|e| e > len) {
-            return Err(self.err(at, "data runs past the end of its bufferView"));
         }
         Ok(())
     }
@@ -630,10 +602,10 @@ impl Reader<'_> {
         let pos_acc = prim
             .get(&Semantic::Positions)
             .ok_or_else(|| self.err(&format!("{at}.attributes"), "no POSITION"))?;
-        self.check_accessor(
+        self.data.check(
             &pos_acc,
             &format!("{at}.attributes.POSITION"),
-            Want::Vec3F32,
+            Want::Vec3,
             None,
         )?;
         let n = pos_acc.count();
@@ -643,45 +615,38 @@ impl Reader<'_> {
         self.vertices += n;
         let normal_acc = prim.get(&Semantic::Normals);
         if let Some(a) = &normal_acc {
-            self.check_accessor(
-                a,
-                &format!("{at}.attributes.NORMAL"),
-                Want::Vec3F32,
-                Some(n),
-            )?;
+            self.data
+                .check(a, &format!("{at}.attributes.NORMAL"), Want::Vec3, Some(n))?;
         }
         let uv_acc = prim.get(&Semantic::TexCoords(0));
         if let Some(a) = &uv_acc {
-            self.check_accessor(
+            self.data.check(
                 a,
                 &format!("{at}.attributes.TEXCOORD_0"),
-                Want::TexCoord,
+                Want::Vec2,
                 Some(n),
             )?;
         }
         if let Some(a) = prim.indices() {
-            self.check_accessor(&a, &format!("{at}.indices"), Want::Index, None)?;
+            self.data
+                .check(&a, &format!("{at}.indices"), Want::Index, None)?;
         }
         let targets: Vec<_> = prim.morph_targets().collect();
         for (t, target) in targets.iter().enumerate() {
             if let Some(a) = target.positions() {
-                self.check_accessor(
+                self.data.check(
                     &a,
                     &format!("{at}.targets[{t}].POSITION"),
-                    Want::Vec3F32,
+                    Want::Vec3,
                     Some(n),
                 )?;
             }
         }
 
-        let buffers = self.buffers;
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|v| v.as_slice()));
         let linear = Mat3::from_mat4(world);
         let normal_m = linear.inverse().transpose();
         // No bufferView and no sparse values: all zeros (glTF 2.0, 3.6.2.3).
-        let local: Vec<Vec3> = reader
-            .read_positions()
-            .map_or_else(|| vec![Vec3::ZERO; n], |r| r.map(Vec3::from).collect());
+        let local = self.data.vec3(&pos_acc);
         if let Some(i) = local.iter().position(|p| !p.is_finite()) {
             return Err(self.err(
                 &format!("{at}.attributes.POSITION"),
@@ -689,8 +654,8 @@ impl Reader<'_> {
             ));
         }
         let positions: Vec<Vec3> = local.iter().map(|&p| world.transform_point3(p)).collect();
-        let indices: Vec<u32> = match reader.read_indices() {
-            Some(r) => r.into_u32().collect(),
+        let indices: Vec<u32> = match prim.indices() {
+            Some(a) => self.data.indices(&a),
             None => (0..n as u32).collect(),
         };
         if let Some(i) = indices.iter().position(|&i| i as usize >= n) {
@@ -726,24 +691,23 @@ impl Reader<'_> {
             polygons: polygons.clone(),
             ..Mesh::default()
         };
-        if normal_acc.is_some() {
-            if let Some(r) = reader.read_normals() {
-                let normals: Vec<Vec3> = r
-                    .map(|v| (normal_m * Vec3::from(v)).normalize_or_zero())
-                    .collect();
-                if normals.iter().all(|v| v.is_finite()) {
-                    mesh.normals = normals;
-                    mesh.normal_polygons = Some(polygons.clone());
-                }
+        if let Some(a) = &normal_acc {
+            let normals: Vec<Vec3> = self
+                .data
+                .vec3(a)
+                .into_iter()
+                .map(|v| (normal_m * v).normalize_or_zero())
+                .collect();
+            if normals.iter().all(|v| v.is_finite()) {
+                mesh.normals = normals;
+                mesh.normal_polygons = Some(polygons.clone());
             }
         }
-        if uv_acc.is_some() {
-            if let Some(r) = reader.read_tex_coords(0) {
-                let uvs: Vec<Vec2> = r.into_f32().map(Vec2::from).collect();
-                if uvs.iter().all(|v| v.is_finite()) {
-                    mesh.uvs = uvs;
-                    mesh.uv_polygons = Some(polygons.clone());
-                }
+        if let Some(a) = &uv_acc {
+            let uvs = self.data.vec2(a);
+            if uvs.iter().all(|v| v.is_finite()) {
+                mesh.uvs = uvs;
+                mesh.uv_polygons = Some(polygons.clone());
             }
         }
         if let Some(material) = prim.material().name() {
@@ -756,9 +720,11 @@ impl Reader<'_> {
         let unique = self.unique_mesh_name(name);
         mesh.name = unique.clone();
 
-        for (t, morph) in reader.read_morph_targets().enumerate() {
-            let Some(deltas) = morph.0 else { continue };
-            let deltas: Vec<Vec3> = deltas.map(Vec3::from).collect();
+        for (t, target) in targets.iter().enumerate() {
+            let Some(acc) = target.positions() else {
+                continue;
+            };
+            let deltas = self.data.vec3(&acc);
             if let Some(i) = deltas.iter().position(|p| !p.is_finite()) {
                 return Err(self.err(
                     &format!("{at}.targets[{t}].POSITION"),

@@ -30,6 +30,9 @@ pub mod capture;
 mod error;
 pub mod fap_map;
 pub mod fat_build;
+mod gltf_accessor;
+#[cfg(test)]
+mod gltf_encodings_tests;
 pub mod gltf_read;
 pub mod gltf_write;
 pub mod obj_folder;

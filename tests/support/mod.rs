@@ -2,4 +2,5 @@
 #![allow(dead_code)]
 pub mod cli;
 pub mod gltf_scenes;
+pub mod gltf_transform;
 pub mod validator;
