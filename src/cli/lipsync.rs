@@ -9,7 +9,10 @@ use fbakit::error::{Error, Result};
 use fbakit::fap::write_stream_file;
 use fbakit::format::OutputFormat;
 use fbakit::speech::lipsync::coarticulation::dominant;
-use fbakit::speech::lipsync::{analyse_file, lipsync_transcript_at, AlignedPhone, LipsyncOptions};
+use fbakit::speech::lipsync::recognition::{check_recogniser, recognise_file};
+use fbakit::speech::lipsync::{
+    analyse_file, lipsync_recognised, lipsync_transcript_at, AlignedPhone, LipsyncOptions,
+};
 use fbakit::speech::{MouthFaps, SpeechOptions};
 use serde::Serialize;
 
@@ -25,7 +28,8 @@ pub struct LipsyncArgs {
     /// The voice recording: WAV (8/16/24/32-bit integer or 32-bit float, any rate from 4 kHz,
     /// stereo mixed down).
     pub recording: PathBuf,
-    /// What the recording says (its transcript).
+    /// What the recording says (its transcript). Without --text or --text-file, English
+    /// phones are recognised with PocketSphinx (Debian: pocketsphinx pocketsphinx-en-us).
     #[arg(long, value_name = "TEXT", conflicts_with = "text_file")]
     pub text: Option<String>,
     /// A UTF-8 text file holding what the recording says.
@@ -80,6 +84,8 @@ struct LipsyncReport {
     audio_seconds: f64,
     speech_seconds: f64,
     lang: String,
+    /// `transcript` (forced alignment) or `recognition` (PocketSphinx phones, ARPAbet).
+    method: &'static str,
     output: String,
     confidence: f64,
     frames: usize,
@@ -101,23 +107,24 @@ fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     }
 }
 
-fn transcript(a: &LipsyncArgs) -> Result<String> {
+fn transcript(a: &LipsyncArgs) -> Result<Option<String>> {
     match (&a.text, &a.text_file) {
-        (Some(t), _) => Ok(t.clone()),
+        (Some(t), _) => Ok(Some(t.clone())),
         (None, Some(path)) => {
             let bytes = fbakit::io::read_bounded(path, MAX_TRANSCRIPT_BYTES)?;
-            String::from_utf8(bytes).map_err(|_| {
+            String::from_utf8(bytes).map(Some).map_err(|_| {
                 Error::io(
                     path,
                     std::io::Error::new(std::io::ErrorKind::InvalidData, "the transcript is not UTF-8 text"),
                 )
             })
         }
-        (None, None) => Err(Error::Usage(
-            "give the transcript with --text \"…\" or --text-file FILE: phone recognition \
-             without a transcript is not available yet"
-                .into(),
-        )),
+        (None, None) if a.lang == "en" || a.lang.starts_with("en-") => Ok(None),
+        (None, None) => Err(Error::Usage(format!(
+            "without a transcript only English is recognised; give the {} transcript with \
+             --text \"…\" or --text-file FILE",
+            a.lang
+        ))),
     }
 }
 
@@ -156,15 +163,29 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
     } else {
         None
     };
+    if text.is_none() {
+        // A missing recogniser is said before anything is read.
+        check_recogniser()?;
+    }
     let bar = progress_bar(1000, "reading");
     let rec = analyse_file(&a.recording, &mut |f| bar.set_position((f * 1000.0) as u64));
     bar.finish_and_clear();
     let rec = rec?;
-    let opts = LipsyncOptions {
-        lang: a.lang.clone(),
-        ..LipsyncOptions::default()
+    let sync = match &text {
+        Some(text) => {
+            let opts = LipsyncOptions {
+                lang: a.lang.clone(),
+                ..LipsyncOptions::default()
+            };
+            lipsync_transcript_at(&rec, text, &opts, a.fps)?
+        }
+        None => {
+            let bar = progress_bar(1000, "recognising");
+            let phones = recognise_file(&a.recording, &mut |f| bar.set_position((f * 1000.0) as u64));
+            bar.finish_and_clear();
+            lipsync_recognised(&rec, phones?, a.fps)?
+        }
     };
-    let sync = lipsync_transcript_at(&rec, &text, &opts, a.fps)?;
     let speech = SpeechOptions {
         fps: a.fps,
         mouth: a.mouth.into(),
@@ -216,6 +237,7 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
         audio_seconds: rec.seconds,
         speech_seconds: rec.activity.speech_seconds,
         lang: a.lang.clone(),
+        method: if text.is_some() { "transcript" } else { "recognition" },
         output: a.output.display().to_string(),
         confidence: sync.confidence,
         frames: stream.frames.len(),

@@ -106,6 +106,12 @@ pub enum SpeechError {
         /// Why.
         detail: String,
     },
+    /// The phone recogniser failed.
+    #[error("PocketSphinx failed: {detail}")]
+    RecognitionFailed {
+        /// Its last message.
+        detail: String,
+    },
     /// The speech engine a command needs is not installed.
     #[error("{engine} is not installed: {why} (Debian/Ubuntu: apt-get install {package})")]
     EngineMissing {
@@ -119,9 +125,10 @@ pub enum SpeechError {
 }
 
 impl SpeechError {
-    /// Always true (see the type's docs); a missing engine is reported as exit code 2 as
+    /// True but for an engine failure; a missing engine is reported as exit code 2 as
     /// well, as `lipsync` promises, with the package to install.
+    /// The recogniser failing is the exception (exit code 1).
     pub fn is_input_error(&self) -> bool {
-        true
+        !matches!(self, SpeechError::RecognitionFailed { .. })
     }
 }

@@ -33,11 +33,11 @@ pub fn distance<const N: usize>(a: &[f32; N], b: &[f32; N]) -> f32 {
 }
 
 /// Aligns `a` with `b` (both non-empty); `None` when either is empty.
-pub fn warp<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize) -> Option<WarpPath> {
+pub fn warp<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize, penalty: f32) -> Option<WarpPath> {
     if a.is_empty() || b.is_empty() {
         return None;
     }
-    let pairs = fast_dtw(a, b, radius.max(1));
+    let pairs = fast_dtw(a, b, radius.max(1), penalty.max(0.0));
     let total: f64 = pairs
         .iter()
         .map(|&(i, j)| f64::from(distance(&a[i as usize], &b[j as usize])))
@@ -60,7 +60,7 @@ fn halve<const N: usize>(x: &[[f32; N]]) -> Vec<[f32; N]> {
         .collect()
 }
 
-fn fast_dtw<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize) -> Vec<(u32, u32)> {
+fn fast_dtw<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize, penalty: f32) -> Vec<(u32, u32)> {
     let (n, m) = (a.len(), b.len());
     if n.saturating_mul(m) <= FULL_CELLS || n < 4 * radius || m < 4 * radius {
         let band: Vec<(usize, usize)> = if n.saturating_mul(m) <= FULL_CELLS {
@@ -69,11 +69,11 @@ fn fast_dtw<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize) -> Ve
             // One side is tiny: a diagonal band wide enough to hold any monotone path.
             diagonal_band(n, m, 4 * radius)
         };
-        return banded_dtw(a, b, &band);
+        return banded_dtw(a, b, &band, penalty);
     }
-    let coarse = fast_dtw(&halve(a), &halve(b), radius);
+    let coarse = fast_dtw(&halve(a), &halve(b), radius, penalty);
     let band = project(&coarse, n, m, radius);
-    banded_dtw(a, b, &band)
+    banded_dtw(a, b, &band, penalty)
 }
 
 /// Rows' column ranges around the straight line from (0, 0) to (n − 1, m − 1).
@@ -115,7 +115,12 @@ fn project(coarse: &[(u32, u32)], n: usize, m: usize, radius: usize) -> Vec<(usi
 }
 
 /// DTW restricted to `band[i]` = (first, last) column of row `i`.
-fn banded_dtw<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], band: &[(usize, usize)]) -> Vec<(u32, u32)> {
+fn banded_dtw<const N: usize>(
+    a: &[[f32; N]],
+    b: &[[f32; N]],
+    band: &[(usize, usize)],
+    penalty: f32,
+) -> Vec<(u32, u32)> {
     let n = a.len();
     let mut offsets = Vec::with_capacity(n + 1);
     let mut total = 0usize;
@@ -139,13 +144,13 @@ fn banded_dtw<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], band: &[(usize, us
                 cur[k] = d;
                 continue;
             }
-            let up = if i > 0 && j >= prev_lo && j - prev_lo < prev.len() { prev[j - prev_lo] + d } else { f32::INFINITY };
+            let up = if i > 0 && j >= prev_lo && j - prev_lo < prev.len() { prev[j - prev_lo] + d + penalty } else { f32::INFINITY };
             let diag = if i > 0 && j > prev_lo && j - 1 - prev_lo < prev.len() {
                 prev[j - 1 - prev_lo] + 2.0 * d
             } else {
                 f32::INFINITY
             };
-            let left = if k > 0 { cur[k - 1] + d } else { f32::INFINITY };
+            let left = if k > 0 { cur[k - 1] + d + penalty } else { f32::INFINITY };
             let (best, dir) = if diag <= up && diag <= left {
                 (diag, DIAG)
             } else if up <= left {
@@ -236,7 +241,7 @@ mod tests {
         let a = seq(&[0.0, 1.0, 2.0, 3.0, 2.0, 1.0, 5.0]);
         // Each value twice.
         let b: Vec<[f32; 1]> = a.iter().flat_map(|v| [*v, *v]).collect();
-        let w = warp(&a, &b, 2).unwrap();
+        let w = warp(&a, &b, 2, 0.0).unwrap();
         check_path(&w.pairs, a.len(), b.len());
         assert_eq!(w.mean_distance, 0.0);
     }
@@ -253,8 +258,8 @@ mod tests {
                 [(t * 0.01).sin(), (t * 0.023).cos()]
             })
             .collect();
-        let fast = fast_dtw(&halve(&a), &halve(&b), 8);
-        let full = banded_dtw(&halve(&a), &halve(&b), &vec![(0, 1299); 1500]);
+        let fast = fast_dtw(&halve(&a), &halve(&b), 8, 0.0);
+        let full = banded_dtw(&halve(&a), &halve(&b), &vec![(0, 1299); 1500], 0.0);
         check_path(&fast, 1500, 1300);
         let cost = |p: &[(u32, u32)]| -> f64 {
             p.iter().map(|&(i, j)| f64::from(distance(&halve(&a)[i as usize], &halve(&b)[j as usize]))).sum()
@@ -264,7 +269,7 @@ mod tests {
         let band = project(&fast, 3000, 2600, 12);
         let cells: usize = band.iter().map(|(lo, hi)| hi + 1 - lo).sum();
         assert!(cells < 3000 * 80, "{cells}");
-        let path = banded_dtw(&a, &b, &band);
+        let path = banded_dtw(&a, &b, &band, 0.0);
         check_path(&path, 3000, 2600);
         // Row 1300 of `a` (t = 1300) sits at column 1000 + 300 / 1.666 ≈ 1180 of `b`.
         let j = path.iter().find(|p| p.0 == 1300).unwrap().1;
@@ -273,8 +278,8 @@ mod tests {
 
     #[test]
     fn empty_sequences_have_no_path() {
-        assert!(warp::<1>(&[], &seq(&[1.0]), 4).is_none());
-        let w = warp(&seq(&[1.0]), &seq(&[1.0, 2.0, 3.0]), 4).unwrap();
+        assert!(warp::<1>(&[], &seq(&[1.0]), 4, 0.0).is_none());
+        let w = warp(&seq(&[1.0]), &seq(&[1.0, 2.0, 3.0]), 4, 0.0).unwrap();
         check_path(&w.pairs, 1, 3);
         assert!(unrelated_distance(&seq(&[0.0, 1.0]), &seq(&[0.0, 1.0])) > 0.3);
     }

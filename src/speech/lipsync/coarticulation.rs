@@ -60,6 +60,10 @@ pub fn is_closure(symbol: &str) -> bool {
 /// it, and at most how many seconds.
 const ROUNDING_LEAD: f64 = 0.3;
 const ROUNDING_LEAD_MAX: f64 = 0.04;
+/// Closure keys stay this far (seconds) inside the phone when it is long enough.
+const CLOSURE_MARGIN: f64 = 0.02;
+/// Longest closure held, seconds.
+const CLOSURE_HOLD: f64 = 0.15;
 /// Silences shorter than this keep the transcript's shapes (a stop's closure is silent).
 pub const MIN_RELAXED_SILENCE: f64 = 0.25;
 
@@ -73,8 +77,8 @@ pub fn lipsync_keys(
     fps: f64,
 ) -> (Vec<VisemeKey>, Vec<String>) {
     let table = PhonemeVisemeTable::standard();
-    let (mut keys, unmapped) = viseme_keys(phones, duration, table);
     let frame = 1.0 / fps;
+    let (mut keys, unmapped) = held_keys(phones, duration, table, frame);
     anticipate_rounding(&mut keys);
     // Silences: drop what the transcript put there, key the rest shape at its edges.
     for &(s, e) in silences {
@@ -90,8 +94,13 @@ pub fn lipsync_keys(
     // Closures: PP on every frame inside the phone, at least the one nearest its middle.
     let mut closures: Vec<(f64, f64)> = Vec::new();
     for p in phones.iter().filter(|p| is_closure(&p.symbol)) {
-        let first = (p.start * fps).ceil();
-        let last = (p.end * fps).floor();
+        // Held on the frames well inside the phone, over at most its last CLOSURE_HOLD
+        // seconds (lips close for a bounded time; the release into the next sound is the
+        // better-placed end).
+        let start = (p.start + CLOSURE_MARGIN).max(p.end - CLOSURE_HOLD);
+        let end = p.end - CLOSURE_MARGIN;
+        let first = (start * fps).ceil();
+        let last = (end * fps).floor();
         let (first, last) = if first > last {
             let mid = (0.5 * (p.start + p.end) * fps).round();
             (mid, mid)
@@ -113,6 +122,37 @@ pub fn lipsync_keys(
     }
     keys.sort_by(|x, y| x.time.total_cmp(&y.time));
     (merge_close_keys(keys, frame), unmapped)
+}
+
+/// Share of a phone at each end given to the transitions: the shape is held between.
+const HOLD_EDGE: f64 = 0.25;
+
+/// The keys of [`viseme_keys`], but a phone at least two frames long holds its shape over
+/// its middle (keys at [`HOLD_EDGE`] from each end) instead of passing through it at its
+/// middle: the dominant shape then changes near the phone boundaries, not inside phones.
+fn held_keys(
+    phones: &[TimedPhoneme],
+    duration: f64,
+    table: &PhonemeVisemeTable,
+    frame: f64,
+) -> (Vec<VisemeKey>, Vec<String>) {
+    let (centre, unmapped) = viseme_keys(phones, duration, table);
+    let edge = HOLD_EDGE;
+    let mut keys = Vec::with_capacity(2 * centre.len());
+    for k in centre {
+        // The phone whose middle this key is (glides and edge keys are left as they are).
+        let phone = phones.iter().find(|p| (0.5 * (p.start + p.end) - k.time).abs() < 1e-9);
+        match phone {
+            Some(p) if p.end - p.start >= 2.0 * frame => {
+                let len = p.end - p.start;
+                keys.push(VisemeKey { time: p.start + edge * len, viseme: k.viseme });
+                keys.push(VisemeKey { time: p.end - edge * len, viseme: k.viseme });
+            }
+            _ => keys.push(k),
+        }
+    }
+    keys.sort_by(|x, y| x.time.total_cmp(&y.time));
+    (keys, unmapped)
 }
 
 fn anticipate_rounding(keys: &mut [VisemeKey]) {

@@ -147,3 +147,89 @@ mod tests {
         assert_eq!(score(&truth, &none, 25.0).closure_rate(), 0.0);
     }
 }
+
+/// How to degrade a rendition into a test recording.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Degradation {
+    /// Sample rate of the recording written.
+    pub sample_rate: u32,
+    /// Channels (the same signal in each).
+    pub channels: u16,
+    /// White noise this many dB below the speech's RMS level (`None`: no noise).
+    pub snr_db: Option<f64>,
+    /// Seconds of silence added before the speech.
+    pub lead_in: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+}
+
+impl Default for Degradation {
+    fn default() -> Self {
+        Degradation {
+            sample_rate: 44_100,
+            channels: 2,
+            snr_db: Some(20.0),
+            lead_in: 0.3,
+            seed: 1,
+        }
+    }
+}
+
+/// `u`'s audio resampled, padded, with noise added, as 16-bit WAV bytes; and its phones
+/// moved by the lead-in (the truth for scoring).
+pub fn degrade(
+    u: &crate::speech::espeak::Utterance,
+    d: &Degradation,
+) -> crate::error::Result<(Vec<u8>, Vec<TimedPhoneme>)> {
+    use crate::speech::audio::Resampler;
+    let mut rs = Resampler::new(u.sample_rate, d.sample_rate);
+    let mut x: Vec<f32> = vec![0.0; (d.lead_in * f64::from(d.sample_rate)) as usize];
+    let input: Vec<f32> = u.samples.iter().map(|&s| f32::from(s) / 32_768.0).collect();
+    rs.push(&input, &mut x);
+    rs.finish(&mut x);
+    x.extend(std::iter::repeat_n(0.0, (0.3 * f64::from(d.sample_rate)) as usize));
+    if let Some(snr) = d.snr_db {
+        let speech: Vec<f64> = input.iter().map(|s| f64::from(*s).powi(2)).collect();
+        let rms = (speech.iter().sum::<f64>() / speech.len().max(1) as f64).sqrt();
+        let sigma = rms / 10f64.powf(snr / 20.0);
+        let mut state = d.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for s in &mut x {
+            // Box–Muller: a Gaussian sample from two uniform ones.
+            let (a, b) = (uniform().max(1e-12), uniform());
+            let g = (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos();
+            *s += (sigma * g) as f32;
+        }
+    }
+    let spec = hound::WavSpec {
+        channels: d.channels.max(1),
+        sample_rate: d.sample_rate,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    let encode = |e: hound::Error| -> crate::error::Error { crate::error::EncodeError::new("WAV", e).into() };
+    let mut w = hound::WavWriter::new(&mut cursor, spec).map_err(encode)?;
+    for s in &x {
+        let v = (s.clamp(-1.0, 1.0) * 32_767.0).round() as i16;
+        for _ in 0..spec.channels {
+            w.write_sample(v).map_err(encode)?;
+        }
+    }
+    w.finalize().map_err(encode)?;
+    let truth = u
+        .phonemes
+        .iter()
+        .map(|p| TimedPhoneme {
+            start: p.start + d.lead_in,
+            end: p.end + d.lead_in,
+            ..p.clone()
+        })
+        .collect();
+    Ok((cursor.into_inner(), truth))
+}
