@@ -10,11 +10,13 @@
 use std::time::Instant;
 
 use fbakit::fap::VisemeParams;
+use fbakit::speech::audio::AudioReader;
 use fbakit::speech::espeak::{speak_at, TimedPhoneme};
 use fbakit::speech::lipsync::coarticulation::lipsync_keys;
 use fbakit::speech::lipsync::evaluation::{degrade, score, Degradation, LipsyncScore};
-use fbakit::speech::lipsync::{analyse_chunks, lipsync_transcript_at, render_transcript, LipsyncOptions};
-use fbakit::speech::audio::AudioReader;
+use fbakit::speech::lipsync::{
+    analyse_chunks, lipsync_transcript_at, render_transcript, LipsyncOptions,
+};
 use fbakit::speech::{animation::key_frame, MouthFaps};
 
 /// Sentences rich in lip closures and rounded vowels.
@@ -54,13 +56,25 @@ pub fn conditions() -> Vec<Condition> {
             name: "en-us+f3, 200 wpm, 48 kHz, 15 dB SNR",
             voice: "en-us+f3",
             rate: 200,
-            degradation: Degradation { sample_rate: 48_000, channels: 1, snr_db: Some(15.0), lead_in: 0.5, seed: 2 },
+            degradation: Degradation {
+                sample_rate: 48_000,
+                channels: 1,
+                snr_db: Some(15.0),
+                lead_in: 0.5,
+                seed: 2,
+            },
         },
         Condition {
             name: "en-gb-x-rp+m3, 120 wpm, 8 kHz, 25 dB SNR",
             voice: "en-gb-x-rp+m3",
             rate: 120,
-            degradation: Degradation { sample_rate: 8_000, channels: 1, snr_db: Some(25.0), lead_in: 0.2, seed: 3 },
+            degradation: Degradation {
+                sample_rate: 8_000,
+                channels: 1,
+                snr_db: Some(25.0),
+                lead_in: 0.2,
+                seed: 3,
+            },
         },
     ]
 }
@@ -92,7 +106,8 @@ pub fn run_case(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<Ca
     let recording = speak_at(text, c.voice, c.rate)?;
     let (wav, truth) = degrade(&recording, &c.degradation)?;
     let started = Instant::now();
-    let mut reader = AudioReader::from_wav(Box::new(std::io::Cursor::new(wav)), "case.wav".as_ref())?;
+    let mut reader =
+        AudioReader::from_wav(Box::new(std::io::Cursor::new(wav)), "case.wav".as_ref())?;
     let chunks = std::iter::from_fn(|| reader.next_chunk().transpose());
     let rec = analyse_chunks(chunks, "case.wav".as_ref())?;
     let sync = lipsync_transcript_at(&rec, text, &LipsyncOptions::default(), fps)?;
@@ -100,8 +115,15 @@ pub fn run_case(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<Ca
     let aligned = score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps);
     // Baseline: the rendition's phones stretched linearly over the recording's speech.
     let rendition = render_transcript(text, "en")?;
-    let spoken: Vec<&TimedPhoneme> = rendition.phonemes.iter().filter(|p| !p.symbol.starts_with('_')).collect();
-    let (r0, r1) = (spoken.first().map_or(0.0, |p| p.start), spoken.last().map_or(1.0, |p| p.end));
+    let spoken: Vec<&TimedPhoneme> = rendition
+        .phonemes
+        .iter()
+        .filter(|p| !p.symbol.starts_with('_'))
+        .collect();
+    let (r0, r1) = (
+        spoken.first().map_or(0.0, |p| p.start),
+        spoken.last().map_or(1.0, |p| p.end),
+    );
     let (s0, s1) = rec.activity.speech_span;
     let scale = (s1 - s0) / (r1 - r0).max(1e-6);
     let stretched: Vec<TimedPhoneme> = rendition
@@ -115,7 +137,13 @@ pub fn run_case(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<Ca
         .collect();
     let (keys, _) = lipsync_keys(&stretched, rec.seconds, &[], fps);
     let stretched = score(&truth, &frames_of(&keys, rec.seconds, fps), fps);
-    Ok(CaseResult { aligned, stretched, audio_seconds: rec.seconds, work_seconds, confidence: sync.confidence })
+    Ok(CaseResult {
+        aligned,
+        stretched,
+        audio_seconds: rec.seconds,
+        work_seconds,
+        confidence: sync.confidence,
+    })
 }
 
 fn line(name: &str, s: &LipsyncScore) {
@@ -156,7 +184,12 @@ fn main() {
                 Err(e) => println!("  {text}: {e}"),
             }
         }
-        println!("{} (confidence {:.2}..{:.2})", c.name, conf.iter().cloned().fold(1.0, f64::min), conf.iter().cloned().fold(0.0, f64::max));
+        println!(
+            "{} (confidence {:.2}..{:.2})",
+            c.name,
+            conf.iter().cloned().fold(1.0, f64::min),
+            conf.iter().cloned().fold(0.0, f64::max)
+        );
         line("aligned", &sum.0);
         line("stretched", &sum.1);
         all.0.add(&sum.0);
@@ -165,5 +198,8 @@ fn main() {
     println!("all conditions");
     line("aligned", &all.0);
     line("stretched", &all.1);
-    println!("{audio:.1} s of audio analysed and aligned in {work:.2} s: {:.0}x real time", audio / work.max(1e-9));
+    println!(
+        "{audio:.1} s of audio analysed and aligned in {work:.2} s: {:.0}x real time",
+        audio / work.max(1e-9)
+    );
 }

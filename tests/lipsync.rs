@@ -82,26 +82,43 @@ fn cli_writes_a_stream_as_long_as_the_recording_and_a_json_report() {
     std::fs::write(dir.path().join("voice.txt"), text).unwrap();
     let o = fbakit(
         dir.path(),
-        &["lipsync", "voice.wav", "--text-file", "voice.txt", "-o", "voice.fap", "--json"],
+        &[
+            "lipsync",
+            "voice.wav",
+            "--text-file",
+            "voice.txt",
+            "-o",
+            "voice.fap",
+            "--json",
+        ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let seconds = report["audio_seconds"].as_f64().unwrap();
     let frames = report["frames"].as_u64().unwrap();
-    assert!((frames as f64 / 25.0 - seconds).abs() <= 0.02, "{frames} {seconds}");
+    assert!(
+        (frames as f64 / 25.0 - seconds).abs() <= 0.02,
+        "{frames} {seconds}"
+    );
     assert_eq!(report["method"], "transcript");
     let phones = report["phones"].as_array().unwrap();
     assert!(phones.iter().any(|p| p["symbol"] == "b"));
-    assert!(phones.windows(2).all(|w| w[0]["start"].as_f64() <= w[1]["start"].as_f64()));
-    assert!(phones.iter().all(|p| (0.0..=1.0).contains(&p["confidence"].as_f64().unwrap())));
+    assert!(phones
+        .windows(2)
+        .all(|w| w[0]["start"].as_f64() <= w[1]["start"].as_f64()));
+    assert!(phones
+        .iter()
+        .all(|p| (0.0..=1.0).contains(&p["confidence"].as_f64().unwrap())));
     let visemes = report["visemes"].as_array().unwrap();
     assert_eq!(visemes.len() as u64, frames);
     assert!(visemes.iter().any(|v| v["viseme"] == "PP"));
     // The lead-in silence is neutral.
     assert_eq!(visemes[2]["viseme"], "sil");
-    let (stream, _) =
-        fbakit::fap::read_fap_file(&dir.path().join("voice.fap"), &fbakit::fap::ReadOptions::strict())
-            .unwrap();
+    let (stream, _) = fbakit::fap::read_fap_file(
+        &dir.path().join("voice.fap"),
+        &fbakit::fap::ReadOptions::strict(),
+    )
+    .unwrap();
     assert_eq!(stream.frames.len() as u64, frames);
 }
 
@@ -161,7 +178,10 @@ fn bad_recordings_and_transcripts_exit_2_naming_the_file_and_write_nothing() {
         assert!(!d.join("out.fap").exists(), "{file}");
     }
     // Without a transcript only English is recognised.
-    let o = fbakit(d, &["lipsync", "voice.wav", "--lang", "de", "-o", "out.fap"]);
+    let o = fbakit(
+        d,
+        &["lipsync", "voice.wav", "--lang", "de", "-o", "out.fap"],
+    );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--text"), "{}", stderr(&o));
     // An output that is not accepted.
@@ -182,13 +202,24 @@ fn without_a_transcript_english_phones_are_recognised() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    recording(dir.path(), "voice.wav", "Bob brought a big blue balloon to the beach.");
-    let o = fbakit(dir.path(), &["lipsync", "voice.wav", "-o", "voice.fap", "--json"]);
+    recording(
+        dir.path(),
+        "voice.wav",
+        "Bob brought a big blue balloon to the beach.",
+    );
+    let o = fbakit(
+        dir.path(),
+        &["lipsync", "voice.wav", "-o", "voice.fap", "--json"],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(report["method"], "recognition");
     let phones = report["phones"].as_array().unwrap();
     assert!(phones.len() > 10, "{phones:?}");
     assert!(phones.iter().any(|p| p["symbol"] == "SIL"));
-    assert!(report["visemes"].as_array().unwrap().iter().any(|v| v["viseme"] != "sil"));
+    assert!(report["visemes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|v| v["viseme"] != "sil"));
 }

@@ -115,7 +115,10 @@ fn transcript(a: &LipsyncArgs) -> Result<Option<String>> {
             String::from_utf8(bytes).map(Some).map_err(|_| {
                 Error::io(
                     path,
-                    std::io::Error::new(std::io::ErrorKind::InvalidData, "the transcript is not UTF-8 text"),
+                    std::io::Error::new(
+                        std::io::ErrorKind::InvalidData,
+                        "the transcript is not UTF-8 text",
+                    ),
                 )
             })
         }
@@ -153,7 +156,8 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
     fbakit::format::refuse_overwriting_input(&a.output, &inputs)?;
     if kind == OutputFormat::Csv && a.fp.is_none() {
         return Err(Error::Usage(
-            ".csv (ARKit weights) needs an ARKit rig as --face and its feature points as --fp".into(),
+            ".csv (ARKit weights) needs an ARKit rig as --face and its feature points as --fp"
+                .into(),
         ));
     }
     let text = transcript(&a)?;
@@ -181,7 +185,8 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
         }
         None => {
             let bar = progress_bar(1000, "recognising");
-            let phones = recognise_file(&a.recording, &mut |f| bar.set_position((f * 1000.0) as u64));
+            let phones =
+                recognise_file(&a.recording, &mut |f| bar.set_position((f * 1000.0) as u64));
             bar.finish_and_clear();
             lipsync_recognised(&rec, phones?, a.fps)?
         }
@@ -199,7 +204,9 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
         (Some(face), OutputFormat::Html) => {
             talking_head = Some(super::speak::write_page(face, &stream, &a.output)?);
         }
-        (Some(face), OutputFormat::Glb) => talking_head = Some(write_glb(face, &stream, &a.output)?),
+        (Some(face), OutputFormat::Glb) => {
+            talking_head = Some(write_glb(face, &stream, &a.output)?)
+        }
         (Some(face), _) => {
             let job = super::render::VideoJob {
                 output: &a.output,
@@ -208,7 +215,13 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
                 fps: None,
                 audio: (kind == OutputFormat::Mp4).then_some(a.recording.as_path()),
             };
-            let video = super::render::write_video(face, &stream, &a.recording.display().to_string(), &job, Vec::new())?;
+            let video = super::render::write_video(
+                face,
+                &stream,
+                &a.recording.display().to_string(),
+                &job,
+                Vec::new(),
+            )?;
             talking_head = Some(serde_json::to_value(&video).unwrap_or_default());
         }
         (None, _) => unreachable!("faces are read for every head output"),
@@ -237,7 +250,11 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
         audio_seconds: rec.seconds,
         speech_seconds: rec.activity.speech_seconds,
         lang: a.lang.clone(),
-        method: if text.is_some() { "transcript" } else { "recognition" },
+        method: if text.is_some() {
+            "transcript"
+        } else {
+            "recognition"
+        },
         output: a.output.display().to_string(),
         confidence: sync.confidence,
         frames: stream.frames.len(),
@@ -262,7 +279,10 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
     }
     let what = match kind {
         OutputFormat::Fap | OutputFormat::Json => "FAP stream".to_string(),
-        OutputFormat::Mp4 => format!("`{}` speaking, with the recording as its soundtrack", a.face.display()),
+        OutputFormat::Mp4 => format!(
+            "`{}` speaking, with the recording as its soundtrack",
+            a.face.display()
+        ),
         OutputFormat::Html => format!("viewer page of `{}` speaking (silent)", a.face.display()),
         OutputFormat::Csv => "ARKit weights".to_string(),
         _ => format!("`{}` speaking", a.face.display()),
@@ -287,10 +307,18 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
 }
 
 /// The face playing `stream` as an animated glTF binary.
-fn write_glb(face: &fbakit::face::FaceModel, stream: &fbakit::fap::FapStream, path: &Path) -> Result<serde_json::Value> {
+fn write_glb(
+    face: &fbakit::face::FaceModel,
+    stream: &fbakit::fap::FapStream,
+    path: &Path,
+) -> Result<serde_json::Value> {
     use fbakit::player::{PlayOptions, Player};
     let player = Player::new(face, stream, PlayOptions::default())?;
-    super::play::with_play_hint(fbakit::export::budget::check_clip(path, &player.frame_range(), face))?;
+    super::play::with_play_hint(fbakit::export::budget::check_clip(
+        path,
+        &player.frame_range(),
+        face,
+    ))?;
     let anim = player.animation()?;
     let export = fbakit::export::gltf::export_face_with_units(face, Some(&anim), None)?;
     super::print_warnings(&export.warnings);

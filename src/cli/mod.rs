@@ -29,11 +29,11 @@ mod fap_arkit;
 mod fapu;
 mod fp;
 mod inputs;
+mod lipsync;
 pub mod play;
 mod render;
 mod rig;
 mod show;
-mod lipsync;
 mod speak;
 mod view;
 

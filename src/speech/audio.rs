@@ -53,7 +53,9 @@ pub struct AudioReader {
 
 impl std::fmt::Debug for AudioReader {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("AudioReader").field("info", &self.info).finish()
+        f.debug_struct("AudioReader")
+            .field("info", &self.info)
+            .finish()
     }
 }
 
@@ -75,9 +77,16 @@ pub fn open_audio(path: &Path) -> Result<AudioReader> {
     let mut head = [0u8; 12];
     let mut reader = BufReader::new(file);
     let n = read_up_to(&mut reader, &mut head).map_err(|e| Error::io(path, e))?;
-    let chained: Box<dyn Read + Send> = Box::new(std::io::Cursor::new(head[..n].to_vec()).chain(reader));
+    let chained: Box<dyn Read + Send> =
+        Box::new(std::io::Cursor::new(head[..n].to_vec()).chain(reader));
     if n < 12 || &head[..4] != b"RIFF" || &head[8..12] != b"WAVE" {
-        return Err(bad(path, format!("{}; fbakit reads WAV (RIFF/WAVE) recordings", sniff(&head[..n]))));
+        return Err(bad(
+            path,
+            format!(
+                "{}; fbakit reads WAV (RIFF/WAVE) recordings",
+                sniff(&head[..n])
+            ),
+        ));
     }
     AudioReader::from_wav(chained, path)
 }
@@ -95,7 +104,10 @@ fn read_up_to(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
 
 /// A name for what a file that is not WAV looks like, from its first bytes.
 fn sniff(head: &[u8]) -> String {
-    let what = if head.starts_with(b"ID3") || head.starts_with(&[0xFF, 0xFB]) || head.starts_with(&[0xFF, 0xF3]) {
+    let what = if head.starts_with(b"ID3")
+        || head.starts_with(&[0xFF, 0xFB])
+        || head.starts_with(&[0xFF, 0xF3])
+    {
         "an MP3 file"
     } else if head.starts_with(b"fLaC") {
         "a FLAC file"
@@ -119,7 +131,10 @@ impl AudioReader {
         let wav = hound::WavReader::new(reader).map_err(|e| bad(path, wav_detail(&e)))?;
         let spec = wav.spec();
         if spec.channels == 0 || spec.channels > MAX_CHANNELS {
-            return Err(bad(path, format!("{} channels (1 to {MAX_CHANNELS} accepted)", spec.channels)));
+            return Err(bad(
+                path,
+                format!("{} channels (1 to {MAX_CHANNELS} accepted)", spec.channels),
+            ));
         }
         if !(MIN_SAMPLE_RATE..=MAX_SAMPLE_RATE).contains(&spec.sample_rate) {
             return Err(SpeechError::BadSampleRate {
@@ -145,7 +160,13 @@ impl AudioReader {
             hound::SampleFormat::Float => "float",
         };
         if spec.sample_format == hound::SampleFormat::Float && spec.bits_per_sample != 32 {
-            return Err(bad(path, format!("{}-bit float samples (32-bit float accepted)", spec.bits_per_sample)));
+            return Err(bad(
+                path,
+                format!(
+                    "{}-bit float samples (32-bit float accepted)",
+                    spec.bits_per_sample
+                ),
+            ));
         }
         Ok(AudioReader {
             info: AudioInfo {
@@ -181,7 +202,11 @@ impl AudioReader {
             hound::SampleFormat::Float => {
                 for s in self.wav.samples::<f32>().take(want) {
                     let s = s.map_err(|e| bad(&path, wav_detail(&e)))?;
-                    interleaved.push(if s.is_finite() { s.clamp(-1.0, 1.0) } else { 0.0 });
+                    interleaved.push(if s.is_finite() {
+                        s.clamp(-1.0, 1.0)
+                    } else {
+                        0.0
+                    });
                 }
             }
             hound::SampleFormat::Int => {
@@ -193,7 +218,10 @@ impl AudioReader {
             }
         }
         if interleaved.len() % channels != 0 {
-            return Err(bad(&path, "the file ends inside a sample frame (truncated?)"));
+            return Err(bad(
+                &path,
+                "the file ends inside a sample frame (truncated?)",
+            ));
         }
         let mono: Vec<f32> = interleaved
             .chunks_exact(channels)
@@ -208,7 +236,9 @@ impl AudioReader {
             }
             .into());
         }
-        let mut out = Vec::with_capacity(mono.len() * ANALYSIS_RATE as usize / self.spec.sample_rate as usize + 2);
+        let mut out = Vec::with_capacity(
+            mono.len() * ANALYSIS_RATE as usize / self.spec.sample_rate as usize + 2,
+        );
         if mono.len() < CHUNK_FRAMES {
             self.done = true;
             self.resampler.push(&mono, &mut out);
@@ -313,7 +343,8 @@ impl Resampler {
             self.next += self.step;
         }
         // Drop input no later output can reach.
-        let keep_from = (self.next.floor() as i64 - self.half as i64).max(self.offset as i64) as u64;
+        let keep_from =
+            (self.next.floor() as i64 - self.half as i64).max(self.offset as i64) as u64;
         let drop = (keep_from - self.offset) as usize;
         if drop > 0 && drop <= self.buf.len() {
             self.buf.drain(..drop);
@@ -366,7 +397,8 @@ mod tests {
     }
 
     fn read_all(bytes: Vec<u8>) -> Result<Vec<f32>> {
-        let mut r = AudioReader::from_wav(Box::new(std::io::Cursor::new(bytes)), Path::new("x.wav"))?;
+        let mut r =
+            AudioReader::from_wav(Box::new(std::io::Cursor::new(bytes)), Path::new("x.wav"))?;
         let mut all = Vec::new();
         while let Some(c) = r.next_chunk()? {
             all.extend(c);
@@ -378,39 +410,74 @@ mod tests {
     fn a_tone_keeps_its_length_and_level_through_resampling() {
         let rate = 44_100;
         let n = rate as usize; // one second
-        let spec = hound::WavSpec { channels: 2, sample_rate: rate, bits_per_sample: 16, sample_format: hound::SampleFormat::Int };
+        let spec = hound::WavSpec {
+            channels: 2,
+            sample_rate: rate,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
         let mut s = Vec::new();
         for i in 0..n {
-            let v = (0.5 * (2.0 * std::f64::consts::PI * 440.0 * i as f64 / f64::from(rate)).sin() * 32767.0) as i32;
+            let v = (0.5
+                * (2.0 * std::f64::consts::PI * 440.0 * i as f64 / f64::from(rate)).sin()
+                * 32767.0) as i32;
             s.push(v);
             s.push(v);
         }
         let out = read_all(wav(spec, &s)).unwrap();
         assert!((out.len() as i64 - 16_000).abs() <= 2, "{}", out.len());
-        let rms = (out[1000..15000].iter().map(|x| f64::from(*x).powi(2)).sum::<f64>() / 14000.0).sqrt();
+        let rms = (out[1000..15000]
+            .iter()
+            .map(|x| f64::from(*x).powi(2))
+            .sum::<f64>()
+            / 14000.0)
+            .sqrt();
         assert!((rms - 0.5 / 2f64.sqrt()).abs() < 0.01, "{rms}");
     }
 
     #[test]
     fn downsampling_removes_what_16_khz_cannot_hold() {
         let rate = 48_000;
-        let spec = hound::WavSpec { channels: 1, sample_rate: rate, bits_per_sample: 24, sample_format: hound::SampleFormat::Int };
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: rate,
+            bits_per_sample: 24,
+            sample_format: hound::SampleFormat::Int,
+        };
         // 12 kHz is above the 8 kHz Nyquist frequency of the analysis rate.
         let s: Vec<i32> = (0..rate as usize)
-            .map(|i| ((2.0 * std::f64::consts::PI * 12_000.0 * i as f64 / f64::from(rate)).sin() * 4_000_000.0) as i32)
+            .map(|i| {
+                ((2.0 * std::f64::consts::PI * 12_000.0 * i as f64 / f64::from(rate)).sin()
+                    * 4_000_000.0) as i32
+            })
             .collect();
         let out = read_all(wav(spec, &s)).unwrap();
-        let rms = (out[1000..15000].iter().map(|x| f64::from(*x).powi(2)).sum::<f64>() / 14000.0).sqrt();
+        let rms = (out[1000..15000]
+            .iter()
+            .map(|x| f64::from(*x).powi(2))
+            .sum::<f64>()
+            / 14000.0)
+            .sqrt();
         assert!(rms < 0.01, "{rms}");
     }
 
     #[test]
     fn bad_recordings_are_refused_with_a_reason() {
-        let spec = hound::WavSpec { channels: 1, sample_rate: 1, bits_per_sample: 16, sample_format: hound::SampleFormat::Int };
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: 1,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
         let e = read_all(wav(spec, &[0, 1, 2])).unwrap_err();
         assert!(e.to_string().contains("1 Hz"), "{e}");
         assert!(e.is_input_error());
-        let spec = hound::WavSpec { channels: 1, sample_rate: 16_000, bits_per_sample: 16, sample_format: hound::SampleFormat::Int };
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: 16_000,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
         let mut bytes = wav(spec, &vec![100; 10_000]);
         bytes.truncate(bytes.len() - 5_001);
         let e = read_all(bytes).unwrap_err();

@@ -33,7 +33,10 @@ impl Activity {
     /// Why there is no speech, when there is none.
     pub fn no_speech(&self) -> Option<String> {
         if self.peak_db < MIN_PEAK_DB {
-            return Some(format!("no speech: the recording is silent (peaks at {:.0} dBFS)", self.peak_db));
+            return Some(format!(
+                "no speech: the recording is silent (peaks at {:.0} dBFS)",
+                self.peak_db
+            ));
         }
         if self.peak_db - self.floor_db < MIN_DYNAMIC_RANGE_DB {
             return Some(format!(
@@ -42,7 +45,10 @@ impl Activity {
             ));
         }
         if self.speech_seconds < 0.1 {
-            return Some(format!("no speech found: {:.2} s above the noise floor", self.speech_seconds));
+            return Some(format!(
+                "no speech found: {:.2} s above the noise floor",
+                self.speech_seconds
+            ));
         }
         None
     }
@@ -71,7 +77,11 @@ pub fn activity(frames: &[FeatureFrame]) -> Activity {
             (false, None) => run_start = Some(k),
             (true, Some(a)) => {
                 if k - a >= MIN_SILENCE_FRAMES {
-                    let start = if a == 0 { 0.0 } else { frame_time(a) - 0.5 * HOP_SECONDS };
+                    let start = if a == 0 {
+                        0.0
+                    } else {
+                        frame_time(a) - 0.5 * HOP_SECONDS
+                    };
                     silences.push((start, frame_time(k - 1) + 0.5 * HOP_SECONDS));
                 }
                 run_start = None;
@@ -98,13 +108,27 @@ mod tests {
     fn frames(levels: &[(f32, usize)]) -> Vec<FeatureFrame> {
         levels
             .iter()
-            .flat_map(|&(db, n)| std::iter::repeat_n(FeatureFrame { mfcc: [0.0; 13], energy_db: db }, n))
+            .flat_map(|&(db, n)| {
+                std::iter::repeat_n(
+                    FeatureFrame {
+                        mfcc: [0.0; 13],
+                        energy_db: db,
+                    },
+                    n,
+                )
+            })
             .collect()
     }
 
     #[test]
     fn speech_between_silences() {
-        let a = activity(&frames(&[(-70.0, 50), (-20.0, 100), (-70.0, 5), (-20.0, 100), (-70.0, 40)]));
+        let a = activity(&frames(&[
+            (-70.0, 50),
+            (-20.0, 100),
+            (-70.0, 5),
+            (-20.0, 100),
+            (-70.0, 40),
+        ]));
         assert!(a.no_speech().is_none());
         assert_eq!(a.silences.len(), 2, "{:?}", a.silences);
         assert!(a.silences[0].0 == 0.0 && (a.silences[0].1 - 0.5).abs() < 0.011);
@@ -114,7 +138,9 @@ mod tests {
     #[test]
     fn silence_and_steady_noise_have_no_speech() {
         assert!(activity(&frames(&[(-120.0, 300)])).no_speech().is_some());
-        assert!(activity(&frames(&[(-30.0, 150), (-27.0, 150)])).no_speech().is_some());
+        assert!(activity(&frames(&[(-30.0, 150), (-27.0, 150)]))
+            .no_speech()
+            .is_some());
         assert!(activity(&[]).no_speech().is_some());
     }
 }

@@ -29,11 +29,20 @@ pub struct WarpPath {
 
 /// The distance between two frames.
 pub fn distance<const N: usize>(a: &[f32; N], b: &[f32; N]) -> f32 {
-    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f32>().sqrt()
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f32>()
+        .sqrt()
 }
 
 /// Aligns `a` with `b` (both non-empty); `None` when either is empty.
-pub fn warp<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize, penalty: f32) -> Option<WarpPath> {
+pub fn warp<const N: usize>(
+    a: &[[f32; N]],
+    b: &[[f32; N]],
+    radius: usize,
+    penalty: f32,
+) -> Option<WarpPath> {
     if a.is_empty() || b.is_empty() {
         return None;
     }
@@ -43,7 +52,10 @@ pub fn warp<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize, penal
         .map(|&(i, j)| f64::from(distance(&a[i as usize], &b[j as usize])))
         .sum();
     let mean_distance = total / pairs.len() as f64;
-    Some(WarpPath { pairs, mean_distance })
+    Some(WarpPath {
+        pairs,
+        mean_distance,
+    })
 }
 
 fn halve<const N: usize>(x: &[[f32; N]]) -> Vec<[f32; N]> {
@@ -60,7 +72,12 @@ fn halve<const N: usize>(x: &[[f32; N]]) -> Vec<[f32; N]> {
         .collect()
 }
 
-fn fast_dtw<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize, penalty: f32) -> Vec<(u32, u32)> {
+fn fast_dtw<const N: usize>(
+    a: &[[f32; N]],
+    b: &[[f32; N]],
+    radius: usize,
+    penalty: f32,
+) -> Vec<(u32, u32)> {
     let (n, m) = (a.len(), b.len());
     if n.saturating_mul(m) <= FULL_CELLS || n < 4 * radius || m < 4 * radius {
         let band: Vec<(usize, usize)> = if n.saturating_mul(m) <= FULL_CELLS {
@@ -78,7 +95,11 @@ fn fast_dtw<const N: usize>(a: &[[f32; N]], b: &[[f32; N]], radius: usize, penal
 
 /// Rows' column ranges around the straight line from (0, 0) to (n − 1, m − 1).
 fn diagonal_band(n: usize, m: usize, half: usize) -> Vec<(usize, usize)> {
-    let slope = if n > 1 { (m - 1) as f64 / (n - 1) as f64 } else { 0.0 };
+    let slope = if n > 1 {
+        (m - 1) as f64 / (n - 1) as f64
+    } else {
+        0.0
+    };
     (0..n)
         .map(|i| {
             let c = (i as f64 * slope).round() as usize;
@@ -144,13 +165,21 @@ fn banded_dtw<const N: usize>(
                 cur[k] = d;
                 continue;
             }
-            let up = if i > 0 && j >= prev_lo && j - prev_lo < prev.len() { prev[j - prev_lo] + d + penalty } else { f32::INFINITY };
+            let up = if i > 0 && j >= prev_lo && j - prev_lo < prev.len() {
+                prev[j - prev_lo] + d + penalty
+            } else {
+                f32::INFINITY
+            };
             let diag = if i > 0 && j > prev_lo && j - 1 - prev_lo < prev.len() {
                 prev[j - 1 - prev_lo] + 2.0 * d
             } else {
                 f32::INFINITY
             };
-            let left = if k > 0 { cur[k - 1] + d + penalty } else { f32::INFINITY };
+            let left = if k > 0 {
+                cur[k - 1] + d + penalty
+            } else {
+                f32::INFINITY
+            };
             let (best, dir) = if diag <= up && diag <= left {
                 (diag, DIAG)
             } else if up <= left {
@@ -251,10 +280,18 @@ mod tests {
         // A slow sine and a version sped up in its middle: 3000 × 2600 cells is above the
         // full-matrix limit only when the limit is low, so compare against the banded
         // search's own full-band answer.
-        let a: Vec<[f32; 2]> = (0..3000).map(|i| [(i as f32 * 0.01).sin(), (i as f32 * 0.023).cos()]).collect();
+        let a: Vec<[f32; 2]> = (0..3000)
+            .map(|i| [(i as f32 * 0.01).sin(), (i as f32 * 0.023).cos()])
+            .collect();
         let b: Vec<[f32; 2]> = (0..2600)
             .map(|j| {
-                let t = if j < 1000 { j as f32 } else if j < 1600 { 1000.0 + (j - 1000) as f32 * 1.666 } else { 2000.0 + (j - 1600) as f32 };
+                let t = if j < 1000 {
+                    j as f32
+                } else if j < 1600 {
+                    1000.0 + (j - 1000) as f32 * 1.666
+                } else {
+                    2000.0 + (j - 1600) as f32
+                };
                 [(t * 0.01).sin(), (t * 0.023).cos()]
             })
             .collect();
@@ -262,9 +299,16 @@ mod tests {
         let full = banded_dtw(&halve(&a), &halve(&b), &vec![(0, 1299); 1500], 0.0);
         check_path(&fast, 1500, 1300);
         let cost = |p: &[(u32, u32)]| -> f64 {
-            p.iter().map(|&(i, j)| f64::from(distance(&halve(&a)[i as usize], &halve(&b)[j as usize]))).sum()
+            p.iter()
+                .map(|&(i, j)| f64::from(distance(&halve(&a)[i as usize], &halve(&b)[j as usize])))
+                .sum()
         };
-        assert!(cost(&fast) <= cost(&full) * 1.05 + 1e-3, "{} vs {}", cost(&fast), cost(&full));
+        assert!(
+            cost(&fast) <= cost(&full) * 1.05 + 1e-3,
+            "{} vs {}",
+            cost(&fast),
+            cost(&full)
+        );
         // And the recursive search on the full sequences stays within a corridor's memory.
         let band = project(&fast, 3000, 2600, 12);
         let cells: usize = band.iter().map(|(lo, hi)| hi + 1 - lo).sum();

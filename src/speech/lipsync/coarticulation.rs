@@ -10,10 +10,10 @@
 //! - silences in the recording relax the mouth to neutral (viseme 0), whatever the
 //!   transcript placed there (except closures, which are never dropped).
 
+use crate::spec::Viseme;
 use crate::speech::animation::{viseme_keys, VisemeKey};
 use crate::speech::espeak::TimedPhoneme;
 use crate::speech::phonemes::{PhonemeVisemeTable, VisemeTarget};
-use crate::spec::Viseme;
 
 /// The five mouth classes lip reading distinguishes (and silence).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -88,8 +88,14 @@ pub fn lipsync_keys(
         let margin = (0.25 * (e - s)).min(0.08);
         let (a, b) = (s + margin, e - margin);
         keys.retain(|k| k.time <= a || k.time >= b || k.viseme.number() == 1);
-        keys.push(VisemeKey { time: a, viseme: v(0) });
-        keys.push(VisemeKey { time: b, viseme: v(0) });
+        keys.push(VisemeKey {
+            time: a,
+            viseme: v(0),
+        });
+        keys.push(VisemeKey {
+            time: b,
+            viseme: v(0),
+        });
     }
     // Closures: PP on every frame inside the phone, at least the one nearest its middle.
     let mut closures: Vec<(f64, f64)> = Vec::new();
@@ -115,9 +121,15 @@ pub fn lipsync_keys(
         keys.retain(|k| k.time < a - 0.5 * frame || k.time > b + 0.5 * frame);
     }
     for &(a, b) in &closures {
-        keys.push(VisemeKey { time: a, viseme: v(1) });
+        keys.push(VisemeKey {
+            time: a,
+            viseme: v(1),
+        });
         if b > a {
-            keys.push(VisemeKey { time: b, viseme: v(1) });
+            keys.push(VisemeKey {
+                time: b,
+                viseme: v(1),
+            });
         }
     }
     keys.sort_by(|x, y| x.time.total_cmp(&y.time));
@@ -141,12 +153,20 @@ fn held_keys(
     let mut keys = Vec::with_capacity(2 * centre.len());
     for k in centre {
         // The phone whose middle this key is (glides and edge keys are left as they are).
-        let phone = phones.iter().find(|p| (0.5 * (p.start + p.end) - k.time).abs() < 1e-9);
+        let phone = phones
+            .iter()
+            .find(|p| (0.5 * (p.start + p.end) - k.time).abs() < 1e-9);
         match phone {
             Some(p) if p.end - p.start >= 2.0 * frame => {
                 let len = p.end - p.start;
-                keys.push(VisemeKey { time: p.start + edge * len, viseme: k.viseme });
-                keys.push(VisemeKey { time: p.end - edge * len, viseme: k.viseme });
+                keys.push(VisemeKey {
+                    time: p.start + edge * len,
+                    viseme: k.viseme,
+                });
+                keys.push(VisemeKey {
+                    time: p.end - edge * len,
+                    viseme: k.viseme,
+                });
             }
             _ => keys.push(k),
         }
@@ -213,7 +233,11 @@ mod tests {
     use crate::speech::animation::viseme_at;
 
     fn p(symbol: &str, start: f64, end: f64) -> TimedPhoneme {
-        TimedPhoneme { symbol: symbol.into(), start, end }
+        TimedPhoneme {
+            symbol: symbol.into(),
+            start,
+            end,
+        }
     }
 
     fn dominant_at(keys: &[VisemeKey], n: u64, fps: f64) -> u8 {
@@ -242,7 +266,10 @@ mod tests {
             .collect();
         let (keys, _) = lipsync_keys(&ph, 0.3, &[], 25.0);
         for w in keys.windows(2) {
-            assert!(w[1].time - w[0].time >= 0.0399 || w[0].viseme == w[1].viseme, "{keys:?}");
+            assert!(
+                w[1].time - w[0].time >= 0.0399 || w[0].viseme == w[1].viseme,
+                "{keys:?}"
+            );
         }
         // The m closure survived the merging.
         assert!(keys.iter().any(|k| k.viseme.number() == 1));
@@ -250,7 +277,12 @@ mod tests {
 
     #[test]
     fn silences_relax_to_rest_but_keep_closures() {
-        let ph = vec![p("a", 0.0, 0.3), p("t", 0.3, 0.9), p("m", 0.95, 1.0), p("a", 1.0, 1.3)];
+        let ph = vec![
+            p("a", 0.0, 0.3),
+            p("t", 0.3, 0.9),
+            p("m", 0.95, 1.0),
+            p("a", 1.0, 1.3),
+        ];
         let (keys, _) = lipsync_keys(&ph, 1.3, &[(0.35, 0.9)], 25.0);
         let mid = dominant_at(&keys, 15, 25.0); // 0.6 s, inside the silence
         assert_eq!(mid, 0);
@@ -261,7 +293,10 @@ mod tests {
     fn rounding_is_anticipated() {
         let ph = vec![p("t", 0.0, 0.1), p("u:", 0.1, 0.3)];
         let (keys, _) = lipsync_keys(&ph, 0.3, &[], 25.0);
-        let ou = keys.iter().find(|k| MouthClass::of(k.viseme) == MouthClass::Rounded).unwrap();
+        let ou = keys
+            .iter()
+            .find(|k| MouthClass::of(k.viseme) == MouthClass::Rounded)
+            .unwrap();
         assert!(ou.time < 0.2, "{}", ou.time);
     }
 }

@@ -92,7 +92,9 @@ pub fn score(truth: &[TimedPhoneme], frames: &[VisemeParams], fps: f64) -> Lipsy
         s.closures += 1;
         let first = ((p.start - CLOSURE_TOLERANCE) * fps).ceil().max(0.0) as usize;
         let last = ((p.end + CLOSURE_TOLERANCE) * fps).floor().max(0.0) as usize;
-        if (first..=last.min(shown.len().saturating_sub(1))).any(|n| shown.get(n) == Some(&MouthClass::Closed)) {
+        if (first..=last.min(shown.len().saturating_sub(1)))
+            .any(|n| shown.get(n) == Some(&MouthClass::Closed))
+        {
             s.closures_shown += 1;
         }
     }
@@ -101,7 +103,11 @@ pub fn score(truth: &[TimedPhoneme], frames: &[VisemeParams], fps: f64) -> Lipsy
         let Some(p) = truth.iter().find(|p| p.start <= t && t < p.end) else {
             continue;
         };
-        let share = if p.end > p.start { (t - p.start) / (p.end - p.start) } else { 0.0 };
+        let share = if p.end > p.start {
+            (t - p.start) / (p.end - p.start)
+        } else {
+            0.0
+        };
         let Some(want) = truth_class(p, share) else {
             continue;
         };
@@ -123,21 +129,41 @@ mod tests {
     use crate::spec::Viseme;
 
     fn p(symbol: &str, start: f64, end: f64) -> TimedPhoneme {
-        TimedPhoneme { symbol: symbol.into(), start, end }
+        TimedPhoneme {
+            symbol: symbol.into(),
+            start,
+            end,
+        }
     }
 
     fn held(n: u8) -> VisemeParams {
         let v = Viseme::new(n).unwrap();
-        VisemeParams { select1: v, select2: v, blend: 63, def: false }
+        VisemeParams {
+            select1: v,
+            select2: v,
+            blend: 63,
+            def: false,
+        }
     }
 
     #[test]
     fn a_perfect_and_a_wrong_stream() {
         // "ma" at 25 fps: m for 0.0-0.12 s, a for 0.12-0.4 s.
         let truth = vec![p("m", 0.0, 0.12), p("a", 0.12, 0.4)];
-        let good: Vec<VisemeParams> = (0..10).map(|n| if n < 3 { held(1) } else { held(10) }).collect();
+        let good: Vec<VisemeParams> = (0..10)
+            .map(|n| if n < 3 { held(1) } else { held(10) })
+            .collect();
         let s = score(&truth, &good, 25.0);
-        assert_eq!((s.closures, s.closures_shown, s.speech_frames, s.agreeing_frames, s.false_closures), (1, 1, 10, 10, 0));
+        assert_eq!(
+            (
+                s.closures,
+                s.closures_shown,
+                s.speech_frames,
+                s.agreeing_frames,
+                s.false_closures
+            ),
+            (1, 1, 10, 10, 0)
+        );
         let bad: Vec<VisemeParams> = (0..10).map(|_| held(1)).collect();
         let s = score(&truth, &bad, 25.0);
         assert_eq!(s.closure_rate(), 1.0);
@@ -187,7 +213,10 @@ pub fn degrade(
     let input: Vec<f32> = u.samples.iter().map(|&s| f32::from(s) / 32_768.0).collect();
     rs.push(&input, &mut x);
     rs.finish(&mut x);
-    x.extend(std::iter::repeat_n(0.0, (0.3 * f64::from(d.sample_rate)) as usize));
+    x.extend(std::iter::repeat_n(
+        0.0,
+        (0.3 * f64::from(d.sample_rate)) as usize,
+    ));
     if let Some(snr) = d.snr_db {
         let speech: Vec<f64> = input.iter().map(|s| f64::from(*s).powi(2)).collect();
         let rms = (speech.iter().sum::<f64>() / speech.len().max(1) as f64).sqrt();
@@ -213,7 +242,9 @@ pub fn degrade(
         sample_format: hound::SampleFormat::Int,
     };
     let mut cursor = std::io::Cursor::new(Vec::new());
-    let encode = |e: hound::Error| -> crate::error::Error { crate::error::EncodeError::new("WAV", e).into() };
+    let encode = |e: hound::Error| -> crate::error::Error {
+        crate::error::EncodeError::new("WAV", e).into()
+    };
     let mut w = hound::WavWriter::new(&mut cursor, spec).map_err(encode)?;
     for s in &x {
         let v = (s.clamp(-1.0, 1.0) * 32_767.0).round() as i16;

@@ -69,13 +69,17 @@ impl FeatureExtractor {
     /// A new extractor.
     pub fn new() -> FeatureExtractor {
         let window = (0..WINDOW)
-            .map(|n| (0.54 - 0.46 * (2.0 * std::f64::consts::PI * n as f64 / (WINDOW - 1) as f64).cos()) as f32)
+            .map(|n| {
+                (0.54 - 0.46 * (2.0 * std::f64::consts::PI * n as f64 / (WINDOW - 1) as f64).cos())
+                    as f32
+            })
             .collect();
         let dct = (0..CEPS)
             .map(|c| {
                 let mut row = [0f32; MELS];
                 for (m, r) in row.iter_mut().enumerate() {
-                    *r = (std::f64::consts::PI * c as f64 * (m as f64 + 0.5) / MELS as f64).cos() as f32;
+                    *r = (std::f64::consts::PI * c as f64 * (m as f64 + 0.5) / MELS as f64).cos()
+                        as f32;
                 }
                 row
             })
@@ -133,7 +137,11 @@ impl FeatureExtractor {
         let mut energy = 0f64;
         for n in 0..WINDOW {
             let x = self.pending[start + n];
-            let before = if start + n == 0 { self.previous } else { self.pending[start + n - 1] };
+            let before = if start + n == 0 {
+                self.previous
+            } else {
+                self.pending[start + n - 1]
+            };
             energy += f64::from(x) * f64::from(x);
             re[n] = (x - 0.97 * before) * self.window[n];
         }
@@ -178,7 +186,11 @@ fn mel_filters() -> Vec<(usize, Vec<f32>)> {
             let weights = (first..=last)
                 .map(|k| {
                     let k = k as f64;
-                    let w = if k <= b { (k - a) / (b - a) } else { (c - k) / (c - b) };
+                    let w = if k <= b {
+                        (k - a) / (b - a)
+                    } else {
+                        (c - k) / (c - b)
+                    };
                     w.max(0.0) as f32
                 })
                 .collect();
@@ -229,8 +241,12 @@ struct Fft {
 
 impl Fft {
     fn new(n: usize) -> Fft {
-        let cos = (0..n / 2).map(|k| (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos() as f32).collect();
-        let sin = (0..n / 2).map(|k| (-2.0 * std::f64::consts::PI * k as f64 / n as f64).sin() as f32).collect();
+        let cos = (0..n / 2)
+            .map(|k| (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos() as f32)
+            .collect();
+        let sin = (0..n / 2)
+            .map(|k| (-2.0 * std::f64::consts::PI * k as f64 / n as f64).sin() as f32)
+            .collect();
         Fft { n, cos, sin }
     }
 
@@ -271,17 +287,29 @@ mod tests {
     #[test]
     fn fft_finds_a_tone_in_its_bin() {
         let fft = Fft::new(64);
-        let mut re: Vec<f32> = (0..64).map(|n| (2.0 * std::f32::consts::PI * 5.0 * n as f32 / 64.0).cos()).collect();
+        let mut re: Vec<f32> = (0..64)
+            .map(|n| (2.0 * std::f32::consts::PI * 5.0 * n as f32 / 64.0).cos())
+            .collect();
         let mut im = vec![0f32; 64];
         fft.run(&mut re, &mut im);
-        let mag: Vec<f32> = re.iter().zip(&im).map(|(r, i)| (r * r + i * i).sqrt()).collect();
+        let mag: Vec<f32> = re
+            .iter()
+            .zip(&im)
+            .map(|(r, i)| (r * r + i * i).sqrt())
+            .collect();
         assert!((mag[5] - 32.0).abs() < 1e-3, "{}", mag[5]);
-        assert!(mag.iter().enumerate().filter(|(k, _)| *k != 5 && *k != 59).all(|(_, m)| *m < 1e-3));
+        assert!(mag
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| *k != 5 && *k != 59)
+            .all(|(_, m)| *m < 1e-3));
     }
 
     #[test]
     fn chunking_does_not_change_the_features() {
-        let samples: Vec<f32> = (0..16_000).map(|n| ((n as f32 * 0.05).sin() * (n as f32 * 0.0007).cos()) * 0.3).collect();
+        let samples: Vec<f32> = (0..16_000)
+            .map(|n| ((n as f32 * 0.05).sin() * (n as f32 * 0.0007).cos()) * 0.3)
+            .collect();
         let mut whole = FeatureExtractor::new();
         whole.push(&samples);
         let whole = whole.finish();

@@ -166,7 +166,7 @@ pub struct Lipsync {
 /// Below this overall confidence the transcript is refused: it does not match at all.
 pub const REFUSE_CONFIDENCE: f64 = 0.08;
 /// Below this overall confidence a warning says the fit is poor.
-pub const WARN_CONFIDENCE: f64 = 0.3;
+pub const WARN_CONFIDENCE: f64 = 0.5;
 /// The path's mean distance as a share of unrelated frames' at which confidence is 0 …
 const RATIO_NONE: f64 = 0.95;
 /// … and at which it is 1 (a rendition matched against itself under noise scores ~0.45).
@@ -211,11 +211,12 @@ pub fn render_transcript(text: &str, voice: &str) -> Result<Utterance> {
             Some(w) => {
                 let offset = w.duration();
                 w.samples.extend_from_slice(&u.samples);
-                w.phonemes.extend(u.phonemes.into_iter().map(|p| TimedPhoneme {
-                    start: p.start + offset,
-                    end: p.end + offset,
-                    ..p
-                }));
+                w.phonemes
+                    .extend(u.phonemes.into_iter().map(|p| TimedPhoneme {
+                        start: p.start + offset,
+                        end: p.end + offset,
+                        ..p
+                    }));
             }
         }
     }
@@ -247,7 +248,10 @@ fn rendition_features(u: &Utterance) -> Vec<FeatureFrame> {
     };
     for chunk in u.samples.chunks(16_384) {
         out.clear();
-        let f: Vec<f32> = chunk.iter().map(|&s| f32::from(s) / 32_768.0 + dither()).collect();
+        let f: Vec<f32> = chunk
+            .iter()
+            .map(|&s| f32::from(s) / 32_768.0 + dither())
+            .collect();
         rs.push(&f, &mut out);
         fx.push(&out);
     }
@@ -291,7 +295,11 @@ fn padded(mut u: Utterance, pad: f64) -> Utterance {
 }
 
 /// Aligns `text` with the analysed recording and makes its viseme keys at `fps`.
-pub fn lipsync_transcript(rec: &RecordingAnalysis, text: &str, opts: &LipsyncOptions) -> Result<Lipsync> {
+pub fn lipsync_transcript(
+    rec: &RecordingAnalysis,
+    text: &str,
+    opts: &LipsyncOptions,
+) -> Result<Lipsync> {
     lipsync_transcript_at(rec, text, opts, super::animation::SPEECH_FPS)
 }
 
@@ -330,8 +338,13 @@ pub fn lipsync_transcript_at(
     let b = normalise(&rec.frames);
     let unrelated = unrelated_distance(&a, &b);
     let penalty = (opts.step_penalty * unrelated) as f32;
-    let path = warp(&a, &b, opts.radius, penalty).ok_or_else(|| cannot("nothing to align".into()))?;
-    let ratio = if unrelated > 0.0 { path.mean_distance / unrelated } else { 1.0 };
+    let path =
+        warp(&a, &b, opts.radius, penalty).ok_or_else(|| cannot("nothing to align".into()))?;
+    let ratio = if unrelated > 0.0 {
+        path.mean_distance / unrelated
+    } else {
+        1.0
+    };
     let confidence = confidence_of(ratio);
     if confidence < REFUSE_CONFIDENCE {
         return Err(cannot(format!(
@@ -359,9 +372,18 @@ pub fn lipsync_transcript_at(
         let start = map_time(p.start).max(floor);
         let end = map_time(p.end).max(start);
         floor = start;
-        let (i0, i1) = (frame_at(p.start, a.len()), frame_at(p.end, a.len()).max(frame_at(p.start, a.len())));
-        let (sum, n) = rows[i0..=i1].iter().fold((0f64, 0u32), |(s, n), r| (s + f64::from(r.2), n + r.3));
-        let local = if n > 0 { sum / f64::from(n) } else { path.mean_distance };
+        let (i0, i1) = (
+            frame_at(p.start, a.len()),
+            frame_at(p.end, a.len()).max(frame_at(p.start, a.len())),
+        );
+        let (sum, n) = rows[i0..=i1]
+            .iter()
+            .fold((0f64, 0u32), |(s, n), r| (s + f64::from(r.2), n + r.3));
+        let local = if n > 0 {
+            sum / f64::from(n)
+        } else {
+            path.mean_distance
+        };
         phones.push(AlignedPhone {
             symbol: p.symbol.clone(),
             start,
@@ -373,11 +395,22 @@ pub fn lipsync_transcript_at(
     for k in 0..phones.len().saturating_sub(1) {
         phones[k].end = phones[k + 1].start.max(phones[k].start);
     }
-    Ok(finish(rec, phones, confidence, fps, |s| s.to_string(), false))
+    Ok(finish(
+        rec,
+        phones,
+        confidence,
+        fps,
+        |s| s.to_string(),
+        false,
+    ))
 }
 
 /// Phones recognised in the recording (ARPAbet, [`recognition`]) to a lip sync at `fps`.
-pub fn lipsync_recognised(rec: &RecordingAnalysis, phones: Vec<AlignedPhone>, fps: f64) -> Result<Lipsync> {
+pub fn lipsync_recognised(
+    rec: &RecordingAnalysis,
+    phones: Vec<AlignedPhone>,
+    fps: f64,
+) -> Result<Lipsync> {
     frame_count(rec.seconds, fps)?;
     if let Some(why) = rec.activity.no_speech() {
         return Err(SpeechError::NoSpeech {
@@ -386,7 +419,10 @@ pub fn lipsync_recognised(rec: &RecordingAnalysis, phones: Vec<AlignedPhone>, fp
         }
         .into());
     }
-    let spoken: Vec<&AlignedPhone> = phones.iter().filter(|p| recognition::arpabet_to_espeak(&p.symbol) != "_").collect();
+    let spoken: Vec<&AlignedPhone> = phones
+        .iter()
+        .filter(|p| recognition::arpabet_to_espeak(&p.symbol) != "_")
+        .collect();
     if spoken.is_empty() {
         return Err(SpeechError::NoSpeech {
             path: rec.source.clone(),

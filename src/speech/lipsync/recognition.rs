@@ -23,7 +23,8 @@ pub const MODEL_DIR: &str = "/usr/share/pocketsphinx/model/en-us";
 
 /// The acoustic model and phone language model, or why they are missing.
 fn model() -> Result<(PathBuf, PathBuf)> {
-    let dir = std::env::var_os("FBAKIT_POCKETSPHINX_MODEL").map_or_else(|| PathBuf::from(MODEL_DIR), PathBuf::from);
+    let dir = std::env::var_os("FBAKIT_POCKETSPHINX_MODEL")
+        .map_or_else(|| PathBuf::from(MODEL_DIR), PathBuf::from);
     let hmm = dir.join("en-us");
     let lm = dir.join("en-us-phone.lm.bin");
     if hmm.join("mdef").is_file() && lm.is_file() {
@@ -77,7 +78,8 @@ pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<
         let mut w = hound::WavWriter::create(&wav, spec).map_err(encode)?;
         while let Some(chunk) = reader.next_chunk()? {
             for s in chunk {
-                w.write_sample((s.clamp(-1.0, 1.0) * 32_767.0).round() as i16).map_err(encode)?;
+                w.write_sample((s.clamp(-1.0, 1.0) * 32_767.0).round() as i16)
+                    .map_err(encode)?;
             }
             progress((reader.frames_read() as f64 / total).min(1.0));
         }
@@ -91,12 +93,25 @@ pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<
         .arg("-allphone")
         .arg(&lm)
         .args(["-allphone_ci", "yes", "-backtrace", "yes", "-time", "yes"])
-        .args(["-beam", "1e-20", "-pbeam", "1e-20", "-lw", "2.0", "-logfn", "/dev/null"])
+        .args([
+            "-beam",
+            "1e-20",
+            "-pbeam",
+            "1e-20",
+            "-lw",
+            "2.0",
+            "-logfn",
+            "/dev/null",
+        ])
         .output()
         .map_err(|e| missing(&e.to_string()))?;
     if !out.status.success() {
         return Err(SpeechError::RecognitionFailed {
-            detail: String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("").to_string(),
+            detail: String::from_utf8_lossy(&out.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+                .to_string(),
         }
         .into());
     }
@@ -112,7 +127,11 @@ pub fn parse_phones(text: &str) -> Vec<AlignedPhone> {
         let [symbol, start, end, conf] = f.as_slice() else {
             continue;
         };
-        let (Ok(start), Ok(end), Ok(conf)) = (start.parse::<f64>(), end.parse::<f64>(), conf.parse::<f64>()) else {
+        let (Ok(start), Ok(end), Ok(conf)) = (
+            start.parse::<f64>(),
+            end.parse::<f64>(),
+            conf.parse::<f64>(),
+        ) else {
             continue;
         };
         if !(start.is_finite() && end.is_finite() && end >= start) {
@@ -199,9 +218,9 @@ mod tests {
     fn every_arpabet_phone_has_a_viseme() {
         let table = crate::speech::phonemes::PhonemeVisemeTable::standard();
         for ph in [
-            "AA", "AE", "AH", "AO", "AW", "AY", "B", "CH", "D", "DH", "EH", "ER", "EY", "F", "G", "HH", "IH", "IY",
-            "JH", "K", "L", "M", "N", "NG", "OW", "OY", "P", "R", "S", "SH", "T", "TH", "UH", "UW", "V", "W", "Y",
-            "Z", "ZH", "SIL", "+NSN+",
+            "AA", "AE", "AH", "AO", "AW", "AY", "B", "CH", "D", "DH", "EH", "ER", "EY", "F", "G",
+            "HH", "IH", "IY", "JH", "K", "L", "M", "N", "NG", "OW", "OY", "P", "R", "S", "SH", "T",
+            "TH", "UH", "UW", "V", "W", "Y", "Z", "ZH", "SIL", "+NSN+",
         ] {
             assert!(table.lookup(arpabet_to_espeak(ph)).is_some(), "{ph}");
         }
