@@ -29,6 +29,7 @@ mod fap_arkit;
 mod fapu;
 mod fp;
 mod inputs;
+mod lipsync;
 pub mod play;
 mod render;
 mod rig;
@@ -294,6 +295,27 @@ pub enum Command {
                       fbakit speak \"Hello\" --mouth faps -o hello-candide.fap --json"
     )]
     Speak(speak::SpeakArgs),
+    /// Lip-sync a voice recording: its transcript aligned to it, a talking face out.
+    #[command(
+        long_about = "Animate a face from a voice recording and its transcript. The \
+                      transcript is spoken by espeak-ng (library libespeak-ng, Debian package \
+                      espeak-ng), which gives its phonemes in 100+ languages (--lang); the \
+                      rendition is aligned to the recording by dynamic time warping of their \
+                      MFCCs, m/b/p closures are placed on the recording's energy dips, \
+                      silences relax the mouth, and the phones become FAP 1 visemes with \
+                      blends (never skipping a lip closure, no shape shorter than a frame). \
+                      The recording is read a chunk at a time. A transcript that fits poorly \
+                      gives a warning with its confidence; one that does not fit at all is \
+                      refused. Phone recognition without a transcript is not available yet. \
+                      Exit codes: 0 ok, 2 bad usage or input (unreadable recording, silence, \
+                      a transcript that cannot be aligned, espeak-ng not installed), 1 other \
+                      failures.",
+        after_help = "Examples:\n  fbakit lipsync voice.wav --text \"Hello world\" -o hello.mp4       the face says it, with the recording as sound\n  \
+                      fbakit lipsync voice.wav --text-file voice.txt -o voice.fap --json\n  \
+                      fbakit lipsync rede.wav --text \"Guten Tag\" --lang de -o rede.html --face alma\n  \
+                      fbakit lipsync voice.wav --text-file voice.txt --face rig.glb --fp rig-fp.csv -o voice.csv"
+    )]
+    Lipsync(lipsync::LipsyncArgs),
     /// Read blendshape rigs (glTF morph targets, OBJ shape folders such as the ICT-FaceKit).
     #[command(
         subcommand,
@@ -341,6 +363,7 @@ pub fn run(cli: Cli, json: bool) -> ExitCode {
         Command::View(args) => view::run(args),
         Command::Render(args) => render::run(args),
         Command::Speak(args) => speak::run(args),
+        Command::Lipsync(args) => lipsync::run(args),
         Command::Rig(cmd) => rig::run(cmd),
         Command::Completions(args) => docs::completions(args),
         Command::Man(args) => docs::man(args),

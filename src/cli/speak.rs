@@ -233,7 +233,7 @@ pub fn run(a: SpeakArgs) -> Result<u8> {
 }
 
 /// The viewer page of `face` playing `stream`; its report as JSON.
-fn write_page(
+pub(super) fn write_page(
     face: &fbakit::face::FaceModel,
     stream: &fbakit::fap::FapStream,
     path: &std::path::Path,

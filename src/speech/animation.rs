@@ -196,14 +196,30 @@ pub fn speech_animation(
     duration: f64,
     opts: &SpeechOptions,
 ) -> Result<SpeechAnimation> {
-    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
-        return Err(SpeechError::BadFrameRate { fps: opts.fps }.into());
+    let count = frame_count(duration, opts.fps)?;
+    let (keys, unmapped) = viseme_keys(phonemes, duration, PhonemeVisemeTable::standard());
+    let mut stream = FapStream::new(opts.name.clone(), opts.fps);
+    stream.frames.reserve(count as usize);
+    stream
+        .frames
+        .extend((0..count).map(|n| key_frame(&keys, n, opts.fps, opts.mouth)));
+    Ok(SpeechAnimation {
+        stream,
+        keys,
+        unmapped,
+    })
+}
+
+/// Frames a stream of `duration` seconds has at `fps` (`round(duration × fps)`, at least
+/// one); refuses a bad rate, a bad duration or too many frames.
+pub fn frame_count(duration: f64, fps: f64) -> Result<u64> {
+    if !(fps.is_finite() && fps > 0.0 && fps <= 1000.0) {
+        return Err(SpeechError::BadFrameRate { fps }.into());
     }
     if !(duration.is_finite() && duration >= 0.0) {
         return Err(SpeechError::BadDuration { duration }.into());
     }
-    let (keys, unmapped) = viseme_keys(phonemes, duration, PhonemeVisemeTable::standard());
-    let count = ((duration * opts.fps).round() as u64).max(1);
+    let count = ((duration * fps).round() as u64).max(1);
     if count > crate::fap::MAX_RESAMPLED_FRAMES {
         return Err(SpeechError::TooManyFrames {
             count,
@@ -211,39 +227,34 @@ pub fn speech_animation(
         }
         .into());
     }
-    let mut stream = FapStream::new(opts.name.clone(), opts.fps);
-    stream.frames.reserve(count as usize);
-    let mut low = [0.0f64; ARTICULATION_FAPS.len()];
-    for n in 0..count {
-        let t = n as f64 / opts.fps;
-        let mut frame = FapFrame::new(n);
-        if opts.mouth != MouthFaps::LowLevel {
-            frame.set_viseme(Some(viseme_at(&keys, t)));
-        }
-        if opts.mouth != MouthFaps::Visemes {
-            if let Some((a, b, w)) = bracket(&keys, t) {
-                low.fill(0.0);
-                for (k, ((_, va), (_, vb))) in articulation(a.viseme)
-                    .zip(articulation(b.viseme))
-                    .enumerate()
-                {
-                    low[k] = va * (1.0 - w) + vb * w;
-                }
-                for (k, &n) in ARTICULATION_FAPS.iter().enumerate() {
-                    if let Some(id) = FapId::new(n) {
-                        // Whole FAP units: the file stays short and the motion is the same.
-                        frame.set(id, low[k].round());
-                    }
+    Ok(count)
+}
+
+/// Frame `n` (at `fps`) of the stream blending `keys`, sending what `mouth` says.
+pub fn key_frame(keys: &[VisemeKey], n: u64, fps: f64, mouth: MouthFaps) -> FapFrame {
+    let t = n as f64 / fps;
+    let mut frame = FapFrame::new(n);
+    if mouth != MouthFaps::LowLevel {
+        frame.set_viseme(Some(viseme_at(keys, t)));
+    }
+    if mouth != MouthFaps::Visemes {
+        if let Some((a, b, w)) = bracket(keys, t) {
+            let mut low = [0.0f64; ARTICULATION_FAPS.len()];
+            for (k, ((_, va), (_, vb))) in articulation(a.viseme)
+                .zip(articulation(b.viseme))
+                .enumerate()
+            {
+                low[k] = va * (1.0 - w) + vb * w;
+            }
+            for (k, &n) in ARTICULATION_FAPS.iter().enumerate() {
+                if let Some(id) = FapId::new(n) {
+                    // Whole FAP units: the file stays short and the motion is the same.
+                    frame.set(id, low[k].round());
                 }
             }
         }
-        stream.frames.push(frame);
     }
-    Ok(SpeechAnimation {
-        stream,
-        keys,
-        unmapped,
-    })
+    frame
 }
 
 #[cfg(test)]

@@ -60,11 +60,75 @@ pub enum SpeechError {
         /// [`crate::fap::MAX_RESAMPLED_FRAMES`].
         limit: u64,
     },
+    /// A recording that cannot be read: empty, truncated, not WAV, odd sample format.
+    #[error("cannot read recording {}: {detail}", path.display())]
+    BadRecording {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong.
+        detail: String,
+    },
+    /// A recording's sample rate out of range.
+    #[error("recording {}: sample rate {rate} Hz is outside {min}..={max} Hz", path.display())]
+    BadSampleRate {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Its rate.
+        rate: u32,
+        /// Lowest accepted.
+        min: u32,
+        /// Highest accepted.
+        max: u32,
+    },
+    /// A recording longer than accepted.
+    #[error("recording {} lasts {seconds:.0} s, more than the {limit:.0} s accepted; split it", path.display())]
+    RecordingTooLong {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Its length (as far as read).
+        seconds: f64,
+        /// The limit.
+        limit: f64,
+    },
+    /// A recording with no speech in it (silence, or too short).
+    #[error("recording {}: {detail}", path.display())]
+    NoSpeech {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What was found instead.
+        detail: String,
+    },
+    /// A transcript that cannot be aligned with the recording at all.
+    #[error("the transcript cannot be aligned with recording {}: {detail}", path.display())]
+    CannotAlign {
+        /// The recording.
+        path: std::path::PathBuf,
+        /// Why.
+        detail: String,
+    },
+    /// The phone recogniser failed.
+    #[error("PocketSphinx failed: {detail}")]
+    RecognitionFailed {
+        /// Its last message.
+        detail: String,
+    },
+    /// The speech engine a command needs is not installed.
+    #[error("{engine} is not installed: {why} (Debian/Ubuntu: apt-get install {package})")]
+    EngineMissing {
+        /// The engine.
+        engine: String,
+        /// What needs it.
+        why: String,
+        /// The Debian package(s) to install.
+        package: String,
+    },
 }
 
 impl SpeechError {
-    /// Always true (see the type's docs).
+    /// True but for an engine failure; a missing engine is reported as exit code 2 as
+    /// well, as `lipsync` promises, with the package to install.
+    /// The recogniser failing is the exception (exit code 1).
     pub fn is_input_error(&self) -> bool {
-        true
+        !matches!(self, SpeechError::RecognitionFailed { .. })
     }
 }

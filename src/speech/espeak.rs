@@ -97,6 +97,12 @@ type SynthFn = unsafe extern "C" fn(
     *mut c_void,
 ) -> c_int;
 type SynchronizeFn = unsafe extern "C" fn() -> c_int;
+type SetParameterFn = unsafe extern "C" fn(c_int, c_int, c_int) -> c_int;
+
+/// `espeakRATE`: speaking rate in words per minute.
+const PARAMETER_RATE: c_int = 1;
+/// espeak-ng's default speaking rate, words per minute.
+pub const DEFAULT_RATE: u32 = 175;
 
 /// The loaded library and its sample rate.
 struct Engine {
@@ -105,6 +111,7 @@ struct Engine {
     set_voice: SetVoiceFn,
     synth: SynthFn,
     synchronize: SynchronizeFn,
+    set_parameter: SetParameterFn,
     sample_rate: u32,
 }
 
@@ -161,6 +168,7 @@ unsafe fn engine_from(lib: libloading::Library) -> std::result::Result<Engine, S
     let set_voice: SetVoiceFn = *lib.get(b"espeak_SetVoiceByName\0").map_err(sym)?;
     let synth: SynthFn = *lib.get(b"espeak_Synth\0").map_err(sym)?;
     let synchronize: SynchronizeFn = *lib.get(b"espeak_Synchronize\0").map_err(sym)?;
+    let set_parameter: SetParameterFn = *lib.get(b"espeak_SetParameter\0").map_err(sym)?;
     let rate = initialize(
         AUDIO_OUTPUT_SYNCHRONOUS,
         0,
@@ -176,6 +184,7 @@ unsafe fn engine_from(lib: libloading::Library) -> std::result::Result<Engine, S
         set_voice,
         synth,
         synchronize,
+        set_parameter,
         sample_rate: rate as u32,
     })
 }
@@ -226,6 +235,11 @@ pub fn espeak_available() -> bool {
 /// Errors: empty or too long text, a NUL byte in it or an unknown voice (bad input), the
 /// library missing ([`Error::MissingTool`]) or failing.
 pub fn speak(text: &str, voice: &str) -> Result<Utterance> {
+    speak_at(text, voice, DEFAULT_RATE)
+}
+
+/// Like [`speak`] at `words_per_minute` (espeak-ng takes 80 to 450; clamped).
+pub fn speak_at(text: &str, voice: &str, words_per_minute: u32) -> Result<Utterance> {
     if text.trim().is_empty() {
         return Err(SpeechError::EmptyText.into());
     }
@@ -245,6 +259,10 @@ pub fn speak(text: &str, voice: &str) -> Result<Utterance> {
             voice: voice.to_string(),
         }
         .into());
+    }
+    let rate = words_per_minute.clamp(80, 450) as c_int;
+    if unsafe { (engine.set_parameter)(PARAMETER_RATE, rate, 0) } != EE_OK {
+        return Err(SpeechError::SynthesisFailed { status: -1 }.into());
     }
     *COLLECTOR.lock().map_err(|_| poisoned())? = Some(Collector::default());
     let bytes = c_text.as_bytes_with_nul();

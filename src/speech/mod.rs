@@ -27,8 +27,10 @@
 
 pub mod animation;
 pub mod articulation;
+pub mod audio;
 mod error;
 pub mod espeak;
+pub mod lipsync;
 pub mod phonemes;
 pub mod wav;
 

@@ -1,0 +1,205 @@
+//! Measures `fbakit::speech::lipsync` on recordings with known phone times: espeak-ng
+//! renditions of sentences in other voices and at other rates, resampled, padded and
+//! with noise, aligned against their transcripts; prints issue 22's three figures per
+//! condition, the same figures for stretching the transcript's rendition over the
+//! recording's speech (the baseline the issue measured), and the real-time factor.
+//!
+//! Run: `cargo run --release --example lipsync_eval` (needs espeak-ng).
+#![allow(dead_code)] // Also included as a module by the tests, which do not call `main`.
+
+use std::time::Instant;
+
+use fbakit::fap::VisemeParams;
+use fbakit::speech::audio::AudioReader;
+use fbakit::speech::espeak::{speak_at, TimedPhoneme};
+use fbakit::speech::lipsync::coarticulation::lipsync_keys;
+use fbakit::speech::lipsync::evaluation::{degrade, score, Degradation, LipsyncScore};
+use fbakit::speech::lipsync::{
+    analyse_chunks, lipsync_transcript_at, render_transcript, LipsyncOptions,
+};
+use fbakit::speech::{animation::key_frame, MouthFaps};
+
+/// Sentences rich in lip closures and rounded vowels.
+pub const SENTENCES: [&str; 8] = [
+    "My mother bought a map of Bombay.",
+    "Peter Piper picked a peck of pickled peppers.",
+    "The quick brown fox jumps over the lazy dog.",
+    "Bob brought a big blue balloon to the beach.",
+    "We remember Mary's famous lemon pie.",
+    "Please open the window before the meeting begins.",
+    "A number of people moved to the mountains in May.",
+    "Thomas wrote a book about the moon and the sun.",
+];
+
+/// One recording condition: the voice that "records", its rate, and the degradation.
+pub struct Condition {
+    /// A name for the report.
+    pub name: &'static str,
+    /// espeak-ng voice of the recording.
+    pub voice: &'static str,
+    /// Its rate, words per minute.
+    pub rate: u32,
+    /// What is done to the audio.
+    pub degradation: Degradation,
+}
+
+/// The conditions measured.
+pub fn conditions() -> Vec<Condition> {
+    vec![
+        Condition {
+            name: "en-us, 140 wpm, 44.1 kHz stereo, 20 dB SNR",
+            voice: "en-us",
+            rate: 140,
+            degradation: Degradation::default(),
+        },
+        Condition {
+            name: "en-us+f3, 200 wpm, 48 kHz, 15 dB SNR",
+            voice: "en-us+f3",
+            rate: 200,
+            degradation: Degradation {
+                sample_rate: 48_000,
+                channels: 1,
+                snr_db: Some(15.0),
+                lead_in: 0.5,
+                seed: 2,
+            },
+        },
+        Condition {
+            name: "en-gb-x-rp+m3, 120 wpm, 8 kHz, 25 dB SNR",
+            voice: "en-gb-x-rp+m3",
+            rate: 120,
+            degradation: Degradation {
+                sample_rate: 8_000,
+                channels: 1,
+                snr_db: Some(25.0),
+                lead_in: 0.2,
+                seed: 3,
+            },
+        },
+    ]
+}
+
+/// Scores of one case: the aligner's and the stretched rendition's; and seconds of audio and
+/// of work.
+pub struct CaseResult {
+    /// The aligner.
+    pub aligned: LipsyncScore,
+    /// The baseline.
+    pub stretched: LipsyncScore,
+    /// Length of the recording.
+    pub audio_seconds: f64,
+    /// Time to analyse and align (no video).
+    pub work_seconds: f64,
+    /// Overall confidence.
+    pub confidence: f64,
+}
+
+fn frames_of(keys: &[fbakit::speech::VisemeKey], duration: f64, fps: f64) -> Vec<VisemeParams> {
+    let count = (duration * fps).round() as u64;
+    (0..count)
+        .filter_map(|n| key_frame(keys, n, fps, MouthFaps::Visemes).viseme())
+        .collect()
+}
+
+/// Runs one sentence under one condition.
+pub fn run_case(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<CaseResult> {
+    let recording = speak_at(text, c.voice, c.rate)?;
+    let (wav, truth) = degrade(&recording, &c.degradation)?;
+    let started = Instant::now();
+    let mut reader =
+        AudioReader::from_wav(Box::new(std::io::Cursor::new(wav)), "case.wav".as_ref())?;
+    let chunks = std::iter::from_fn(|| reader.next_chunk().transpose());
+    let rec = analyse_chunks(chunks, "case.wav".as_ref())?;
+    let sync = lipsync_transcript_at(&rec, text, &LipsyncOptions::default(), fps)?;
+    let work_seconds = started.elapsed().as_secs_f64();
+    let aligned = score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps);
+    // Baseline: the rendition's phones stretched linearly over the recording's speech.
+    let rendition = render_transcript(text, "en")?;
+    let spoken: Vec<&TimedPhoneme> = rendition
+        .phonemes
+        .iter()
+        .filter(|p| !p.symbol.starts_with('_'))
+        .collect();
+    let (r0, r1) = (
+        spoken.first().map_or(0.0, |p| p.start),
+        spoken.last().map_or(1.0, |p| p.end),
+    );
+    let (s0, s1) = rec.activity.speech_span;
+    let scale = (s1 - s0) / (r1 - r0).max(1e-6);
+    let stretched: Vec<TimedPhoneme> = rendition
+        .phonemes
+        .iter()
+        .map(|p| TimedPhoneme {
+            symbol: p.symbol.clone(),
+            start: (s0 + (p.start - r0) * scale).max(0.0),
+            end: (s0 + (p.end - r0) * scale).max(0.0),
+        })
+        .collect();
+    let (keys, _) = lipsync_keys(&stretched, rec.seconds, &[], fps);
+    let stretched = score(&truth, &frames_of(&keys, rec.seconds, fps), fps);
+    Ok(CaseResult {
+        aligned,
+        stretched,
+        audio_seconds: rec.seconds,
+        work_seconds,
+        confidence: sync.confidence,
+    })
+}
+
+fn line(name: &str, s: &LipsyncScore) {
+    println!(
+        "  {name:<10} closures {:>5.1} % ({}/{})  agreement {:>5.1} %  false closures {:>4.1} %  ({} speech frames)",
+        100.0 * s.closure_rate(),
+        s.closures_shown,
+        s.closures,
+        100.0 * s.agreement(),
+        100.0 * s.false_closure_rate(),
+        s.speech_frames
+    );
+}
+
+fn main() {
+    if !fbakit::speech::espeak_available() {
+        eprintln!("espeak-ng is not installed (apt-get install espeak-ng)");
+        std::process::exit(1);
+    }
+    let (mut audio, mut work) = (0.0, 0.0);
+    let mut all = (LipsyncScore::default(), LipsyncScore::default());
+    for c in conditions() {
+        let mut sum = (LipsyncScore::default(), LipsyncScore::default());
+        let mut conf = Vec::new();
+        for text in SENTENCES {
+            match run_case(text, &c, 25.0) {
+                Ok(r) => {
+                    sum.0.add(&r.aligned);
+                    sum.1.add(&r.stretched);
+                    audio += r.audio_seconds;
+                    work += r.work_seconds;
+                    conf.push(r.confidence);
+                    if std::env::var_os("VERBOSE").is_some() {
+                        println!("    {text}: conf {:.2}", r.confidence);
+                        line("aligned", &r.aligned);
+                    }
+                }
+                Err(e) => println!("  {text}: {e}"),
+            }
+        }
+        println!(
+            "{} (confidence {:.2}..{:.2})",
+            c.name,
+            conf.iter().cloned().fold(1.0, f64::min),
+            conf.iter().cloned().fold(0.0, f64::max)
+        );
+        line("aligned", &sum.0);
+        line("stretched", &sum.1);
+        all.0.add(&sum.0);
+        all.1.add(&sum.1);
+    }
+    println!("all conditions");
+    line("aligned", &all.0);
+    line("stretched", &all.1);
+    println!(
+        "{audio:.1} s of audio analysed and aligned in {work:.2} s: {:.0}x real time",
+        audio / work.max(1e-9)
+    );
+}

@@ -1,0 +1,489 @@
+//! Recordings in: WAV through `hound` (8/16/24/32-bit integer and float, any channel count,
+//! mixed down to mono), decoded a chunk at a time and resampled to [`ANALYSIS_RATE`] for
+//! analysis, so a long recording never has to be in memory whole.
+//!
+//! Every problem names the file: a 0-byte or truncated file, a format that is not WAV, a
+//! sample rate outside [`MIN_SAMPLE_RATE`]..=[`MAX_SAMPLE_RATE`] or a recording longer than
+//! [`MAX_AUDIO_SECONDS`].
+
+use std::io::{BufReader, Read};
+use std::path::{Path, PathBuf};
+
+use super::SpeechError;
+use crate::error::{Error, Result};
+
+/// The rate recordings are analysed at: speech has what lip shapes need below 8 kHz.
+pub const ANALYSIS_RATE: u32 = 16_000;
+/// Lowest sample rate accepted (telephone speech is 8 kHz).
+pub const MIN_SAMPLE_RATE: u32 = 4_000;
+/// Highest sample rate accepted.
+pub const MAX_SAMPLE_RATE: u32 = 384_000;
+/// Longest recording accepted, in seconds (two hours).
+pub const MAX_AUDIO_SECONDS: f64 = 7_200.0;
+/// Input frames decoded per chunk.
+const CHUNK_FRAMES: usize = 8_192;
+/// Most channels accepted.
+const MAX_CHANNELS: u16 = 64;
+
+/// What a recording is.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct AudioInfo {
+    /// The file.
+    pub path: PathBuf,
+    /// Container and sample format, e.g. `WAV 16-bit integer`.
+    pub format: String,
+    /// Samples per second per channel in the file.
+    pub sample_rate: u32,
+    /// Channels in the file (mixed down to one).
+    pub channels: u16,
+    /// Length in seconds, from the header when it says (0 when unknown).
+    pub seconds: f64,
+}
+
+/// A recording read a chunk at a time as mono samples in `[-1, 1]` at [`ANALYSIS_RATE`].
+pub struct AudioReader {
+    info: AudioInfo,
+    wav: hound::WavReader<Box<dyn Read + Send>>,
+    spec: hound::WavSpec,
+    resampler: Resampler,
+    /// Input frames read so far.
+    frames_read: u64,
+    done: bool,
+}
+
+impl std::fmt::Debug for AudioReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AudioReader")
+            .field("info", &self.info)
+            .finish()
+    }
+}
+
+fn bad(path: &Path, detail: impl Into<String>) -> Error {
+    SpeechError::BadRecording {
+        path: path.to_path_buf(),
+        detail: detail.into(),
+    }
+    .into()
+}
+
+/// Opens the recording at `path`.
+pub fn open_audio(path: &Path) -> Result<AudioReader> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    if len == 0 {
+        return Err(bad(path, "the file is empty (0 bytes)"));
+    }
+    let mut head = [0u8; 12];
+    let mut reader = BufReader::new(file);
+    let n = read_up_to(&mut reader, &mut head).map_err(|e| Error::io(path, e))?;
+    let chained: Box<dyn Read + Send> =
+        Box::new(std::io::Cursor::new(head[..n].to_vec()).chain(reader));
+    if n < 12 || &head[..4] != b"RIFF" || &head[8..12] != b"WAVE" {
+        return Err(bad(
+            path,
+            format!(
+                "{}; fbakit reads WAV (RIFF/WAVE) recordings",
+                sniff(&head[..n])
+            ),
+        ));
+    }
+    AudioReader::from_wav(chained, path)
+}
+
+fn read_up_to(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match r.read(&mut buf[n..])? {
+            0 => break,
+            k => n += k,
+        }
+    }
+    Ok(n)
+}
+
+/// A name for what a file that is not WAV looks like, from its first bytes.
+fn sniff(head: &[u8]) -> String {
+    let what = if head.starts_with(b"ID3")
+        || head.starts_with(&[0xFF, 0xFB])
+        || head.starts_with(&[0xFF, 0xF3])
+    {
+        "an MP3 file"
+    } else if head.starts_with(b"fLaC") {
+        "a FLAC file"
+    } else if head.starts_with(b"OggS") {
+        "an Ogg file"
+    } else if head.len() >= 8 && &head[4..8] == b"ftyp" {
+        "an MP4/M4A file"
+    } else if head.starts_with(b"RIFF") {
+        "a RIFF file that is not WAVE"
+    } else if head.len() < 12 {
+        "too short to be a recording (truncated?)"
+    } else {
+        "not a recording fbakit knows"
+    };
+    format!("it is {what}")
+}
+
+impl AudioReader {
+    /// A WAV recording from `reader`; `path` names it in errors.
+    pub fn from_wav(reader: Box<dyn Read + Send>, path: &Path) -> Result<AudioReader> {
+        let wav = hound::WavReader::new(reader).map_err(|e| bad(path, wav_detail(&e)))?;
+        let spec = wav.spec();
+        if spec.channels == 0 || spec.channels > MAX_CHANNELS {
+            return Err(bad(
+                path,
+                format!("{} channels (1 to {MAX_CHANNELS} accepted)", spec.channels),
+            ));
+        }
+        if !(MIN_SAMPLE_RATE..=MAX_SAMPLE_RATE).contains(&spec.sample_rate) {
+            return Err(SpeechError::BadSampleRate {
+                path: path.to_path_buf(),
+                rate: spec.sample_rate,
+                min: MIN_SAMPLE_RATE,
+                max: MAX_SAMPLE_RATE,
+            }
+            .into());
+        }
+        let frames = u64::from(wav.duration());
+        let seconds = frames as f64 / f64::from(spec.sample_rate);
+        if seconds > MAX_AUDIO_SECONDS {
+            return Err(SpeechError::RecordingTooLong {
+                path: path.to_path_buf(),
+                seconds,
+                limit: MAX_AUDIO_SECONDS,
+            }
+            .into());
+        }
+        let kind = match spec.sample_format {
+            hound::SampleFormat::Int => "integer",
+            hound::SampleFormat::Float => "float",
+        };
+        if spec.sample_format == hound::SampleFormat::Float && spec.bits_per_sample != 32 {
+            return Err(bad(
+                path,
+                format!(
+                    "{}-bit float samples (32-bit float accepted)",
+                    spec.bits_per_sample
+                ),
+            ));
+        }
+        Ok(AudioReader {
+            info: AudioInfo {
+                path: path.to_path_buf(),
+                format: format!("WAV {}-bit {kind}", spec.bits_per_sample),
+                sample_rate: spec.sample_rate,
+                channels: spec.channels,
+                seconds,
+            },
+            wav,
+            spec,
+            resampler: Resampler::new(spec.sample_rate, ANALYSIS_RATE),
+            frames_read: 0,
+            done: false,
+        })
+    }
+
+    /// What the recording is.
+    pub fn info(&self) -> &AudioInfo {
+        &self.info
+    }
+
+    /// The next chunk of mono samples at [`ANALYSIS_RATE`]; `None` at the end.
+    pub fn next_chunk(&mut self) -> Result<Option<Vec<f32>>> {
+        if self.done {
+            return Ok(None);
+        }
+        let channels = usize::from(self.spec.channels);
+        let want = CHUNK_FRAMES * channels;
+        let mut interleaved: Vec<f32> = Vec::with_capacity(want);
+        let path = self.info.path.clone();
+        match self.spec.sample_format {
+            hound::SampleFormat::Float => {
+                for s in self.wav.samples::<f32>().take(want) {
+                    let s = s.map_err(|e| bad(&path, wav_detail(&e)))?;
+                    interleaved.push(if s.is_finite() {
+                        s.clamp(-1.0, 1.0)
+                    } else {
+                        0.0
+                    });
+                }
+            }
+            hound::SampleFormat::Int => {
+                let scale = 1.0 / (1u64 << (self.spec.bits_per_sample.clamp(1, 32) - 1)) as f32;
+                for s in self.wav.samples::<i32>().take(want) {
+                    let s = s.map_err(|e| bad(&path, wav_detail(&e)))?;
+                    interleaved.push(s as f32 * scale);
+                }
+            }
+        }
+        if interleaved.len() % channels != 0 {
+            return Err(bad(
+                &path,
+                "the file ends inside a sample frame (truncated?)",
+            ));
+        }
+        let mono: Vec<f32> = interleaved
+            .chunks_exact(channels)
+            .map(|f| f.iter().sum::<f32>() / channels as f32)
+            .collect();
+        self.frames_read += mono.len() as u64;
+        if (self.frames_read as f64) / f64::from(self.spec.sample_rate) > MAX_AUDIO_SECONDS {
+            return Err(SpeechError::RecordingTooLong {
+                path,
+                seconds: self.frames_read as f64 / f64::from(self.spec.sample_rate),
+                limit: MAX_AUDIO_SECONDS,
+            }
+            .into());
+        }
+        let mut out = Vec::with_capacity(
+            mono.len() * ANALYSIS_RATE as usize / self.spec.sample_rate as usize + 2,
+        );
+        if mono.len() < CHUNK_FRAMES {
+            self.done = true;
+            self.resampler.push(&mono, &mut out);
+            self.resampler.finish(&mut out);
+        } else {
+            self.resampler.push(&mono, &mut out);
+        }
+        Ok(Some(out))
+    }
+
+    /// Input frames decoded so far.
+    pub fn frames_read(&self) -> u64 {
+        self.frames_read
+    }
+}
+
+fn wav_detail(e: &hound::Error) -> String {
+    match e {
+        hound::Error::IoError(io)
+            if io.kind() == std::io::ErrorKind::UnexpectedEof
+                || io.to_string().contains("enough bytes") =>
+        {
+            "the WAV data ends early (truncated file)".into()
+        }
+        hound::Error::IoError(io) => format!("cannot read the WAV data: {io}"),
+        hound::Error::FormatError(m) => format!("not a well-formed WAV file: {m}"),
+        hound::Error::Unsupported => "a WAV sample format fbakit does not read (8/16/24/32-bit PCM and 32-bit float are read)".into(),
+        other => format!("cannot read the WAV file: {other}"),
+    }
+}
+
+/// A streaming band-limited resampler: windowed-sinc interpolation whose cut-off follows
+/// the lower of the two rates, so downsampling does not alias.
+#[derive(Clone, Debug)]
+pub struct Resampler {
+    /// Input samples per output sample.
+    step: f64,
+    /// Cut-off as a fraction of the input rate's Nyquist frequency.
+    cutoff: f64,
+    /// Kernel half-width in input samples.
+    half: usize,
+    /// Input not yet consumed; `buf[0]` is input sample `offset`.
+    buf: Vec<f32>,
+    offset: u64,
+    /// Position of the next output sample, in input samples.
+    next: f64,
+    /// Whether the input started (the first samples are padded with zeros before it).
+    identity: bool,
+}
+
+/// Kernel zero crossings on each side.
+const ZEROS: f64 = 8.0;
+
+impl Resampler {
+    /// From `from` Hz to `to` Hz.
+    pub fn new(from: u32, to: u32) -> Resampler {
+        let step = f64::from(from) / f64::from(to.max(1));
+        let cutoff = (1.0 / step).min(1.0) * 0.95;
+        let half = (ZEROS / cutoff).ceil() as usize;
+        Resampler {
+            step,
+            cutoff,
+            half,
+            buf: Vec::new(),
+            offset: 0,
+            next: 0.0,
+            identity: from == to,
+        }
+    }
+
+    /// Feeds input samples; appends the outputs they complete.
+    pub fn push(&mut self, input: &[f32], out: &mut Vec<f32>) {
+        if self.identity {
+            out.extend_from_slice(input);
+            return;
+        }
+        self.buf.extend_from_slice(input);
+        self.drain(out, false);
+    }
+
+    /// Ends the input (zeros after it); appends the remaining outputs.
+    pub fn finish(&mut self, out: &mut Vec<f32>) {
+        if self.identity {
+            return;
+        }
+        self.drain(out, true);
+        self.buf.clear();
+    }
+
+    fn drain(&mut self, out: &mut Vec<f32>, last: bool) {
+        let end = self.offset + self.buf.len() as u64;
+        loop {
+            let centre = self.next.floor() as i64;
+            if last {
+                if self.next >= end as f64 {
+                    break;
+                }
+            } else if centre + self.half as i64 >= end as i64 {
+                break;
+            }
+            out.push(self.sample_at(self.next));
+            self.next += self.step;
+        }
+        // Drop input no later output can reach.
+        let keep_from =
+            (self.next.floor() as i64 - self.half as i64).max(self.offset as i64) as u64;
+        let drop = (keep_from - self.offset) as usize;
+        if drop > 0 && drop <= self.buf.len() {
+            self.buf.drain(..drop);
+            self.offset = keep_from;
+        }
+    }
+
+    fn sample_at(&self, t: f64) -> f32 {
+        let centre = t.floor() as i64;
+        let mut acc = 0.0f64;
+        let mut norm = 0.0f64;
+        for k in (centre - self.half as i64 + 1)..=(centre + self.half as i64) {
+            let x = t - k as f64;
+            let arg = x * self.cutoff;
+            let sinc = if arg.abs() < 1e-9 {
+                1.0
+            } else {
+                let p = std::f64::consts::PI * arg;
+                p.sin() / p
+            };
+            // Hann window over the kernel's span.
+            let w = 0.5 + 0.5 * (std::f64::consts::PI * x / (self.half as f64 + 1.0)).cos();
+            let h = sinc * w;
+            norm += h;
+            let idx = k - self.offset as i64;
+            if idx >= 0 && (idx as usize) < self.buf.len() {
+                acc += h * f64::from(self.buf[idx as usize]);
+            }
+        }
+        if norm.abs() > 1e-12 {
+            (acc / norm) as f32
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wav(spec: hound::WavSpec, samples: &[i32]) -> Vec<u8> {
+        let mut c = std::io::Cursor::new(Vec::new());
+        let mut w = hound::WavWriter::new(&mut c, spec).unwrap();
+        for &s in samples {
+            w.write_sample(s).unwrap();
+        }
+        w.finalize().unwrap();
+        c.into_inner()
+    }
+
+    fn read_all(bytes: Vec<u8>) -> Result<Vec<f32>> {
+        let mut r =
+            AudioReader::from_wav(Box::new(std::io::Cursor::new(bytes)), Path::new("x.wav"))?;
+        let mut all = Vec::new();
+        while let Some(c) = r.next_chunk()? {
+            all.extend(c);
+        }
+        Ok(all)
+    }
+
+    #[test]
+    fn a_tone_keeps_its_length_and_level_through_resampling() {
+        let rate = 44_100;
+        let n = rate as usize; // one second
+        let spec = hound::WavSpec {
+            channels: 2,
+            sample_rate: rate,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
+        let mut s = Vec::new();
+        for i in 0..n {
+            let v = (0.5
+                * (2.0 * std::f64::consts::PI * 440.0 * i as f64 / f64::from(rate)).sin()
+                * 32767.0) as i32;
+            s.push(v);
+            s.push(v);
+        }
+        let out = read_all(wav(spec, &s)).unwrap();
+        assert!((out.len() as i64 - 16_000).abs() <= 2, "{}", out.len());
+        let rms = (out[1000..15000]
+            .iter()
+            .map(|x| f64::from(*x).powi(2))
+            .sum::<f64>()
+            / 14000.0)
+            .sqrt();
+        assert!((rms - 0.5 / 2f64.sqrt()).abs() < 0.01, "{rms}");
+    }
+
+    #[test]
+    fn downsampling_removes_what_16_khz_cannot_hold() {
+        let rate = 48_000;
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: rate,
+            bits_per_sample: 24,
+            sample_format: hound::SampleFormat::Int,
+        };
+        // 12 kHz is above the 8 kHz Nyquist frequency of the analysis rate.
+        let s: Vec<i32> = (0..rate as usize)
+            .map(|i| {
+                ((2.0 * std::f64::consts::PI * 12_000.0 * i as f64 / f64::from(rate)).sin()
+                    * 4_000_000.0) as i32
+            })
+            .collect();
+        let out = read_all(wav(spec, &s)).unwrap();
+        let rms = (out[1000..15000]
+            .iter()
+            .map(|x| f64::from(*x).powi(2))
+            .sum::<f64>()
+            / 14000.0)
+            .sqrt();
+        assert!(rms < 0.01, "{rms}");
+    }
+
+    #[test]
+    fn bad_recordings_are_refused_with_a_reason() {
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: 1,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
+        let e = read_all(wav(spec, &[0, 1, 2])).unwrap_err();
+        assert!(e.to_string().contains("1 Hz"), "{e}");
+        assert!(e.is_input_error());
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: 16_000,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
+        let mut bytes = wav(spec, &vec![100; 10_000]);
+        bytes.truncate(bytes.len() - 5_001);
+        let e = read_all(bytes).unwrap_err();
+        assert!(e.to_string().contains("truncated"), "{e}");
+        let e = read_all(b"RIFF\0\0\0\0WAVEjunk".to_vec()).unwrap_err();
+        assert!(e.is_input_error(), "{e}");
+        assert!(sniff(b"fLaC\0\0\0\0\0\0\0\0").contains("FLAC"));
+    }
+}

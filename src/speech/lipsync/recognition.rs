@@ -1,0 +1,229 @@
+//! Phones without a transcript (English): PocketSphinx's phone recogniser, run as the
+//! `pocketsphinx_continuous` program of Debian's `pocketsphinx` package with the
+//! `pocketsphinx-en-us` acoustic model and phone language model.
+//!
+//! It runs with context-independent phones (`-allphone_ci yes`, about 13× faster than the
+//! context-dependent search and faster than real time) and prints one line per phone with
+//! its start and end in seconds from the start of the file (`-time yes`); utterances its
+//! own silence detector splits keep file times. Phones are ARPAbet (`AA`, `B`, `SIL`);
+//! [`arpabet_to_espeak`] gives the espeak-ng mnemonic the viseme table knows.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use super::AlignedPhone;
+use crate::error::{Error, Result};
+use crate::speech::audio::{open_audio, ANALYSIS_RATE};
+use crate::speech::SpeechError;
+
+/// The program run.
+pub const PROGRAM: &str = "pocketsphinx_continuous";
+/// Where Debian's `pocketsphinx-en-us` puts the model.
+pub const MODEL_DIR: &str = "/usr/share/pocketsphinx/model/en-us";
+
+/// The acoustic model and phone language model, or why they are missing.
+fn model() -> Result<(PathBuf, PathBuf)> {
+    let dir = std::env::var_os("FBAKIT_POCKETSPHINX_MODEL")
+        .map_or_else(|| PathBuf::from(MODEL_DIR), PathBuf::from);
+    let hmm = dir.join("en-us");
+    let lm = dir.join("en-us-phone.lm.bin");
+    if hmm.join("mdef").is_file() && lm.is_file() {
+        Ok((hmm, lm))
+    } else {
+        Err(missing(&format!("no model in {}", dir.display())))
+    }
+}
+
+fn missing(detail: &str) -> Error {
+    SpeechError::EngineMissing {
+        engine: "PocketSphinx".into(),
+        why: format!("lip sync without a transcript recognises phones with it ({detail})"),
+        package: "pocketsphinx pocketsphinx-en-us".into(),
+    }
+    .into()
+}
+
+/// Whether the recogniser and its English model are installed.
+pub fn recognition_available() -> bool {
+    check_recogniser().is_ok()
+}
+
+/// The recogniser and its English model, or an error naming the packages to install.
+pub fn check_recogniser() -> Result<()> {
+    model()?;
+    Command::new(PROGRAM)
+        .arg("-help")
+        .output()
+        .map(|_| ())
+        .map_err(|e| missing(&format!("cannot run {PROGRAM}: {e}")))
+}
+
+/// The ARPAbet phones of the recording at `path` with their times; the share of the file
+/// read goes to `progress`.
+pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<AlignedPhone>> {
+    let (hmm, lm) = model()?;
+    // The recogniser reads 16 kHz mono 16-bit; write the recording so, a chunk at a time.
+    let scratch = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
+    let wav = scratch.path().join("recording.wav");
+    {
+        let mut reader = open_audio(path)?;
+        let total = (reader.info().seconds * f64::from(reader.info().sample_rate)).max(1.0);
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: ANALYSIS_RATE,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
+        let encode = |e: hound::Error| -> Error { crate::error::EncodeError::new("WAV", e).into() };
+        let mut w = hound::WavWriter::create(&wav, spec).map_err(encode)?;
+        while let Some(chunk) = reader.next_chunk()? {
+            for s in chunk {
+                w.write_sample((s.clamp(-1.0, 1.0) * 32_767.0).round() as i16)
+                    .map_err(encode)?;
+            }
+            progress((reader.frames_read() as f64 / total).min(1.0));
+        }
+        w.finalize().map_err(encode)?;
+    }
+    let out = Command::new(PROGRAM)
+        .arg("-infile")
+        .arg(&wav)
+        .arg("-hmm")
+        .arg(&hmm)
+        .arg("-allphone")
+        .arg(&lm)
+        .args(["-allphone_ci", "yes", "-backtrace", "yes", "-time", "yes"])
+        .args([
+            "-beam",
+            "1e-20",
+            "-pbeam",
+            "1e-20",
+            "-lw",
+            "2.0",
+            "-logfn",
+            "/dev/null",
+        ])
+        .output()
+        .map_err(|e| missing(&e.to_string()))?;
+    if !out.status.success() {
+        return Err(SpeechError::RecognitionFailed {
+            detail: String::from_utf8_lossy(&out.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+                .to_string(),
+        }
+        .into());
+    }
+    Ok(parse_phones(&String::from_utf8_lossy(&out.stdout)))
+}
+
+/// The phone lines (`SYMBOL START END CONFIDENCE`) of the recogniser's output; the
+/// hypothesis lines between them have no times and are skipped.
+pub fn parse_phones(text: &str) -> Vec<AlignedPhone> {
+    let mut phones: Vec<AlignedPhone> = Vec::new();
+    for line in text.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        let [symbol, start, end, conf] = f.as_slice() else {
+            continue;
+        };
+        let (Ok(start), Ok(end), Ok(conf)) = (
+            start.parse::<f64>(),
+            end.parse::<f64>(),
+            conf.parse::<f64>(),
+        ) else {
+            continue;
+        };
+        if !(start.is_finite() && end.is_finite() && end >= start) {
+            continue;
+        }
+        let floor = phones.last().map_or(0.0, |p| p.end);
+        // Phones end 10 ms before the next starts: close the gap so intervals touch.
+        if let Some(last) = phones.last_mut() {
+            if start > last.end && start - last.end <= 0.011 {
+                last.end = start;
+            }
+        }
+        phones.push(AlignedPhone {
+            symbol: (*symbol).to_string(),
+            start: start.max(floor),
+            end: (end + 0.01).max(start.max(floor)),
+            confidence: conf.clamp(0.0, 1.0),
+        });
+    }
+    phones
+}
+
+/// The espeak-ng mnemonic of an ARPAbet phone (`_` for silence and noises).
+pub fn arpabet_to_espeak(phone: &str) -> &'static str {
+    match phone.trim_end_matches(['0', '1', '2']) {
+        "AA" => "A:",
+        "AE" => "a",
+        "AH" => "V",
+        "AO" => "O:",
+        "AW" => "aU",
+        "AY" => "aI",
+        "B" => "b",
+        "CH" => "tS",
+        "D" => "d",
+        "DH" => "D",
+        "EH" => "E",
+        "ER" => "3:",
+        "EY" => "eI",
+        "F" => "f",
+        "G" => "g",
+        "HH" => "h",
+        "IH" => "I",
+        "IY" => "i:",
+        "JH" => "dZ",
+        "K" => "k",
+        "L" => "l",
+        "M" => "m",
+        "N" => "n",
+        "NG" => "N",
+        "OW" => "oU",
+        "OY" => "OI",
+        "P" => "p",
+        "R" => "r",
+        "S" => "s",
+        "SH" => "S",
+        "T" => "t",
+        "TH" => "T",
+        "UH" => "U",
+        "UW" => "u:",
+        "V" => "v",
+        "W" => "w",
+        "Y" => "j",
+        "Z" => "z",
+        "ZH" => "Z",
+        _ => "_",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn phone_lines_are_read_and_hypotheses_skipped() {
+        let out = "SIL AA B SIL\nSIL 0.000 0.160 1.000000\nAA 0.170 0.260 0.9\nB 0.270 0.330 1.000000\nnoise\nSIL 3.330 x 1\n";
+        let p = parse_phones(out);
+        let s: Vec<&str> = p.iter().map(|p| p.symbol.as_str()).collect();
+        assert_eq!(s, ["SIL", "AA", "B"]);
+        assert!((p[0].end - 0.17).abs() < 1e-9 && (p[1].start - 0.17).abs() < 1e-9);
+        assert!((p[1].confidence - 0.9).abs() < 1e-9);
+    }
+
+    #[test]
+    fn every_arpabet_phone_has_a_viseme() {
+        let table = crate::speech::phonemes::PhonemeVisemeTable::standard();
+        for ph in [
+            "AA", "AE", "AH", "AO", "AW", "AY", "B", "CH", "D", "DH", "EH", "ER", "EY", "F", "G",
+            "HH", "IH", "IY", "JH", "K", "L", "M", "N", "NG", "OW", "OY", "P", "R", "S", "SH", "T",
+            "TH", "UH", "UW", "V", "W", "Y", "Z", "ZH", "SIL", "+NSN+",
+        ] {
+            assert!(table.lookup(arpabet_to_espeak(ph)).is_some(), "{ph}");
+        }
+        assert_eq!(arpabet_to_espeak("M"), "m");
+    }
+}
