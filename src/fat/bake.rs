@@ -22,7 +22,8 @@
 //! from the arc by at most `r·(1 − cos(Δ/2)) ≈ r·Δ²/8`, at the middle of the interval. Halving
 //! an interval therefore divides its error by about four, and [`bake_motion`] bisects every
 //! interval whose error, sampled at a quarter, half and three quarters of it, exceeds the
-//! tolerance. A part of size `s` baked with tolerance `0.01·s` needs intervals of at most
+//! tolerance (between integer borders the new border is rounded to an integer, as VRML's
+//! `intervalBorders` are integers). A part of size `s` baked with tolerance `0.01·s` needs intervals of at most
 //! `√(0.08·s/r)` radians: about 0.4 rad (23°) for an eyeball (`r ≈ s/2`).
 //!
 //! Between `range.0` and `range.1` (the FAP values the FAT covers) the result is within the
@@ -126,9 +127,12 @@ pub fn bake_motion(req: &BakeRequest, mut motion: impl FnMut(f64) -> Affine3A) -
                 err = err.max(d.distance(lin));
             }
         }
-        let splittable = borders.len() - 1 < MAX_INTERVALS && (b - a) > (b.abs() + a.abs()) * 1e-9;
+        let mid = midpoint(a, b);
+        let splittable = borders.len() - 1 < MAX_INTERVALS
+            && mid > a
+            && mid < b
+            && (b - a) > (b.abs() + a.abs()) * 1e-9;
         if err > tol && splittable {
-            let mid = a + (b - a) / 2.0;
             borders.insert(j + 1, mid);
             at.insert(j + 1, displaced(mid));
         } else {
@@ -152,6 +156,17 @@ pub fn bake_motion(req: &BakeRequest, mut motion: impl FnMut(f64) -> Affine3A) -
             displacements: rates,
         },
         max_error: max_error as f32,
+    }
+}
+
+/// The border that bisects `[a, b]`: rounded to an integer between integer borders (VRML's
+/// `intervalBorders` are integers), so it may equal an end when they are 1 apart.
+fn midpoint(a: f64, b: f64) -> f64 {
+    let mid = a + (b - a) / 2.0;
+    if a.fract() == 0.0 && b.fract() == 0.0 {
+        mid.round()
+    } else {
+        mid
     }
 }
 
