@@ -140,14 +140,7 @@ pub fn bake_motion(req: &BakeRequest, mut motion: impl FnMut(f64) -> Affine3A) -
             j += 1;
         }
     }
-    let intervals = borders.len() - 1;
-    let mut rates = Vec::with_capacity(n * intervals);
-    for i in 0..n {
-        for j in 0..intervals {
-            let rate = (at[j + 1][i] - at[j][i]) / (borders[j + 1] - borders[j]);
-            rates.push(rate.as_vec3());
-        }
-    }
+    let rates = rates_between(&at, &borders, n);
     BakedMesh {
         entry: FaceDefMesh {
             mesh: req.mesh.to_string(),
@@ -157,6 +150,19 @@ pub fn bake_motion(req: &BakeRequest, mut motion: impl FnMut(f64) -> Affine3A) -
         },
         max_error: max_error as f32,
     }
+}
+
+/// Rates, vertex-major, of `n` vertices whose displacements at each border are `at[border]`.
+fn rates_between(at: &[Vec<DVec3>], borders: &[f64], n: usize) -> Vec<Vec3> {
+    let spans: Vec<f64> = borders.windows(2).map(|w| w[1] - w[0]).collect();
+    let spans = &spans;
+    (0..n)
+        .flat_map(|i| {
+            at.windows(2)
+                .zip(spans)
+                .map(move |(w, &s)| ((w[1][i] - w[0][i]) / s).as_vec3())
+        })
+        .collect()
 }
 
 /// The border that bisects `[a, b]`: rounded to an integer between integer borders (VRML's
@@ -177,7 +183,6 @@ fn midpoint(a: f64, b: f64) -> f64 {
 pub fn on_borders(entry: &FaceDefMesh, borders: &[f64]) -> FaceDefMesh {
     let n = entry.coord_index.len();
     let own = entry.interval_count();
-    let intervals = borders.len().saturating_sub(1);
     let mut weights = Vec::new();
     // Displacement of every listed vertex at every new border.
     let at: Vec<Vec<DVec3>> = borders
@@ -200,12 +205,7 @@ pub fn on_borders(entry: &FaceDefMesh, borders: &[f64]) -> FaceDefMesh {
                 .collect()
         })
         .collect();
-    let mut rates = Vec::with_capacity(n * intervals);
-    for i in 0..n {
-        for j in 0..intervals {
-            rates.push(((at[j + 1][i] - at[j][i]) / (borders[j + 1] - borders[j])).as_vec3());
-        }
-    }
+    let rates = rates_between(&at, borders, n);
     FaceDefMesh {
         mesh: entry.mesh.clone(),
         interval_borders: borders.to_vec(),
