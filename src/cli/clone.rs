@@ -9,6 +9,7 @@ use fbakit::clone::eval::{
 };
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
 use fbakit::error::{Error, Result, ResultExt};
+use fbakit::export::obj_shapes::{write_obj_shapes, ObjShapesReport, ShapeNames};
 use fbakit::export::write_face;
 use fbakit::face::{FaceFormat, FaceModel};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
@@ -23,8 +24,10 @@ pub struct CloneArgs {
     pub source: PathBuf,
     /// Target face: VRML (`.wrl`), or `.obj` with --fp-target.
     pub target: PathBuf,
-    /// Output: a face file (`.wrl`, `.wrl.gz`, `.obj`) or glTF (`.glb`, `.gltf`: the cloned FAT as
-    /// morph targets).
+    /// Output: a face file (`.wrl`, `.wrl.gz`), glTF (`.glb`, `.gltf`: the cloned FAT as
+    /// morph targets), or an OBJ shape set: `DIR/` (`neutral.obj`, `feature-points.csv` and
+    /// one OBJ per morph target) or `OUT.obj` (the neutral, the set in `OUT_shapes/`). An OBJ
+    /// target comes back as the user's file with only its `v` lines rewritten.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Surface method.
@@ -56,8 +59,9 @@ pub struct CloneArgs {
     /// Print the time of each cloning step (always in --json).
     #[arg(short, long)]
     pub verbose: bool,
-    /// Morph target names of a .glb/.gltf output: `fat` (the cloned FAT's keys) or `arkit`
-    /// (the 52 ARKit blend shapes from their FAP recipes, as `face export --names arkit`).
+    /// Morph target names of a .glb/.gltf or OBJ shape-set output: `fat` (the cloned FAT's
+    /// keys, `NAME@VALUE` per interval border) or `arkit` (the 52 ARKit blend shapes from their
+    /// FAP recipes, as `face export --names arkit`).
     #[arg(long, value_name = "fat|arkit", default_value = "fat")]
     pub names: super::face_export::NamesArg,
 }
@@ -255,14 +259,28 @@ struct Output<'a> {
     write_warnings: Vec<fbakit::error::Diagnostic>,
     #[serde(skip_serializing_if = "Option::is_none")]
     arkit: Option<fbakit::rig::arkit_export::ArkitExportReport>,
+    /// What an OBJ shape-set output wrote.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shapes: Option<ObjShapesReport>,
 }
 
+/// What `clone -o` accepts: face files and OBJ shape sets (`.obj` or a directory).
+const CLONE_OUTPUTS: &[OutputFormat] = &[
+    OutputFormat::Vrml,
+    OutputFormat::VrmlGz,
+    OutputFormat::Obj,
+    OutputFormat::Glb,
+    OutputFormat::Gltf,
+    OutputFormat::Directory,
+];
+
 pub fn run(args: CloneArgs) -> Result<u8> {
-    let format = OutputFormat::resolve(&args.output, OutputFormat::FACES, "the cloned face")?;
+    let format = OutputFormat::resolve(&args.output, CLONE_OUTPUTS, "the cloned face")?;
     let arkit_names = args.names == super::face_export::NamesArg::Arkit;
-    if arkit_names && !matches!(format, OutputFormat::Glb | OutputFormat::Gltf) {
+    let shape_set = matches!(format, OutputFormat::Obj | OutputFormat::Directory);
+    if arkit_names && !matches!(format, OutputFormat::Glb | OutputFormat::Gltf) && !shape_set {
         return Err(Error::Usage(format!(
-            "{}: --names arkit needs a .glb or .gltf output",
+            "{}: --names arkit needs a .glb, .gltf or .obj output or a directory",
             args.output.display()
         )));
     }
@@ -299,6 +317,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
                 quality: None,
                 write_warnings: Vec::new(),
                 arkit: None,
+                shapes: None,
             })?;
         } else {
             print_warnings(&r.warnings);
@@ -314,7 +333,18 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it), or
     // ARKit-named shapes made from it.
     let mut arkit = None;
-    let write_warnings = if arkit_names {
+    let mut shapes = None;
+    let write_warnings = if shape_set {
+        let names = if arkit_names {
+            ShapeNames::Arkit
+        } else {
+            ShapeNames::Fat
+        };
+        let mut report = write_obj_shapes(&outcome.face, &args.output, names)?;
+        arkit = report.arkit.take();
+        shapes = Some(report);
+        Vec::new()
+    } else if arkit_names {
         let (report, warnings) =
             fbakit::rig::arkit_export::write_arkit_gltf(&outcome.face, &args.output, None)?;
         arkit = Some(report);
@@ -343,6 +373,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
             quality,
             write_warnings,
             arkit,
+            shapes,
         })?;
         return Ok(EXIT_OK);
     }
@@ -367,6 +398,19 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         for (step, s) in &r.timings.steps {
             println!("  {step:<20} {:>8.1} ms", s * 1000.0);
         }
+    }
+    if let Some(sh) = &shapes {
+        println!(
+            "{} shapes in {} ({}), neutral {}",
+            sh.shapes.len(),
+            sh.folder.display(),
+            if sh.user_layout {
+                "the target's own OBJ, v lines rewritten"
+            } else {
+                "meshes merged in face coordinates"
+            },
+            sh.neutral.display()
+        );
     }
     if arkit.is_some() {
         super::face_export::print_arkit_report(

@@ -202,12 +202,16 @@ pub enum Command {
                       (fit, the default), facial motion cloning (fmc, Pandzic 2003) or RBF \
                       cloning (rbf, Fratarcangeli & Schaerf 2005), eyes, teeth, tongue and \
                       head by their transforms. Faces are VRML face files, or OBJ meshes with a \
-                      feature-point file. Exit codes: 0 ok, 2 bad usage or input (including \
+                      feature-point file. The target comes back in its own layout: every mesh \
+                      with its vertices in their order (eyes and teeth inside one mesh move by \
+                      per-vertex tables); an OBJ target cloned to DIR/ or .obj comes back as \
+                      its own file plus one OBJ per morph target (shape keys). Exit codes: 0 ok, 2 bad usage or input (including \
                       missing feature points), 1 other failures.",
         after_help = "Examples:\n  fbakit clone alma.wrl bruno.wrl -o bruno-animated.wrl\n  \
                       fbakit clone alma.wrl head.obj --fp-target head.fdp -o head.wrl --method rbf --report\n  \
                       fbakit clone alma.wrl bruno.wrl -o out.wrl --json > report.json\n  \
-                      fbakit clone alma bruno -o bruno-arkit.glb --method rbf --names arkit"
+                      fbakit clone alma bruno -o bruno-arkit.glb --method rbf --names arkit\n  \
+                      fbakit clone alma head.obj --fp-target fp.csv -o shapes/ --names arkit"
     )]
     Clone(clone::CloneArgs),
     /// Quality figures of a face's FAT (compliance, self-cloning error).

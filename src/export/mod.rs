@@ -19,6 +19,7 @@ mod error;
 pub mod gltf;
 pub mod movie;
 pub mod obj_sequence;
+pub mod obj_shapes;
 pub mod picture;
 pub mod video;
 pub mod viewer;

@@ -154,6 +154,9 @@ pub struct FaceModel {
     pub fat: Fat,
     /// The VRML scene it was read from, kept so writing preserves every other node.
     pub scene: Option<crate::vrml::Scene>,
+    /// The OBJ text it was read from, kept so OBJ outputs keep the user's file (groups,
+    /// materials, `vt`, `vn`, comments) and rewrite only its `v` lines ([`obj_patch`]).
+    pub obj_source: Option<std::sync::Arc<str>>,
 }
 
 impl PartialEq for FaceModel {
@@ -184,6 +187,7 @@ impl FaceModel {
             feature_points: FeaturePointSet::new(),
             fat: Fat::default(),
             scene: None,
+            obj_source: None,
         }
     }
 

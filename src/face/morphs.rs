@@ -18,7 +18,8 @@
 //! [`fat_from_morph_targets`].
 //!
 //! **Writing.** [`write_morph_set`] writes `neutral.obj` (all meshes merged in face
-//! coordinates, as [`super::write()`] writes OBJ), `feature-points.csv` (the feature points
+//! coordinates, as [`super::write()`] writes OBJ; a face read from an OBJ file that still has
+//! its layout gets that file back with only its `v` lines rewritten, in every file of the set), `feature-points.csv` (the feature points
 //! bound to the merged mesh's vertices) and one OBJ per table and value: the table's vertex
 //! motion plus the effect of the transforms it drives on the meshes under them. Files other
 //! than `*.obj` and the file `neutral.obj` are ignored when a set is read, so a written set
@@ -31,7 +32,7 @@ use glam::{Affine3A, DVec3, Vec3};
 use serde::Serialize;
 
 use super::attach::attach_feature_points;
-use super::write::merged_mesh;
+use super::write::{merged_mesh, source_obj_text};
 use super::{FaceError, FaceModel};
 use crate::error::{Error, Location, Result};
 use crate::fat::eval::Activation;
@@ -437,7 +438,13 @@ pub fn write_morph_set(
         mesh: merged_mesh(face, &neutral_frames.meshes, None)?,
         material_libraries: Vec::new(),
     };
-    out_dir.write_file(NEUTRAL_FILE, |p| write_obj_file(&neutral, p))?;
+    // A face read from OBJ keeps the user's file: only the `v` lines change.
+    let write_obj =
+        |name: &str, scene: &ObjScene| match source_obj_text(face, &scene.mesh.positions) {
+            Some(text) => out_dir.write_file(name, |p| crate::io::write_atomic(p, text.as_bytes())),
+            None => out_dir.write_file(name, |p| write_obj_file(scene, p)),
+        };
+    write_obj(NEUTRAL_FILE, &neutral)?;
     let points = FeaturePointTable::from_set(&merged_feature_points(face));
     out_dir.write_file(FEATURE_POINTS_FILE, |p| write_csv_file(p, &points))?;
 
@@ -459,7 +466,7 @@ pub fn write_morph_set(
                 mesh,
                 material_libraries: Vec::new(),
             };
-            out_dir.write_file(&name, |p| write_obj_file(&scene, p))?;
+            write_obj(&name, &scene)?;
             written.push(WrittenMorph {
                 file: dir.join(name),
                 key,

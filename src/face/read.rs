@@ -199,7 +199,8 @@ fn vrml_face(path: &Path, text: &str, name: &str) -> Result<(FaceModel, FaceRead
 fn obj_face(path: &Path, bytes: &[u8], name: &str) -> Result<(FaceModel, FaceReadReport)> {
     let text = text_of(path, bytes, "UTF-8 OBJ text")?;
     let (obj, diagnostics) = crate::mesh::obj::parse_obj(&text, path)?;
-    let face = FaceModel::single_mesh(name, obj.mesh);
+    let mut face = FaceModel::single_mesh(name, obj.mesh);
+    face.obj_source = Some(text.into());
     let report = FaceReadReport {
         diagnostics,
         mesh_paths: vec![format!("OBJ {}", path.display())],

@@ -1,6 +1,7 @@
 //! Writing a face in the format its file name asks for: VRML97 (patching the source scene
-//! so other nodes survive), gzip VRML, or OBJ (all meshes merged in face coordinates, each an
-//! `o` span; feature points, transforms and the FAT cannot be held by OBJ and are not
+//! so other nodes survive), gzip VRML, or OBJ (a face read from OBJ: the user's text with only
+//! its `v` lines rewritten, [`source_obj_text`]; otherwise all meshes merged in face
+//! coordinates, each an `o` span; feature points, transforms and the FAT cannot be held by OBJ and are not
 //! written: use VRML for a complete face). glTF output is [`crate::export::gltf`].
 
 use std::path::Path;
@@ -30,6 +31,10 @@ pub fn write(path: impl AsRef<Path>, face: &FaceModel) -> Result<()> {
         }
         // `resolve` accepted only WRITABLE: this is OBJ.
         _ => {
+            let world: Vec<Vec3> = face.neutral_world_positions().concat();
+            if let Some(text) = source_obj_text(face, &world) {
+                return crate::io::write_atomic(path, text.as_bytes());
+            }
             let scene = ObjScene {
                 mesh: merged_mesh(face, &face.frames().meshes, None)?,
                 material_libraries: Vec::new(),
@@ -37,6 +42,23 @@ pub fn write(path: impl AsRef<Path>, face: &FaceModel) -> Result<()> {
             crate::mesh::obj::write_obj_file(&scene, path)
         }
     }
+}
+
+/// The OBJ text `face` was read from with its vertices moved to `positions` (face frame, in
+/// its vertex order): every other statement as the user wrote it
+/// ([`crate::mesh::obj_patch`]). `None` when the face has no OBJ source or no longer has its
+/// layout (one mesh with as many vertices and polygons as the text has `v` and `f`
+/// statements) — then [`merged_mesh`] is the fallback.
+pub fn source_obj_text(face: &FaceModel, positions: &[Vec3]) -> Option<String> {
+    let text = face.obj_source.as_deref()?;
+    let [only] = face.meshes.as_slice() else {
+        return None;
+    };
+    let layout = crate::mesh::obj_patch::obj_layout(text);
+    if layout.vertices != only.mesh.positions.len() || layout.faces != only.mesh.polygons.len() {
+        return None;
+    }
+    crate::mesh::obj_patch::patch_vertex_lines(text, positions)
 }
 
 /// All meshes of `face` merged into one in face coordinates, each mesh placed by

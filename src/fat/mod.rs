@@ -7,7 +7,8 @@
 //! and transforms are referred to by their `DEF` name, exactly as the VRML `USE` does.
 //!
 //! Evaluation ([`eval`]) turns FAP values into per-vertex displacements and transform changes;
-//! [`morph`] converts between FATs and morph targets.
+//! [`morph`] converts between FATs and morph targets; [`bake`] turns a motion of some vertices
+//! (a transform's, a rigid part's) into displacement entries.
 //!
 //! ## Units
 //! The value `P` a table is evaluated at is the raw FAP value for low-level FAPs (so the face's
@@ -17,6 +18,7 @@
 //! `intensity2` (the two terms are added). A table whose only interval is `[0, 63]` therefore
 //! shows its full morph target at `P = 63`.
 
+pub mod bake;
 mod error;
 pub mod eval;
 pub mod morph;

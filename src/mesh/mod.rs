@@ -19,6 +19,7 @@ pub mod components;
 mod error;
 pub mod geometry;
 pub mod obj;
+pub mod obj_patch;
 pub mod orient;
 pub mod spatial;
 pub mod subdivide;

@@ -27,9 +27,11 @@
 //!    axes. [`CloneOptions::align`] turns the whole step off.
 //! 3. **`surfaces`** — a [`CloneSurface`] per face: skin meshes placed by their transforms
 //!    (`FaceModel::frames`), concatenated, polygons triangulated, coincident vertices welded
-//!    (within 1e-6 of the face's size) so seams do not cut the surface — except inside the
-//!    mouth box (between the lip corners, ±0.35 MNS0 around the lip line), where a closed
-//!    mouth's upper and lower lip vertices coincide and must stay apart. A target that is one
+//!    (within 1e-6 of the face's size) so seams do not cut the surface — except, inside the
+//!    mouth box (between the lip corners, ±0.35 MNS0 around the lip line), a closed mouth's
+//!    upper and lower lip vertices, which coincide and must stay apart: there duplicates are
+//!    welded unless one's polygons lie all above it and the other's all below (a seam down
+//!    the lips or a skin / mouth primitive border is welded, the slit is not). A target that is one
 //!    mesh with the source (same vertex counts and polygons) is welded exactly as the source
 //!    ([`build_skin_surface_like`]). Results on a welded vertex go back to every duplicate that
 //!    is a corner of some polygon: a vertex in no polygon is invisible and never moves
@@ -81,6 +83,15 @@
 //!    (inverse world 3×3) and [`fat_from_morph_targets`] rebuilds the tables (multi-interval
 //!    tables keep their borders); transform entries are appended. Every output number must be
 //!    finite, or the clone fails.
+//! 9. **`fold`** — a one-mesh target cut in step 1 comes back in its own layout: the cut is an
+//!    internal view only. Entries on the view's skin and part meshes go back to the target
+//!    mesh's own vertex numbers through the cut's index maps (a vertex on the cut along the
+//!    lip line, in both jaws, takes the mean of both), and transforms created in step 7 for
+//!    cut parts alone are baked into per-vertex displacements of those vertices
+//!    ([`crate::fat::bake`]: piecewise linear over the table's intervals, borders added until
+//!    within 1 % of the part's size at every FAP value the source's table covers, both signs
+//!    for bidirectional FAPs) and left out of the face. The output has exactly the target's
+//!    meshes with every vertex, polygon and attribute in its order.
 //!
 //! Rotations from the FAT are taken as composed after the neutral rotation (`R₀·ΔR`), so their
 //! axes live in the transform's own rotated frame.
@@ -112,12 +123,13 @@
 //! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
 //! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
 //! the surface (steps 4 and 8), `rescale` step 6 and the guard, `rigid` and `part_motion`
-//! step 7 and `assemble` step 8. This file runs them in order.
+//! step 7, `assemble` step 8 and `fold` step 9. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
 
 mod align;
 mod assemble;
+mod fold;
 mod motions;
 mod options;
 mod part_deform;
@@ -198,7 +210,11 @@ pub fn clone_face(
     // The target's own FAT is replaced anyway; without it its skin mesh can be cut.
     let mut bare = target.clone();
     bare.fat = Fat::default();
-    let (split_target, split) = split_embedded_parts(&bare);
+    let view = split::split_view(&bare);
+    let (split_target, split) = match &view {
+        Some(v) => (v.face.clone(), v.parts.clone()),
+        None => (bare.clone(), Vec::new()),
+    };
     let target = &split_target;
     let sparts = identify_parts(source);
     let mut tparts = identify_parts(target);
@@ -324,9 +340,15 @@ pub fn clone_face(
         .collect();
     fat.tables
         .retain(|t| !dropped.contains(&t.key.name().as_str()));
-    report.tables = fat.tables.len();
     face.fat = fat;
     report.timings.push("fat", clock.elapsed().as_secs_f64());
+    // 9. The target's own layout.
+    if let Some(v) = &view {
+        let clock = Instant::now();
+        face = fold::fold_into_target(&face, &bare, v, &targets, &mut report)?;
+        report.timings.push("fold", clock.elapsed().as_secs_f64());
+    }
+    report.tables = face.fat.tables.len();
     report.source_parts = sparts;
     report.target_parts = tparts;
     Ok(CloneOutcome { face, report })

@@ -24,6 +24,9 @@ pub struct RigidReport {
     pub transform_entries: usize,
     /// Tables whose tongue deformation became a rigid tongue translation.
     pub rigid_tongue_tables: usize,
+    /// Transforms the clone needed only for parts cut out of a one-mesh target: their motion
+    /// is baked into that mesh's tables and they are not in the output face.
+    pub baked_transforms: Vec<String>,
 }
 
 /// Everything [`clone_face`](super::clone_face) reports besides the face.
@@ -39,7 +42,8 @@ pub struct CloneReport {
     pub warnings: Vec<crate::error::Diagnostic>,
     /// Source parts.
     pub source_parts: FaceParts,
-    /// Target parts.
+    /// Target parts, as mesh indices of the internal view the clone worked on: for a one-mesh
+    /// target whose parts were cut out (`split_parts`), that view's meshes, not the output's.
     pub target_parts: FaceParts,
     /// Target → source alignment used.
     pub alignment: Similarity,

@@ -108,7 +108,7 @@ pub fn build_skin_surface_like(
             }
             (l.welded.clone(), surface_positions)
         }
-        _ => weld_outside_mouth(&positions, eps, mouth),
+        _ => weld_outside_mouth(&positions, &triangles, eps, mouth),
     };
     let (member_start, members) = duplicate_lists(&welded, surface_positions.len());
     let tris: Vec<[u32; 3]> = triangles
@@ -192,17 +192,45 @@ fn framed_feature_points(
     Ok((fp_positions, fapu))
 }
 
-/// Welds vertices within `eps` of each other, except clusters inside the `mouth` box (a
-/// closed mouth's lips coincide and must stay apart). Returns the surface vertex of every
-/// input vertex and the surface positions.
-fn weld_outside_mouth(positions: &[Vec3], eps: f32, mouth: Option<Box3>) -> (Vec<u32>, Vec<Vec3>) {
+/// Welds vertices within `eps` of each other. Inside the `mouth` box a closed mouth's upper
+/// and lower lips coincide and must stay apart, while seam duplicates there (a UV seam down the
+/// lips, the border between a skin and a mouth primitive) must not: coincident vertices in the
+/// box are welded unless one's polygons lie all above it and the other's all below (the
+/// opposite lips of the closed slit; `y` is up in the frame cloning works in). Returns the
+/// surface vertex of every input vertex and the surface positions.
+fn weld_outside_mouth(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    eps: f32,
+    mouth: Option<Box3>,
+) -> (Vec<u32>, Vec<Vec3>) {
     let coincident = find_coincident_vertices(positions, eps);
     let mut rep = coincident.representative.clone();
-    for cluster in &coincident.clusters {
-        let p = positions[cluster[0] as usize];
-        if mouth.is_some_and(|b| b.contains(p)) {
+    let in_mouth: Vec<&Vec<u32>> = coincident
+        .clusters
+        .iter()
+        .filter(|c| mouth.is_some_and(|b| b.contains(positions[c[0] as usize])))
+        .collect();
+    if !in_mouth.is_empty() {
+        let side = lip_sides(positions, triangles);
+        for cluster in in_mouth {
+            // Members join the first group whose side is compatible; a group takes the side
+            // of a sided member.
+            let mut groups: Vec<(u32, LipSide)> = Vec::new();
             for &v in cluster {
-                rep[v as usize] = v;
+                let s = side[v as usize];
+                match groups.iter_mut().find(|(_, g)| g.compatible(s)) {
+                    Some((r, g)) => {
+                        rep[v as usize] = *r;
+                        if *g == LipSide::Both {
+                            *g = s;
+                        }
+                    }
+                    None => {
+                        rep[v as usize] = v;
+                        groups.push((v, s));
+                    }
+                }
             }
         }
     }
@@ -218,6 +246,59 @@ fn weld_outside_mouth(positions: &[Vec3], eps: f32, mouth: Option<Box3>) -> (Vec
         welded[i] = welded[rep[i] as usize];
     }
     (welded, surface_positions)
+}
+
+/// Where a vertex's polygons lie, vertically.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum LipSide {
+    /// All above it (an upper lip's edge).
+    Above,
+    /// All below it.
+    Below,
+    /// Both, or no polygon.
+    Both,
+}
+
+impl LipSide {
+    /// Whether two duplicates with these sides may be one vertex.
+    fn compatible(self, other: LipSide) -> bool {
+        !matches!(
+            (self, other),
+            (LipSide::Above, LipSide::Below) | (LipSide::Below, LipSide::Above)
+        )
+    }
+}
+
+/// The [`LipSide`] of every vertex from its triangles' other corners (a tenth of the fan's
+/// height of tolerance).
+fn lip_sides(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<LipSide> {
+    let mut range = vec![(f32::INFINITY, f32::NEG_INFINITY); positions.len()];
+    for t in triangles {
+        for &v in t {
+            let y0 = positions[v as usize].y;
+            let r = &mut range[v as usize];
+            for &w in t {
+                let dy = positions[w as usize].y - y0;
+                r.0 = r.0.min(dy);
+                r.1 = r.1.max(dy);
+            }
+        }
+    }
+    range
+        .into_iter()
+        .map(|(lo, hi)| {
+            let tol = 0.1 * (hi - lo);
+            if lo > hi || hi - lo <= 0.0 {
+                LipSide::Both
+            } else if lo >= -tol {
+                LipSide::Above
+            } else if hi <= tol {
+                LipSide::Below
+            } else {
+                LipSide::Both
+            }
+        })
+        .collect()
 }
 
 /// The input vertices behind each of `count` surface vertices, as CSR lists

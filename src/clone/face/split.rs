@@ -1,6 +1,7 @@
 //! One-mesh heads: eyes, teeth and gums that are separate connected pieces of the skin mesh
 //! (the bundled `ict`) are split into part meshes before cloning, so the rigid-part step can
-//! move them (module docs of [`super`], step 1).
+//! move them (module docs of [`super`], step 1). The split is an internal view: its index maps
+//! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
 
 use std::collections::BTreeMap;
 
@@ -27,6 +28,24 @@ pub struct SplitPart {
     pub vertices: usize,
     /// Connected pieces it gathers (a piece straddling the lip line counts for both jaws).
     pub pieces: usize,
+    /// For each of its vertices, the vertex of the original mesh it is (the index map that
+    /// folds the part's motion back into that mesh; vertices on a cut along the lip line are
+    /// in both jaws' parts).
+    #[serde(skip)]
+    pub source_vertices: Vec<u32>,
+}
+
+/// The internal view of a one-mesh head cut into parts, with the index maps back to it.
+#[derive(Clone, Debug)]
+pub(super) struct SplitView {
+    /// The face with the cut mesh replaced by its skin and the part meshes appended.
+    pub face: FaceModel,
+    /// The parts cut out (their `source_vertices` map their vertices back).
+    pub parts: Vec<SplitPart>,
+    /// Name of the mesh that was cut (its skin keeps the name).
+    pub mesh: String,
+    /// For each vertex of the skin left in the view, its vertex in the original mesh.
+    pub skin_vertices: Vec<u32>,
 }
 
 /// Connected pieces of a mesh (polygon connectivity, coincident vertices joined): the piece
@@ -121,16 +140,31 @@ impl Landmarks {
 /// meshes no FAT table deforms are cut (a FAT would need remapping). Returns the face (unchanged
 /// when nothing was split) and the new part meshes.
 pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
-    let Some(lm) = Landmarks::of(face) else {
-        return (face.clone(), Vec::new());
-    };
+    match split_view(face) {
+        Some(v) => (v.face, v.parts),
+        None => (face.clone(), Vec::new()),
+    }
+}
+
+/// New → old vertex indices from an old → new map.
+fn inverse(map: &BTreeMap<u32, u32>) -> Vec<u32> {
+    let mut out = vec![0; map.len()];
+    for (&old, &new) in map {
+        if let Some(o) = out.get_mut(new as usize) {
+            *o = old;
+        }
+    }
+    out
+}
+
+/// [`split_embedded_parts`] with the index maps, `None` when nothing is cut.
+pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
+    let lm = Landmarks::of(face)?;
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
     // Meshes holding a skin feature point (2.1: the chin) are the candidates.
     let chin = FeaturePointId::FP_2_1;
-    let Some((mi, _)) = fp_mesh_vertex(face, &frames, chin, diag * 1e-4) else {
-        return (face.clone(), Vec::new());
-    };
+    let (mi, _) = fp_mesh_vertex(face, &frames, chin, diag * 1e-4)?;
     let name = face.meshes[mi].name.clone();
     if face
         .fat
@@ -138,7 +172,7 @@ pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
         .iter()
         .any(|t| t.meshes.iter().any(|m| m.mesh == name))
     {
-        return (face.clone(), Vec::new());
+        return None;
     }
     let mesh = &face.meshes[mi].mesh;
     let world: Vec<Vec3> = mesh
@@ -148,7 +182,7 @@ pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
         .collect();
     let (piece, count) = mesh_pieces(mesh, diag * 1e-6);
     if count < 2 {
-        return (face.clone(), Vec::new());
+        return None;
     }
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
     for (v, &k) in piece.iter().enumerate() {
@@ -194,9 +228,8 @@ pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
         dest.entry(part).or_default().push(pi);
     }
     if dest.keys().all(|p| p.is_none()) {
-        return (face.clone(), Vec::new());
+        return None;
     }
-    // The scene stays: the writer adds the new part meshes' shapes beside the skin's.
     let mut out = face.clone();
     // Skin keeps its polygons and every vertex no part polygon uses (isolated ones too).
     let mut used_by_part = vec![false; mesh.positions.len()];
@@ -236,6 +269,7 @@ pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
             mesh: new_name.clone(),
             vertices: m.positions.len(),
             pieces: pieces.get(p).map_or(0, |s| s.len()),
+            source_vertices: inverse(&map),
         });
         out.meshes.push(FaceMesh {
             name: new_name.clone(),
@@ -249,7 +283,12 @@ pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
         maps.push((new_name, map));
     }
     rebind_feature_points(&mut out, face, mi, &maps);
-    (out, report)
+    Some(SplitView {
+        face: out,
+        parts: report,
+        skin_vertices: inverse(&maps[0].1),
+        mesh: name,
+    })
 }
 
 /// Feature points bound to the cut mesh follow their vertex into its new mesh.

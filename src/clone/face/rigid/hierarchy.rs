@@ -7,7 +7,7 @@ use crate::clone::face::{FaceParts, Part};
 use crate::face::FaceModel;
 
 /// `t` and its ancestors, nearest first (stops on a cycle).
-pub(super) fn ancestors(face: &FaceModel, mut t: Option<usize>) -> Vec<usize> {
+pub(in crate::clone::face) fn ancestors(face: &FaceModel, mut t: Option<usize>) -> Vec<usize> {
     let mut out = Vec::new();
     while let Some(i) = t {
         if out.contains(&i) || out.len() > face.transforms.len() {

@@ -12,6 +12,7 @@ use glam::{Affine3A, Vec3};
 
 pub use centres::install_center;
 use centres::{install_eye_centres, install_head_centre, install_rotated_part_centres};
+pub(super) use hierarchy::ancestors as hierarchy_ancestors;
 use hierarchy::{encloses, lowest_enclosing, roles, unique_name};
 
 use super::{CloneReport, FaceParts, Part, Similarity};

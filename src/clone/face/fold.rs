@@ -1,0 +1,375 @@
+//! Handing the target back in its own layout (module docs of [`super`], step 9): a one-mesh
+//! head was cloned through an internal view with its eyes and teeth cut into part meshes
+//! ([`super::split`]); this folds the view's FAT back into the user's mesh. Entries on the
+//! view's skin and part meshes go back to the original vertex numbers through the split's
+//! index maps, and the motion of transforms created only for cut parts is baked into
+//! per-vertex displacements of those vertices ([`crate::fat::bake`]), within 1 % of the part's
+//! size at every FAP value the table covers. The face returned has exactly the target's
+//! meshes, vertices and polygons; its transforms are the target's plus those that still hold
+//! a mesh (a created root `head`).
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+use glam::{Affine3A, Vec3};
+
+use super::rigid::hierarchy_ancestors;
+use super::split::SplitView;
+use super::{CloneReport, Part};
+use crate::error::{Diagnostic, Result};
+use crate::face::FaceModel;
+use crate::fat::bake::{bake_motion, on_borders, part_size, BakeRequest};
+use crate::fat::eval::{Activation, FatEvaluator};
+use crate::fat::morph::MorphTarget;
+use crate::fat::{FaceDefMesh, FaceDefTable, Fat, TableKey};
+use crate::spec::Directionality;
+
+/// Share of a part's size a baked motion may be off by.
+pub(super) const BAKE_TOLERANCE: f32 = 0.01;
+
+/// One mesh of the view and where its vertices are in the target.
+struct ViewMesh<'a> {
+    /// Index in the view face.
+    index: usize,
+    /// View vertex → target vertex.
+    to_target: &'a [u32],
+    /// The part it is, `None` for the skin left of the cut mesh.
+    part: Option<Part>,
+}
+
+/// The cloned view `cloned` folded back into `target`'s layout (module docs). `targets` are the
+/// source's morph targets (the FAP values each table covers); `report` gets warnings and its
+/// rigid-part figures corrected for the transforms that were baked.
+pub(super) fn fold_into_target(
+    cloned: &FaceModel,
+    target: &FaceModel,
+    view: &SplitView,
+    targets: &[MorphTarget],
+    report: &mut CloneReport,
+) -> Result<FaceModel> {
+    let Some(target_mesh) = target.mesh_index(&view.mesh) else {
+        return Ok(cloned.clone());
+    };
+    let mut meshes: Vec<ViewMesh> = Vec::new();
+    if let Some(index) = cloned.mesh_index(&view.mesh) {
+        meshes.push(ViewMesh {
+            index,
+            to_target: &view.skin_vertices,
+            part: None,
+        });
+    }
+    for p in &view.parts {
+        if let Some(index) = cloned.mesh_index(&p.mesh) {
+            meshes.push(ViewMesh {
+                index,
+                to_target: &p.source_vertices,
+                part: Some(p.part),
+            });
+        }
+    }
+    // How many view meshes hold each target vertex (2 on a cut along the lip line).
+    let mut multiplicity = vec![0u8; target.meshes[target_mesh].mesh.positions.len()];
+    for m in &meshes {
+        for &v in m.to_target {
+            if let Some(k) = multiplicity.get_mut(v as usize) {
+                *k = k.saturating_add(1);
+            }
+        }
+    }
+    let part_names: BTreeSet<&str> = view.parts.iter().map(|p| p.mesh.as_str()).collect();
+    let baked = baked_transforms(cloned, &part_names, &report.rigid.created_transforms);
+    let ranges = covered_ranges(targets);
+    let original = &target.meshes[target_mesh].mesh.positions;
+    let mut fat = Fat::default();
+    for table in &cloned.fat.tables {
+        let mut entries: Vec<FaceDefMesh> = Vec::new();
+        let mut out = FaceDefTable::new(table.key);
+        for e in &table.meshes {
+            match meshes
+                .iter()
+                .find(|m| cloned.meshes[m.index].name == e.mesh)
+            {
+                Some(m) => entries.push(FaceDefMesh {
+                    mesh: view.mesh.clone(),
+                    coord_index: e
+                        .coord_index
+                        .iter()
+                        .map(|&v| m.to_target.get(v as usize).copied().unwrap_or(v))
+                        .collect(),
+                    ..e.clone()
+                }),
+                None => out.meshes.push(e.clone()),
+            }
+        }
+        if table
+            .transforms
+            .iter()
+            .any(|t| baked.contains(&t.transform))
+        {
+            let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
+            let borders: Vec<f64> = entries
+                .iter()
+                .flat_map(|e| e.interval_borders.iter().copied())
+                .collect();
+            let mut motion = TableMotion::new(cloned, table)?;
+            for m in meshes.iter().filter(|m| m.part.is_some()) {
+                let Some(t) = cloned.meshes[m.index].transform else {
+                    continue;
+                };
+                if !hierarchy_ancestors(cloned, Some(t))
+                    .iter()
+                    .any(|&a| baked.contains(&cloned.transforms[a].name))
+                {
+                    continue;
+                }
+                let skin = meshes.first().map_or(m.index, |s| s.index);
+                let neutral: Vec<Vec3> = m
+                    .to_target
+                    .iter()
+                    .map(|&v| original.get(v as usize).copied().unwrap_or(Vec3::ZERO))
+                    .collect();
+                let size = part_size(&neutral);
+                let tolerance = BAKE_TOLERANCE * size;
+                let b = bake_motion(
+                    &BakeRequest {
+                        mesh: &view.mesh,
+                        vertices: m.to_target,
+                        neutral: &neutral,
+                        range,
+                        borders: &borders,
+                        tolerance,
+                    },
+                    |p| motion.in_mesh_frame(skin, m.index, table.key, p),
+                );
+                if b.max_error > tolerance {
+                    report.warnings.push(Diagnostic::warning(format!(
+                        "{}: the baked motion of {} is off by {:.3} % of its size",
+                        table.key,
+                        cloned.meshes[m.index].name,
+                        100.0 * b.max_error / size.max(f32::MIN_POSITIVE)
+                    )));
+                }
+                entries.push(b.entry);
+            }
+        }
+        if let Some(merged) = merge_entries(&entries, &multiplicity) {
+            out.meshes.insert(0, merged);
+        }
+        out.transforms = table
+            .transforms
+            .iter()
+            .filter(|t| !baked.contains(&t.transform))
+            .cloned()
+            .collect();
+        if !out.meshes.is_empty() || !out.transforms.is_empty() {
+            fat.tables.push(out);
+        }
+    }
+    let face = layout_face(cloned, target, &baked, fat);
+    correct_report(report, &baked);
+    Ok(face)
+}
+
+/// Created transforms that hold only cut part meshes: their motion becomes displacements.
+fn baked_transforms(
+    cloned: &FaceModel,
+    part_names: &BTreeSet<&str>,
+    created: &[String],
+) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for (t, tf) in cloned.transforms.iter().enumerate() {
+        if !created.contains(&tf.name) {
+            continue;
+        }
+        let held: Vec<&str> = cloned
+            .meshes
+            .iter()
+            .filter(|m| hierarchy_ancestors(cloned, m.transform).contains(&t))
+            .map(|m| m.name.as_str())
+            .collect();
+        if !held.is_empty() && held.iter().all(|n| part_names.contains(n)) {
+            out.insert(tf.name.clone());
+        }
+    }
+    out
+}
+
+/// Per key, the FAP values its morph targets cover (0 included; both signs for bidirectional
+/// FAPs, which the source's borders may show on one side only).
+fn covered_ranges(targets: &[MorphTarget]) -> HashMap<TableKey, (f64, f64)> {
+    let mut out: HashMap<TableKey, (f64, f64)> = HashMap::new();
+    for t in targets {
+        let r = out.entry(t.key).or_insert((0.0, 0.0));
+        r.0 = r.0.min(t.value);
+        r.1 = r.1.max(t.value);
+    }
+    for (key, r) in &mut out {
+        if let TableKey::LowLevel(f) = key {
+            if f.info().directionality == Some(Directionality::Bidirectional) {
+                let a = r.1.max(-r.0);
+                *r = (-a, a);
+            }
+        }
+    }
+    out
+}
+
+/// The transform motion of one table on the cloned view.
+struct TableMotion<'a> {
+    face: &'a FaceModel,
+    evaluator: FatEvaluator,
+    neutral: Vec<Affine3A>,
+}
+
+impl<'a> TableMotion<'a> {
+    fn new(face: &'a FaceModel, table: &FaceDefTable) -> Result<Self> {
+        let only = Fat {
+            tables: vec![FaceDefTable {
+                key: table.key,
+                meshes: Vec::new(),
+                transforms: table.transforms.clone(),
+            }],
+        };
+        let evaluator = FatEvaluator::new(&only, &[], &face.transform_names())?;
+        Ok(TableMotion {
+            face,
+            evaluator,
+            neutral: face.frames().meshes,
+        })
+    }
+
+    /// The map, in the frame of view mesh `skin` (the target mesh's frame), that takes a
+    /// vertex of view mesh `part` at neutral to where the table at `p` puts it:
+    /// `W_skin(p)⁻¹ · W_part(p) · W_part(0)⁻¹ · W_skin(0)`.
+    fn in_mesh_frame(&mut self, skin: usize, part: usize, key: TableKey, p: f64) -> Affine3A {
+        let mut out = self.evaluator.output();
+        self.evaluator
+            .evaluate(&[Activation { key, value: p }], &mut out);
+        let locals: Vec<Affine3A> = self
+            .face
+            .transforms
+            .iter()
+            .zip(&out.transforms)
+            .map(|(t, d)| t.animated_matrix(d))
+            .collect();
+        let posed = self.face.frames_with(&locals);
+        posed.meshes[skin].inverse()
+            * posed.meshes[part]
+            * self.neutral[part].inverse()
+            * self.neutral[skin]
+    }
+}
+
+/// One entry for the target mesh from the view's entries (already in target numbering): on
+/// the union of their borders, each vertex's rates summed over the view meshes that moved it
+/// and divided by the number of view meshes holding it (a vertex on a cut takes the mean of
+/// both sides, a side without an entry counting as still).
+fn merge_entries(entries: &[FaceDefMesh], multiplicity: &[u8]) -> Option<FaceDefMesh> {
+    let first = entries.first()?;
+    let shared = entries.iter().any(|e| {
+        e.coord_index
+            .iter()
+            .any(|&v| multiplicity.get(v as usize).is_some_and(|&k| k > 1))
+    });
+    if entries.len() == 1 && !shared {
+        return Some(first.clone());
+    }
+    let mut borders: Vec<f64> = entries
+        .iter()
+        .flat_map(|e| e.interval_borders.iter().copied())
+        .chain([0.0])
+        .collect();
+    borders.sort_by(f64::total_cmp);
+    borders.dedup();
+    let n = borders.len().saturating_sub(1);
+    let mut rates: BTreeMap<u32, Vec<Vec3>> = BTreeMap::new();
+    for e in entries {
+        let fine = on_borders(e, &borders);
+        for (slot, &v) in fine.coord_index.iter().enumerate() {
+            let sum = rates.entry(v).or_insert_with(|| vec![Vec3::ZERO; n]);
+            for (s, r) in sum
+                .iter_mut()
+                .zip(&fine.displacements[slot * n..(slot + 1) * n])
+            {
+                *s += *r;
+            }
+        }
+    }
+    let mut coord_index = Vec::with_capacity(rates.len());
+    let mut displacements = Vec::with_capacity(rates.len() * n);
+    for (v, r) in rates {
+        let k = f32::from(multiplicity.get(v as usize).copied().unwrap_or(1).max(1));
+        coord_index.push(v);
+        displacements.extend(r.into_iter().map(|x| x / k));
+    }
+    Some(FaceDefMesh {
+        mesh: first.mesh.clone(),
+        interval_borders: borders,
+        coord_index,
+        displacements,
+    })
+}
+
+/// The target's meshes (vertices, polygons, attributes as the user gave them) under the
+/// cloned view's transforms, minus the baked ones, with `fat`.
+fn layout_face(
+    cloned: &FaceModel,
+    target: &FaceModel,
+    baked: &BTreeSet<String>,
+    fat: Fat,
+) -> FaceModel {
+    let mut face = cloned.clone();
+    let keep: Vec<usize> = (0..cloned.transforms.len())
+        .filter(|&t| !baked.contains(&cloned.transforms[t].name))
+        .collect();
+    let new_index: HashMap<usize, usize> = keep.iter().enumerate().map(|(i, &t)| (t, i)).collect();
+    face.transforms = keep
+        .iter()
+        .map(|&t| {
+            let mut tf = cloned.transforms[t].clone();
+            tf.parent = tf.parent.and_then(|p| new_index.get(&p).copied());
+            tf
+        })
+        .collect();
+    face.meshes = target
+        .meshes
+        .iter()
+        .map(|m| {
+            let mut out = m.clone();
+            if let Some(c) = cloned.mesh_index(&m.name) {
+                out.transform = cloned.meshes[c]
+                    .transform
+                    .and_then(|t| new_index.get(&t).copied());
+                if cloned.meshes[c].mesh.positions.len() == m.mesh.positions.len() {
+                    // Same mesh (not cut): positions as the clone left them (a part moved
+                    // under a new transform is re-expressed in its frame).
+                    out.mesh.positions = cloned.meshes[c].mesh.positions.clone();
+                }
+            }
+            out
+        })
+        .collect();
+    face.feature_points = target.feature_points.clone();
+    face.fat = fat;
+    face
+}
+
+/// The report without the baked transforms (they are not in the face).
+fn correct_report(report: &mut CloneReport, baked: &BTreeSet<String>) {
+    if baked.is_empty() {
+        return;
+    }
+    let rigid = &mut report.rigid;
+    rigid.created_transforms.retain(|t| !baked.contains(t));
+    rigid.part_transforms.retain(|_, t| !baked.contains(t));
+    rigid.installed_centres.retain(|(t, _)| !baked.contains(t));
+    rigid.baked_transforms = baked.iter().cloned().collect();
+    report
+        .warnings
+        .retain(|w| !w.message.starts_with("created transforms "));
+    if !rigid.created_transforms.is_empty() {
+        report.warnings.push(Diagnostic::warning(format!(
+            "created transforms {}",
+            rigid.created_transforms.join(", ")
+        )));
+    }
+}
