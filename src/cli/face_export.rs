@@ -65,6 +65,9 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
     if a.names == NamesArg::Arkit {
         return export_arkit(&a, &face);
     }
+    if let Some(source) = &face.gltf_source {
+        return export_patch(&a, &face, source);
+    }
     let export = export_face_with_units(&face, None, a.units)?;
     if format == OutputFormat::Glb {
         export.document.write_glb(&a.output)?;
@@ -90,6 +93,36 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
     } else {
         println!(
             "wrote {}: {} meshes, {} morph targets",
+            report.output, report.meshes, report.morph_targets
+        );
+        super::print_warnings(&report.warnings);
+    }
+    Ok(EXIT_OK)
+}
+
+/// `face export` of a face read from glTF: its own document, patched with the FAT.
+fn export_patch(
+    a: &FaceExportArgs,
+    face: &fbakit::face::FaceModel,
+    source: &fbakit::gltf::source::GltfSource,
+) -> Result<u8> {
+    let export = fbakit::export::gltf_patch::patch_face(face, source, None)?;
+    export.document.write(&a.output)?;
+    let report = Report {
+        face: face.name.clone(),
+        output: a.output.display().to_string(),
+        meshes: export.document.json["meshes"]
+            .as_array()
+            .map_or(0, Vec::len),
+        morph_targets: export.morph_targets,
+        warnings: export.warnings,
+        arkit: None,
+    };
+    if a.json {
+        print_json(&report)?;
+    } else {
+        println!(
+            "wrote {}: {} meshes, {} morph targets added",
             report.output, report.meshes, report.morph_targets
         );
         super::print_warnings(&report.warnings);

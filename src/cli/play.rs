@@ -215,11 +215,18 @@ pub fn run(a: PlayArgs) -> Result<u8> {
         PlayFormat::Glb | PlayFormat::Gltf => {
             let anim = player.animation()?;
             bar.set_position(anim.len() as u64);
-            let export = export_face_with_units(&face, Some(&anim), a.units)?;
-            warnings.extend(export.warnings);
-            match format {
-                PlayFormat::Glb => export.document.write_glb(&a.output)?,
-                _ => export.document.write_gltf(&a.output)?,
+            // A glTF face plays into its own document, which keeps its units.
+            if let Some(source) = &face.gltf_source {
+                let export = fbakit::export::gltf_patch::patch_face(&face, source, Some(&anim))?;
+                warnings.extend(export.warnings);
+                export.document.write(&a.output)?;
+            } else {
+                let export = export_face_with_units(&face, Some(&anim), a.units)?;
+                warnings.extend(export.warnings);
+                match format {
+                    PlayFormat::Glb => export.document.write_glb(&a.output)?,
+                    _ => export.document.write_gltf(&a.output)?,
+                }
             }
             1
         }

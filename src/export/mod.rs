@@ -17,6 +17,7 @@
 pub mod budget;
 mod error;
 pub mod gltf;
+pub mod gltf_patch;
 pub mod movie;
 pub mod obj_sequence;
 pub mod picture;
@@ -37,6 +38,11 @@ use crate::format::OutputFormat;
 pub fn write_face(path: &Path, face: &FaceModel) -> Result<Vec<crate::error::Diagnostic>> {
     match OutputFormat::resolve(path, OutputFormat::FACES, "a face file")? {
         OutputFormat::Glb | OutputFormat::Gltf => {
+            if let Some(source) = &face.gltf_source {
+                let export = gltf_patch::patch_face(face, source, None)?;
+                export.document.write(path)?;
+                return Ok(export.warnings);
+            }
             let export = gltf::export_face(face, None)?;
             export.document.write(path)?;
             Ok(export.warnings)

@@ -17,6 +17,7 @@ pub mod candide;
 mod error;
 pub mod format;
 mod from_rig;
+pub mod gltf_fat;
 pub mod morphs;
 pub mod parts;
 pub mod pose;
@@ -152,6 +153,9 @@ pub struct FaceModel {
     pub fat: Fat,
     /// The VRML scene it was read from, kept so writing preserves every other node.
     pub scene: Option<crate::vrml::Scene>,
+    /// The glTF document it was read from, kept so glTF outputs patch it (mesh names match
+    /// [`crate::gltf::source::SourcePart::face_mesh`]).
+    pub gltf_source: Option<std::sync::Arc<crate::gltf::source::GltfSource>>,
 }
 
 impl PartialEq for FaceModel {
@@ -182,6 +186,7 @@ impl FaceModel {
             feature_points: FeaturePointSet::new(),
             fat: Fat::default(),
             scene: None,
+            gltf_source: None,
         }
     }
 

@@ -73,9 +73,11 @@ pub mod container;
 mod document;
 mod error;
 pub mod json;
+pub mod patch;
 mod layout;
 mod normals;
 mod scene_data;
+pub mod source;
 
 pub use builder::SceneBuilder;
 pub use container::{parse_glb, GlbChunks, GltfDocument};

@@ -25,6 +25,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use super::{BlendShape, Rig, RigError, RigMesh, ShapeDelta, MAX_RIG_SHAPES, MAX_RIG_VERTICES};
 use crate::error::{Diagnostic, Error, Result};
+use crate::gltf::source::{GltfSource, RestPose, SourcePart};
 use crate::mesh::{FaceGroup, Mesh, Polygons};
 
 /// Largest glTF file (and each external buffer) read: 1 GiB.
@@ -50,6 +51,7 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
     check_attribute_indices(&gltf.document, path)?;
     validate(&gltf.document, path)?;
     let buffers = load_buffers(&gltf, path)?;
+    let json = document_json(bytes, path)?;
     let mut reader = Reader {
         file: path,
         doc: &gltf.document,
@@ -59,20 +61,31 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
             meshes: Vec::new(),
             shapes: Vec::new(),
             warnings: Vec::new(),
+            source: None,
         },
         shape_by_name: HashMap::new(),
         vertices: 0,
         mesh_names: HashMap::new(),
+        parts: Vec::new(),
+        node_world: Vec::new(),
     };
     reader.check_views()?;
-    let scene = gltf
-        .default_scene()
-        .or_else(|| gltf.scenes().next())
-        .ok_or_else(|| located(path, "scenes", "no scene to read"))?;
+    reader.node_world = rest::node_world_matrices(&gltf.document);
+    let roots = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            reader.rig.warnings.push(Diagnostic::warning(format!(
+                "{}: no scene: every mesh is read",
+                path.display()
+            )));
+            rest::root_nodes(&gltf.document)
+        }
+    };
     let mut stack: Vec<(::gltf::Node, Mat4, usize)> =
-        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+        roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     stack.reverse();
     let mut seen = vec![false; gltf.nodes().len()];
+    let mut instanced = vec![false; gltf.meshes().len()];
     while let Some((node, parent, depth)) = stack.pop() {
         let at = format!("nodes[{}]", node.index());
         if std::mem::replace(&mut seen[node.index()], true) {
@@ -86,22 +99,54 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
             return Err(located(path, &at, "non-finite transform"));
         }
         if let Some(mesh) = node.mesh() {
+            instanced[mesh.index()] = true;
             // A skinned mesh ignores its node's transform (glTF 2.0, 3.7.3): its vertices are
-            // read in the bind pose.
-            let placed = if node.skin().is_some() {
-                Mat4::IDENTITY
-            } else {
-                world
+            // placed by its joints at rest.
+            let placed = match node.skin() {
+                Some(skin) => reader.skin_rest(&skin)?,
+                None => rest::Placement::Matrix(world),
             };
-            reader.mesh_instance(&node, &mesh, placed)?;
+            reader.mesh_instance(Some(&node), &mesh, placed)?;
         }
         let children: Vec<_> = node.children().collect();
         for c in children.into_iter().rev() {
             stack.push((c, world, depth + 1));
         }
     }
+    if gltf.scenes().len() == 0 {
+        // A file without scenes (nor nodes for some meshes): those meshes as they are.
+        for mesh in gltf.meshes().filter(|m| !instanced[m.index()]) {
+            reader.mesh_instance(None, &mesh, rest::Placement::Matrix(Mat4::IDENTITY))?;
+        }
+    }
     reader.rig.check()?;
-    Ok(reader.rig)
+    let parts = std::mem::take(&mut reader.parts);
+    let mut rig = reader.rig;
+    rig.source = Some(std::sync::Arc::new(GltfSource {
+        path: path.to_path_buf(),
+        json,
+        buffers,
+        parts,
+    }));
+    Ok(rig)
+}
+
+/// The document's JSON as a value (the `JSON` chunk of a `.glb`), kept for writing back.
+fn document_json(bytes: &[u8], path: &Path) -> Result<serde_json::Value> {
+    let json: std::borrow::Cow<[u8]> = if bytes.starts_with(b"glTF") {
+        ::gltf::binary::Glb::from_slice(bytes)
+            .map_err(|e| gltf_error(path, e))?
+            .json
+    } else {
+        bytes.into()
+    };
+    serde_json::from_slice(&json).map_err(|e| {
+        RigError::UnreadableGltf {
+            file: path.to_path_buf(),
+            message: format!("JSON: {e}"),
+        }
+        .into()
+    })
 }
 
 /// A GLB header whose total length is below the header's own 12 bytes: the `gltf` crate
@@ -288,6 +333,8 @@ fn percent_decode(s: &str) -> Option<String> {
     String::from_utf8(out).ok()
 }
 
+mod rest;
+
 struct Reader<'a> {
     file: &'a Path,
     doc: &'a Document,
@@ -296,6 +343,10 @@ struct Reader<'a> {
     shape_by_name: HashMap<String, usize>,
     vertices: usize,
     mesh_names: HashMap<String, usize>,
+    /// Where each rig mesh came from, for writing the document back.
+    parts: Vec<SourcePart>,
+    /// World matrix of every node at rest (joints need them whether in the scene or not).
+    node_world: Vec<Mat4>,
 }
 
 /// The element an accessor must hold for the crate's typed readers.
@@ -509,9 +560,9 @@ impl Reader<'_> {
 
     fn mesh_instance(
         &mut self,
-        node: &::gltf::Node,
+        node: Option<&::gltf::Node>,
         mesh: &::gltf::Mesh,
-        world: Mat4,
+        placed: rest::Placement,
     ) -> Result<()> {
         let m = mesh.index();
         let prims: Vec<_> = mesh.primitives().collect();
@@ -551,10 +602,11 @@ impl Reader<'_> {
                 ));
             }
         }
-        let weights = match node.weights().or(mesh.weights()) {
+        let node_weights = node.and_then(|n| n.weights());
+        let weights = match node_weights.or(mesh.weights()) {
             Some(w) if w.len() != targets => {
-                let at = if node.weights().is_some() {
-                    format!("nodes[{}].weights", node.index())
+                let at = if let (Some(n), Some(_)) = (node, node_weights) {
+                    format!("nodes[{}].weights", n.index())
                 } else {
                     format!("meshes[{m}].weights")
                 };
@@ -594,7 +646,7 @@ impl Reader<'_> {
             shape_ids.push(id);
         }
         let base = node
-            .name()
+            .and_then(|n| n.name())
             .or(mesh.name())
             .map_or_else(|| format!("mesh{m}"), str::to_string);
         for (p, prim) in prims.iter().enumerate() {
@@ -604,7 +656,28 @@ impl Reader<'_> {
             } else {
                 base.clone()
             };
+            let before = self.rig.meshes.len();
+            let vertex_count = prim.get(&Semantic::Positions).map_or(0, |a| a.count());
+            let (world, per_vertex) = placed.for_primitive(self, prim, &at, vertex_count)?;
             self.primitive(prim, &at, name, world, &shape_ids)?;
+            if self.rig.meshes.len() == before {
+                continue;
+            }
+            let rest = match per_vertex {
+                Some(list) => {
+                    self.place_per_vertex(before, &list);
+                    RestPose::PerVertex(list)
+                }
+                None => RestPose::Matrix(world),
+            };
+            self.parts.push(SourcePart {
+                face_mesh: self.rig.meshes[before].name.clone(),
+                node: node.map(|n| n.index()),
+                mesh: m,
+                primitive: p,
+                vertex_count,
+                rest,
+            });
         }
         Ok(())
     }

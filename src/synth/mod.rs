@@ -411,6 +411,7 @@ impl SynthFace {
             feature_points,
             fat: face.fat.clone(),
             scene: None,
+            gltf_source: None,
         }
     }
 

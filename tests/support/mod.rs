@@ -3,3 +3,4 @@
 pub mod cli;
 pub mod gltf_scenes;
 pub mod validator;
+pub mod avatar;
