@@ -329,3 +329,43 @@ fn validator_finds_no_new_issue() {
     assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
     assert_eq!(issues(&reports[2]), issues(&reports[3]), "{}", reports[3]);
 }
+
+#[test]
+fn generated_glb_reads_back_with_its_fat() {
+    let dir = tempfile::tempdir().unwrap();
+    let face = fbakit::synth::alma().to_face_model();
+    let glb = dir.path().join("alma.glb");
+    fbakit::export::write_face(&glb, &face).unwrap();
+    let back = fbakit::face::read(&glb).unwrap();
+    let (k, _) = fbakit::face::units::metres_factor(&face, None);
+    let frames = face.frames();
+    // Feature points come back (in metres) without --fp.
+    assert_eq!(back.feature_points.len(), face.feature_points.len());
+    let mut compared = 0;
+    for table in &face.fat.tables {
+        let Some(got) = back.fat.tables.iter().find(|t| t.key == table.key) else {
+            assert!(table.meshes.is_empty(), "{:?} lost", table.key);
+            continue;
+        };
+        for m in &table.meshes {
+            let mi = face.mesh_index(&m.mesh).unwrap();
+            let g = got.meshes.iter().find(|g| g.mesh == m.mesh).expect("entry kept");
+            assert_eq!(g.interval_borders, m.interval_borders);
+            let n = m.interval_count();
+            for (slot, v) in m.coord_index.iter().enumerate() {
+                let Ok(gs) = g.coord_index.binary_search(v) else {
+                    // Not moved in any interval: nothing to write.
+                    assert!((0..n).all(|j| m.displacements[slot * n + j] == Vec3::ZERO));
+                    continue;
+                };
+                for j in 0..n {
+                    let want = frames.meshes[mi].transform_vector3(m.displacements[slot * n + j]) * k;
+                    let have = g.displacements[gs * n + j];
+                    assert!((want - have).length() <= 1e-4 * want.length() + 1e-9, "{:?} {} {want} {have}", table.key, m.mesh);
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert!(compared > 1000, "{compared}");
+}

@@ -251,7 +251,7 @@ pub fn patch_face(
             },
         );
     }
-    patch.scene_extras = gltf_fat::scene_record(face);
+    patch.scene_extras = gltf_fat::scene_record(face, 1.0);
     if let Some(frames) = frames.filter(|f| !f.is_empty()) {
         patch.animation = animation(source, &meshes, &layouts, frames);
     }

@@ -59,8 +59,9 @@ pub fn targets_record(records: &[TargetRecord]) -> Value {
     json!({ "targets": list })
 }
 
-/// The scene record of `face`: feature points and FAPU (when they can be measured).
-pub fn scene_record(face: &FaceModel) -> Map<String, Value> {
+/// The scene record of `face`: feature points and FAPU (when they can be measured), lengths
+/// multiplied by `scale` (the output's units per face unit).
+pub fn scene_record(face: &FaceModel, scale: f32) -> Map<String, Value> {
     let mut out = Map::new();
     if face.feature_points.is_empty() && face.fat.tables.is_empty() {
         return out;
@@ -71,6 +72,7 @@ pub fn scene_record(face: &FaceModel) -> Map<String, Value> {
         .map(|p| {
             let mut v = json!({ "id": p.id.to_string() });
             if let Some(pos) = p.position {
+                let pos = pos * scale;
                 v["position"] = json!([pos.x, pos.y, pos.z]);
             }
             if let Some(b) = &p.binding {
@@ -84,7 +86,12 @@ pub fn scene_record(face: &FaceModel) -> Map<String, Value> {
         .collect();
     let mut record = json!({ "version": VERSION, "featurePoints": points });
     if let Ok(f) = face.fapu() {
-        record["fapu"] = serde_json::to_value(f.distances).unwrap_or(Value::Null);
+        let d = f.distances;
+        let s = f64::from(scale);
+        record["fapu"] = json!({
+            "irisd0": d.irisd0 * s, "es0": d.es0 * s, "ens0": d.ens0 * s,
+            "mns0": d.mns0 * s, "mw0": d.mw0 * s,
+        });
     }
     out.insert(KEY.into(), record);
     out
