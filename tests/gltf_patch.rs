@@ -326,6 +326,11 @@ fn validator_finds_no_new_issue() {
         codes.sort();
         codes
     };
+    if std::env::var_os("FBAKIT_SHOW_VALIDATOR").is_some() {
+        for r in &reports {
+            eprintln!("{r}");
+        }
+    }
     assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
     assert_eq!(issues(&reports[2]), issues(&reports[3]), "{}", reports[3]);
 }
