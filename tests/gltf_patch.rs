@@ -374,3 +374,64 @@ fn generated_glb_reads_back_with_its_fat() {
     }
     assert!(compared > 1000, "{compared}");
 }
+
+#[test]
+fn exported_ict_keeps_its_vertices_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ict.glb");
+    let run = command()
+        .args(["face".as_ref(), "export".as_ref(), "ict".as_ref(), "-o".as_ref(), out.as_os_str()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/faces/ict-head/ict-head.glb");
+    let (x, y) = (json_of(&input), json_of(&out));
+    assert_kept(&x, &y);
+    let (a, b) = (fbakit::face::read(&input).unwrap(), fbakit::face::read(&out).unwrap());
+    assert_eq!(a.meshes.len(), b.meshes.len());
+    for (p, q) in a.meshes.iter().zip(&b.meshes) {
+        assert_eq!(p.mesh.positions, q.mesh.positions);
+        assert_eq!(p.mesh.polygons, q.mesh.polygons);
+    }
+    // The FAT built from ICT's shapes (with its feature points) came along in the extras.
+    let ict = fbakit::face::read("ict").unwrap();
+    assert_eq!(b.fat.tables.len(), ict.fat.tables.iter().filter(|t| !t.meshes.is_empty()).count());
+    assert_eq!(b.feature_points.len(), ict.feature_points.len());
+}
+
+#[test]
+fn target_names_that_do_not_match_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = avatar::build();
+    a.json["meshes"][0]["extras"]["targetNames"] = serde_json::json!(["Blink", "Extra"]);
+    let input = dir.path().join("bad.glb");
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let out = dir.path().join("out.glb");
+    let run = command()
+        .args(["face".as_ref(), "export".as_ref(), input.as_os_str(), "-o".as_ref(), out.as_os_str()])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
+    let err = text(&run.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("bad.glb") && err.contains("meshes[0].extras.targetNames"), "{err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = avatar::build();
+    let o = a.json.as_object_mut().unwrap();
+    o.remove("scene");
+    o.remove("scenes");
+    let input = dir.path().join("noscene.glb");
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let (face, report) = fbakit::face::read_with(&input, &Default::default()).unwrap();
+    assert_eq!(face.meshes.len(), 5);
+    assert!(
+        report.diagnostics.iter().any(|d| d.message.contains("no scene")),
+        "{:?}",
+        report.diagnostics
+    );
+}

@@ -65,10 +65,13 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
     if a.names == NamesArg::Arkit {
         return export_arkit(&a, &face);
     }
-    if let Some(source) = &face.gltf_source {
-        return export_patch(&a, &face, source);
+    let mut warnings = Vec::new();
+    if let Some(export) = fbakit::export::gltf_patch::patch_if_fits(&face, None, &mut warnings)? {
+        return export_patch(&a, &face, export);
     }
-    let export = export_face_with_units(&face, None, a.units)?;
+    let mut export = export_face_with_units(&face, None, a.units)?;
+    warnings.append(&mut export.warnings);
+    export.warnings = warnings;
     if format == OutputFormat::Glb {
         export.document.write_glb(&a.output)?;
     } else {
@@ -104,9 +107,8 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
 fn export_patch(
     a: &FaceExportArgs,
     face: &fbakit::face::FaceModel,
-    source: &fbakit::gltf::source::GltfSource,
+    export: fbakit::export::gltf_patch::GltfPatchExport,
 ) -> Result<u8> {
-    let export = fbakit::export::gltf_patch::patch_face(face, source, None)?;
     export.document.write(&a.output)?;
     let report = Report {
         face: face.name.clone(),

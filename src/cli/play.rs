@@ -216,8 +216,9 @@ pub fn run(a: PlayArgs) -> Result<u8> {
             let anim = player.animation()?;
             bar.set_position(anim.len() as u64);
             // A glTF face plays into its own document, which keeps its units.
-            if let Some(source) = &face.gltf_source {
-                let export = fbakit::export::gltf_patch::patch_face(&face, source, Some(&anim))?;
+            if let Some(export) =
+                fbakit::export::gltf_patch::patch_if_fits(&face, Some(&anim), &mut warnings)?
+            {
                 warnings.extend(export.warnings);
                 export.document.write(&a.output)?;
             } else {

@@ -113,6 +113,55 @@ impl MeshTargets {
     }
 }
 
+/// Why `face` no longer fits the document it was read from, if it does not: a mesh the
+/// FAT moves that the document lacks, or one whose vertex count changed (a cloner that cut
+/// parts out of a mesh). Callers then write a new document instead of losing that motion.
+pub fn mismatch(face: &FaceModel, source: &GltfSource) -> Option<String> {
+    let moved: std::collections::HashSet<&str> = face
+        .fat
+        .tables
+        .iter()
+        .flat_map(|t| t.meshes.iter().map(|m| m.mesh.as_str()))
+        .collect();
+    for m in &face.meshes {
+        match source.part(&m.name) {
+            None if moved.contains(m.name.as_str()) || m.transform.is_some() => {
+                return Some(format!("mesh `{}` is not in the document", m.name))
+            }
+            Some(p) if p.vertex_count != m.mesh.vertex_count() => {
+                return Some(format!(
+                    "mesh `{}` has {} vertices, its glTF primitive {}",
+                    m.name,
+                    m.mesh.vertex_count(),
+                    p.vertex_count
+                ))
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// The face's glTF output: its own document patched when it was read from glTF and still
+/// fits it ([`mismatch`]), else `None` with the reason as a warning in `warnings`.
+pub fn patch_if_fits(
+    face: &FaceModel,
+    frames: Option<&[AnimationFrame]>,
+    warnings: &mut Vec<Diagnostic>,
+) -> Result<Option<GltfPatchExport>> {
+    let Some(source) = &face.gltf_source else {
+        return Ok(None);
+    };
+    if let Some(why) = mismatch(face, source) {
+        warnings.push(Diagnostic::warning(format!(
+            "{} cannot be patched ({why}): written as a new document",
+            source.path.display()
+        )));
+        return Ok(None);
+    }
+    patch_face(face, source, frames).map(Some)
+}
+
 /// `face` (read from `source`) patched into that document; with `frames`, its animation.
 pub fn patch_face(
     face: &FaceModel,

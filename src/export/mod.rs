@@ -38,14 +38,16 @@ use crate::format::OutputFormat;
 pub fn write_face(path: &Path, face: &FaceModel) -> Result<Vec<crate::error::Diagnostic>> {
     match OutputFormat::resolve(path, OutputFormat::FACES, "a face file")? {
         OutputFormat::Glb | OutputFormat::Gltf => {
-            if let Some(source) = &face.gltf_source {
-                let export = gltf_patch::patch_face(face, source, None)?;
+            let mut warnings = Vec::new();
+            if let Some(export) = gltf_patch::patch_if_fits(face, None, &mut warnings)? {
                 export.document.write(path)?;
-                return Ok(export.warnings);
+                warnings.extend(export.warnings);
+                return Ok(warnings);
             }
             let export = gltf::export_face(face, None)?;
             export.document.write(path)?;
-            Ok(export.warnings)
+            warnings.extend(export.warnings);
+            Ok(warnings)
         }
         _ => crate::face::write(path, face).map(|()| Vec::new()),
     }
