@@ -169,7 +169,10 @@ fn eyelids_never_move_an_eyeball() {
                 .fold(0.0, f32::max);
             eprintln!("{method:?} FAP {fap}: peak {peak:.6}, eyeball peak {eye_peak:.8}");
             assert!(peak > 0.05 * CM, "FAP {fap} does not move ({method:?})");
-            assert!(eye_peak < 1e-5 * CM, "FAP {fap} moves an eyeball by {eye_peak}");
+            assert!(
+                eye_peak < 1e-5 * CM,
+                "FAP {fap} moves an eyeball by {eye_peak}"
+            );
         }
     }
 }

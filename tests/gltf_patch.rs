@@ -57,8 +57,14 @@ fn with_fat(mut face: FaceModel) -> FaceModel {
             displacements,
         }
     };
-    let mouth: Vec<u32> = (0..face.meshes[face.mesh_index("Body.1").unwrap()].mesh.vertex_count() as u32).collect();
-    let lashes: Vec<u32> = (0..face.meshes[face.mesh_index("Body.3").unwrap()].mesh.vertex_count() as u32).collect();
+    let mouth: Vec<u32> = (0..face.meshes[face.mesh_index("Body.1").unwrap()]
+        .mesh
+        .vertex_count() as u32)
+        .collect();
+    let lashes: Vec<u32> = (0..face.meshes[face.mesh_index("Body.3").unwrap()]
+        .mesh
+        .vertex_count() as u32)
+        .collect();
     face.fat.tables = vec![
         FaceDefTable {
             key: key("open_jaw"),
@@ -103,17 +109,36 @@ fn assert_kept(input: &Value, output: &Value) {
                 }
             }
             "meshes" => {
-                for (m, (x, y)) in v.as_array().unwrap().iter().zip(output[k].as_array().unwrap()).enumerate() {
+                for (m, (x, y)) in v
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .zip(output[k].as_array().unwrap())
+                    .enumerate()
+                {
                     for (f, xv) in x.as_object().unwrap() {
                         match f.as_str() {
                             "primitives" => {
-                                for (p, (xp, yp)) in xv.as_array().unwrap().iter().zip(y[f].as_array().unwrap()).enumerate() {
+                                for (p, (xp, yp)) in xv
+                                    .as_array()
+                                    .unwrap()
+                                    .iter()
+                                    .zip(y[f].as_array().unwrap())
+                                    .enumerate()
+                                {
                                     for (pf, pv) in xp.as_object().unwrap() {
                                         if pf == "targets" {
                                             let yt = yp[pf].as_array().unwrap();
-                                            assert_eq!(&yt[..pv.as_array().unwrap().len()], &pv.as_array().unwrap()[..], "meshes[{m}].primitives[{p}] targets");
+                                            assert_eq!(
+                                                &yt[..pv.as_array().unwrap().len()],
+                                                &pv.as_array().unwrap()[..],
+                                                "meshes[{m}].primitives[{p}] targets"
+                                            );
                                         } else {
-                                            assert_eq!(pv, &yp[pf], "meshes[{m}].primitives[{p}].{pf}");
+                                            assert_eq!(
+                                                pv, &yp[pf],
+                                                "meshes[{m}].primitives[{p}].{pf}"
+                                            );
                                         }
                                     }
                                 }
@@ -122,7 +147,10 @@ fn assert_kept(input: &Value, output: &Value) {
                                 for (ek, ev) in xv.as_object().unwrap() {
                                     if ek == "targetNames" {
                                         let ya = y[f][ek].as_array().unwrap();
-                                        assert_eq!(&ya[..ev.as_array().unwrap().len()], &ev.as_array().unwrap()[..]);
+                                        assert_eq!(
+                                            &ya[..ev.as_array().unwrap().len()],
+                                            &ev.as_array().unwrap()[..]
+                                        );
                                     } else {
                                         assert_eq!(ev, &y[f][ek], "meshes[{m}].extras.{ek}");
                                     }
@@ -130,7 +158,10 @@ fn assert_kept(input: &Value, output: &Value) {
                             }
                             "weights" => {
                                 let ya = y[f].as_array().unwrap();
-                                assert_eq!(&ya[..xv.as_array().unwrap().len()], &xv.as_array().unwrap()[..]);
+                                assert_eq!(
+                                    &ya[..xv.as_array().unwrap().len()],
+                                    &xv.as_array().unwrap()[..]
+                                );
                             }
                             _ => assert_eq!(xv, &y[f], "meshes[{m}].{f}"),
                         }
@@ -142,14 +173,26 @@ fn assert_kept(input: &Value, output: &Value) {
                 for (i, x) in v.as_array().unwrap().iter().enumerate() {
                     assert_eq!(x["channels"], b[i]["channels"], "animations[{i}].channels");
                     assert_eq!(x["name"], b[i]["name"]);
-                    for (s, (xs, ys)) in x["samplers"].as_array().unwrap().iter().zip(b[i]["samplers"].as_array().unwrap()).enumerate() {
+                    for (s, (xs, ys)) in x["samplers"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .zip(b[i]["samplers"].as_array().unwrap())
+                        .enumerate()
+                    {
                         assert_eq!(xs["input"], ys["input"], "animations[{i}].samplers[{s}]");
                         assert_eq!(xs["interpolation"], ys["interpolation"]);
                     }
                 }
             }
             "scenes" => {
-                for (s, (x, y)) in v.as_array().unwrap().iter().zip(output[k].as_array().unwrap()).enumerate() {
+                for (s, (x, y)) in v
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .zip(output[k].as_array().unwrap())
+                    .enumerate()
+                {
                     for (f, xv) in x.as_object().unwrap() {
                         if f == "extras" {
                             for (ek, ev) in xv.as_object().unwrap() {
@@ -176,7 +219,11 @@ fn fat_close(a: &fbakit::fat::Fat, b: &fbakit::fat::Fat) {
             assert_eq!(p.interval_borders, q.interval_borders);
             assert_eq!(p.coord_index, q.coord_index, "{} {:?}", p.mesh, x.key);
             for (d, e) in p.displacements.iter().zip(&q.displacements) {
-                assert!((*d - *e).length() <= 1e-4 * d.length().max(1e-6), "{} {d} {e}", p.mesh);
+                assert!(
+                    (*d - *e).length() <= 1e-4 * d.length().max(1e-6),
+                    "{} {d} {e}",
+                    p.mesh
+                );
             }
         }
     }
@@ -201,7 +248,11 @@ fn avatar_reads_in_its_rest_pose() {
     assert!((mouth[0] - want).length() < 1e-5, "{} {}", mouth[0], want);
     // The hat hangs under the head joint: (0, 160, 0) cm + its own 8 cm.
     let hat = &face.meshes[0].mesh.positions;
-    assert!((hat[4] - Vec3::new(0.0, 1.8, 0.0)).length() < 1e-5, "{}", hat[4]);
+    assert!(
+        (hat[4] - Vec3::new(0.0, 1.8, 0.0)).length() < 1e-5,
+        "{}",
+        hat[4]
+    );
     let source = face.gltf_source.as_ref().expect("document kept");
     assert_eq!(source.parts.len(), 5);
 }
@@ -225,10 +276,15 @@ fn avatar_comes_back_whole_with_its_fat() {
     for p in y["meshes"][0]["primitives"].as_array().unwrap() {
         assert_eq!(p["targets"].as_array().unwrap().len(), names.len());
     }
-    assert_eq!(y["meshes"][0]["weights"].as_array().unwrap().len(), names.len());
+    assert_eq!(
+        y["meshes"][0]["weights"].as_array().unwrap().len(),
+        names.len()
+    );
     // The user's Blink channel got one zero per new target.
     let widened = &y["animations"][0]["samplers"][1]["output"];
-    let count = y["accessors"][widened.as_u64().unwrap() as usize]["count"].as_u64().unwrap();
+    let count = y["accessors"][widened.as_u64().unwrap() as usize]["count"]
+        .as_u64()
+        .unwrap();
     assert_eq!(count as usize, 3 * names.len());
     // Read back: same meshes in the same order, same positions, same FAT.
     let back = fbakit::face::read(&out).unwrap();
@@ -277,7 +333,13 @@ fn patched_avatar_plays_into_its_own_document() {
     let played = dir.path().join("played.glb");
     let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/lowlevel.fap");
     let out = command()
-        .args(["play".as_ref(), patched.as_os_str(), sample.as_os_str(), "-o".as_ref(), played.as_os_str()])
+        .args([
+            "play".as_ref(),
+            patched.as_os_str(),
+            sample.as_os_str(),
+            "-o".as_ref(),
+            played.as_os_str(),
+        ])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", text(&out.stderr));
@@ -354,7 +416,11 @@ fn generated_glb_reads_back_with_its_fat() {
         };
         for m in &table.meshes {
             let mi = face.mesh_index(&m.mesh).unwrap();
-            let g = got.meshes.iter().find(|g| g.mesh == m.mesh).expect("entry kept");
+            let g = got
+                .meshes
+                .iter()
+                .find(|g| g.mesh == m.mesh)
+                .expect("entry kept");
             assert_eq!(g.interval_borders, m.interval_borders);
             let n = m.interval_count();
             for (slot, v) in m.coord_index.iter().enumerate() {
@@ -364,9 +430,15 @@ fn generated_glb_reads_back_with_its_fat() {
                     continue;
                 };
                 for j in 0..n {
-                    let want = frames.meshes[mi].transform_vector3(m.displacements[slot * n + j]) * k;
+                    let want =
+                        frames.meshes[mi].transform_vector3(m.displacements[slot * n + j]) * k;
                     let have = g.displacements[gs * n + j];
-                    assert!((want - have).length() <= 1e-4 * want.length() + 1e-9, "{:?} {} {want} {have}", table.key, m.mesh);
+                    assert!(
+                        (want - have).length() <= 1e-4 * want.length() + 1e-9,
+                        "{:?} {} {want} {have}",
+                        table.key,
+                        m.mesh
+                    );
                     compared += 1;
                 }
             }
@@ -380,14 +452,23 @@ fn exported_ict_keeps_its_vertices_in_order() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ict.glb");
     let run = command()
-        .args(["face".as_ref(), "export".as_ref(), "ict".as_ref(), "-o".as_ref(), out.as_os_str()])
+        .args([
+            "face".as_ref(),
+            "export".as_ref(),
+            "ict".as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
         .output()
         .unwrap();
     assert!(run.status.success(), "{}", text(&run.stderr));
     let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/faces/ict-head/ict-head.glb");
     let (x, y) = (json_of(&input), json_of(&out));
     assert_kept(&x, &y);
-    let (a, b) = (fbakit::face::read(&input).unwrap(), fbakit::face::read(&out).unwrap());
+    let (a, b) = (
+        fbakit::face::read(&input).unwrap(),
+        fbakit::face::read(&out).unwrap(),
+    );
     assert_eq!(a.meshes.len(), b.meshes.len());
     for (p, q) in a.meshes.iter().zip(&b.meshes) {
         assert_eq!(p.mesh.positions, q.mesh.positions);
@@ -395,7 +476,14 @@ fn exported_ict_keeps_its_vertices_in_order() {
     }
     // The FAT built from ICT's shapes (with its feature points) came along in the extras.
     let ict = fbakit::face::read("ict").unwrap();
-    assert_eq!(b.fat.tables.len(), ict.fat.tables.iter().filter(|t| !t.meshes.is_empty()).count());
+    assert_eq!(
+        b.fat.tables.len(),
+        ict.fat
+            .tables
+            .iter()
+            .filter(|t| !t.meshes.is_empty())
+            .count()
+    );
     assert_eq!(b.feature_points.len(), ict.feature_points.len());
 }
 
@@ -408,13 +496,22 @@ fn target_names_that_do_not_match_are_refused() {
     std::fs::write(&input, a.to_glb()).unwrap();
     let out = dir.path().join("out.glb");
     let run = command()
-        .args(["face".as_ref(), "export".as_ref(), input.as_os_str(), "-o".as_ref(), out.as_os_str()])
+        .args([
+            "face".as_ref(),
+            "export".as_ref(),
+            input.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
         .output()
         .unwrap();
     assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
     let err = text(&run.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(err.contains("bad.glb") && err.contains("meshes[0].extras.targetNames"), "{err}");
+    assert!(
+        err.contains("bad.glb") && err.contains("meshes[0].extras.targetNames"),
+        "{err}"
+    );
     assert!(!out.exists());
 }
 
@@ -430,7 +527,10 @@ fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
     let (face, report) = fbakit::face::read_with(&input, &Default::default()).unwrap();
     assert_eq!(face.meshes.len(), 5);
     assert!(
-        report.diagnostics.iter().any(|d| d.message.contains("no scene")),
+        report
+            .diagnostics
+            .iter()
+            .any(|d| d.message.contains("no scene")),
         "{:?}",
         report.diagnostics
     );

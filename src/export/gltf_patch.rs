@@ -358,7 +358,11 @@ fn existing_names(source: &GltfSource, m: usize) -> Vec<String> {
     mesh["extras"]["targetNames"]
         .as_array()
         .or_else(|| mesh["primitives"][0]["extras"]["targetNames"].as_array())
-        .map(|a| a.iter().filter_map(|v| v.as_str().map(str::to_string)).collect())
+        .map(|a| {
+            a.iter()
+                .filter_map(|v| v.as_str().map(str::to_string))
+                .collect()
+        })
         .unwrap_or_default()
 }
 
@@ -407,7 +411,11 @@ fn face_pieces(face: &FaceModel) -> Result<Vec<Vec<FaceMeshPiece>>> {
                         span: p.span,
                     },
                     vertices: p.vertices.clone(),
-                    world: p.offsets.iter().map(|&o| linear.transform_vector3(o)).collect(),
+                    world: p
+                        .offsets
+                        .iter()
+                        .map(|&o| linear.transform_vector3(o))
+                        .collect(),
                 })
                 .collect(),
         );
@@ -428,7 +436,10 @@ fn bake_transforms(
     only.fat = Fat::default();
     let mut t = table.clone();
     t.meshes.clear();
-    let rotates = t.transforms.iter().any(|x| x.field == TransformField::Rotation);
+    let rotates = t
+        .transforms
+        .iter()
+        .any(|x| x.field == TransformField::Rotation);
     only.fat.tables.push(t);
     let v = default_value(table.key);
     let borders: Vec<f64> = if rotates {
@@ -439,7 +450,6 @@ fn bake_transforms(
     } else {
         vec![0.0, v]
     };
-    let neutral = only.pose(&[])?;
     let at: Vec<Vec<Vec<Vec3>>> = borders
         .iter()
         .map(|&b| {
@@ -455,14 +465,11 @@ fn bake_transforms(
         for (mi, list) in out.iter_mut().enumerate() {
             let mut vertices = Vec::new();
             let mut world = Vec::new();
-            for v in 0..neutral[mi].len() {
+            let (lo_at, hi_at) = (&at[j][mi], &at[j + 1][mi]);
+            for (v, (a, b)) in lo_at.iter().zip(hi_at).enumerate() {
                 // Offsets at the span: the change across the interval, signed towards zero's
                 // far side (the rule of `FaceMorphs`).
-                let d = if hi <= 0.0 {
-                    at[j][mi][v] - at[j + 1][mi][v]
-                } else {
-                    at[j + 1][mi][v] - at[j][mi][v]
-                };
+                let d = if hi <= 0.0 { *a - *b } else { *b - *a };
                 if d.length_squared() > 0.0 && d.is_finite() {
                     vertices.push(v as u32);
                     world.push(d);
@@ -514,7 +521,12 @@ fn animation(
         if t.pieces.is_empty() {
             continue;
         }
-        let Some(node) = source.parts.iter().find(|p| p.mesh == m).and_then(|p| p.node) else {
+        let Some(node) = source
+            .parts
+            .iter()
+            .find(|p| p.mesh == m)
+            .and_then(|p| p.node)
+        else {
             continue;
         };
         let mesh = &source.json["meshes"][m];
@@ -534,7 +546,10 @@ fn animation(
         let mut key = old.clone();
         key.resize(layout.total, 0.0);
         // fbakit's earlier targets are driven below or stay at zero.
-        for i in recorded_pieces(source, m, &existing_names(source, m)).iter().map(|r| r.0) {
+        for i in recorded_pieces(source, m, &existing_names(source, m))
+            .iter()
+            .map(|r| r.0)
+        {
             if let Some(w) = key.get_mut(i) {
                 *w = 0.0;
             }
@@ -551,3 +566,55 @@ fn animation(
     (!anim.weights.is_empty()).then_some(anim)
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Baked transform motion reproduces the posed face at the bake's borders, where the
+    /// piecewise-linear targets are exact.
+    #[test]
+    fn baked_transforms_reproduce_the_pose_at_their_borders() {
+        let face = crate::synth::alma().to_face_model();
+        let table = face
+            .fat
+            .tables
+            .iter()
+            .find(|t| {
+                t.transforms
+                    .iter()
+                    .any(|x| x.field == TransformField::Rotation)
+            })
+            .expect("alma turns something by a transform");
+        let mut only = face.clone();
+        only.fat.tables = vec![crate::fat::FaceDefTable {
+            meshes: Vec::new(),
+            ..table.clone()
+        }];
+        let mut pieces: Vec<Vec<FaceMeshPiece>> =
+            (0..face.meshes.len()).map(|_| Vec::new()).collect();
+        bake_transforms(&face, table, &mut pieces).unwrap();
+        assert!(pieces.iter().any(|p| !p.is_empty()));
+        let v = default_value(table.key);
+        let neutral = only.pose(&[]).unwrap();
+        let mut scratch = Vec::new();
+        for value in [-2.0 * v, -0.5 * v, 0.5 * v, v, 2.0 * v] {
+            let a = [Activation {
+                key: table.key,
+                value,
+            }];
+            let want = only.pose(&a).unwrap();
+            for (mi, list) in pieces.iter().enumerate() {
+                let mut got = neutral[mi].clone();
+                for p in list {
+                    let w = p.piece.weight(&a, &mut scratch);
+                    for (&vi, d) in p.vertices.iter().zip(&p.world) {
+                        got[vi as usize] += *d * w;
+                    }
+                }
+                for (g, w) in got.iter().zip(&want[mi]) {
+                    assert!(g.distance(*w) < 1e-4, "{value}: {g} vs {w}");
+                }
+            }
+        }
+    }
+}

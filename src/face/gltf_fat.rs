@@ -138,11 +138,21 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
         let id = p["id"]
             .as_str()
             .and_then(|s| s.parse().ok())
-            .ok_or_else(|| bad(rig, &at, "`id` must be a feature point label such as \"2.1\""))?;
+            .ok_or_else(|| {
+                bad(
+                    rig,
+                    &at,
+                    "`id` must be a feature point label such as \"2.1\"",
+                )
+            })?;
         let position = match p.get("position") {
             None => None,
             Some(v) => Some(vec3(v).ok_or_else(|| {
-                bad(rig, &format!("{at}.position"), "must be three finite numbers")
+                bad(
+                    rig,
+                    &format!("{at}.position"),
+                    "must be three finite numbers",
+                )
             })?),
         };
         let binding = match p.get("vertices") {
@@ -155,9 +165,7 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
                             .map(|x| x.as_u64().and_then(|n| u32::try_from(n).ok()))
                             .collect::<Option<Vec<u32>>>()
                     })
-                    .ok_or_else(|| {
-                        bad(rig, &format!("{at}.vertices"), "must be vertex indices")
-                    })?;
+                    .ok_or_else(|| bad(rig, &format!("{at}.vertices"), "must be vertex indices"))?;
                 Some(VertexBinding {
                     mesh: p["mesh"].as_str().map(str::to_string),
                     vertices,
@@ -172,7 +180,9 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
     }
     // Tables: per (key, borders bits) and face mesh, the targets of each interval.
     type Group = (TableKey, Vec<u64>);
-    let mut tables: BTreeMap<Group, BTreeMap<usize, Vec<(usize, f64, String)>>> = BTreeMap::new();
+    // Per glTF mesh: (interval, span, target name).
+    type Pieces = BTreeMap<usize, Vec<(usize, f64, String)>>;
+    let mut tables: BTreeMap<Group, Pieces> = BTreeMap::new();
     let mut borders_of: BTreeMap<Group, Vec<f64>> = BTreeMap::new();
     for (m, mesh) in json["meshes"].as_array().into_iter().flatten().enumerate() {
         let Some(list) = mesh["extras"][KEY]["targets"].as_array() else {
@@ -186,7 +196,13 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
             let key = r["key"]
                 .as_str()
                 .and_then(TableKey::from_name)
-                .ok_or_else(|| bad(rig, &format!("{at}.key"), "not a FAP, viseme or expression name"))?;
+                .ok_or_else(|| {
+                    bad(
+                        rig,
+                        &format!("{at}.key"),
+                        "not a FAP, viseme or expression name",
+                    )
+                })?;
             let borders: Vec<f64> = r["borders"]
                 .as_array()
                 .and_then(|a| a.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>())
@@ -196,13 +212,23 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
                 .as_u64()
                 .map(|j| j as usize)
                 .filter(|&j| j + 1 < borders.len())
-                .ok_or_else(|| bad(rig, &format!("{at}.interval"), "must index an interval of `borders`"))?;
+                .ok_or_else(|| {
+                    bad(
+                        rig,
+                        &format!("{at}.interval"),
+                        "must index an interval of `borders`",
+                    )
+                })?;
             let span = r["span"]
                 .as_f64()
                 .filter(|s| s.is_finite() && *s != 0.0)
                 .ok_or_else(|| bad(rig, &format!("{at}.span"), "must be a non-zero number"))?;
             if rig.shape(target).is_none() {
-                return Err(bad(rig, &format!("{at}.target"), format!("no morph target named `{target}`")));
+                return Err(bad(
+                    rig,
+                    &format!("{at}.target"),
+                    format!("no morph target named `{target}`"),
+                ));
             }
             let group = (key, borders.iter().map(|b| b.to_bits()).collect());
             borders_of.insert(group.clone(), borders);
@@ -227,7 +253,9 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
                 };
                 let mut rates: BTreeMap<u32, Vec<Vec3>> = BTreeMap::new();
                 for (j, span, target) in pieces {
-                    let Some(shape) = rig.shape(target) else { continue };
+                    let Some(shape) = rig.shape(target) else {
+                        continue;
+                    };
                     let Some(d) = shape.delta(mi) else { continue };
                     for (&v, &o) in d.vertices.iter().zip(&d.offsets) {
                         let slot = rates.entry(v).or_insert_with(|| vec![Vec3::ZERO; n]);

@@ -73,9 +73,9 @@ pub mod container;
 mod document;
 mod error;
 pub mod json;
-pub mod patch;
 mod layout;
 mod normals;
+pub mod patch;
 mod scene_data;
 pub mod source;
 

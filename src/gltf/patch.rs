@@ -209,7 +209,11 @@ impl GltfPatch {
                 merge_extras(scene, &self.scene_extras, &format!("{file}: scenes[{s}]"))?;
             } else {
                 // A file without scenes: fbakit's record goes on the asset instead.
-                merge_extras(&mut b.json["asset"], &self.scene_extras, &format!("{file}: asset"))?;
+                merge_extras(
+                    &mut b.json["asset"],
+                    &self.scene_extras,
+                    &format!("{file}: asset"),
+                )?;
             }
         }
         if let Some(anim) = &self.animation {
@@ -314,13 +318,20 @@ fn patch_mesh(
     // Names of the user's targets: mesh extras, else primitive 0's (both conventions exist).
     let mut names: Vec<Value> = mesh["extras"]["targetNames"]
         .as_array()
-        .or_else(|| prims.first().and_then(|p| p["extras"]["targetNames"].as_array()))
+        .or_else(|| {
+            prims
+                .first()
+                .and_then(|p| p["extras"]["targetNames"].as_array())
+        })
         .cloned()
         .unwrap_or_default();
     if names.len() != old {
         return Err(content(
             format!("{at}.extras.targetNames"),
-            format!("{} names for {old} morph targets (the counts must match)", names.len()),
+            format!(
+                "{} names for {old} morph targets (the counts must match)",
+                names.len()
+            ),
         ));
     }
     let mut new_prims = Vec::with_capacity(prims.len());
@@ -328,7 +339,10 @@ fn patch_mesh(
         let mut prim = prim.clone();
         let count = accessor_count(&b.json, prim["attributes"]["POSITION"].as_u64());
         if count == 0 {
-            return Err(content(format!("{at}.primitives[{p}]"), "no POSITION to add morph targets to"));
+            return Err(content(
+                format!("{at}.primitives[{p}]"),
+                "no POSITION to add morph targets to",
+            ));
         }
         let have = prim["targets"].as_array().map_or(0, Vec::len);
         if have != old {
@@ -509,7 +523,8 @@ fn add_animation(b: &mut Builder, anim: &PatchAnimation) {
         let out = b.accessor(json!({
             "bufferView": v, "componentType": FLOAT, "count": values.len(), "type": "SCALAR"
         }));
-        channels.push(json!({"sampler": samplers.len(), "target": {"node": node, "path": "weights"}}));
+        channels
+            .push(json!({"sampler": samplers.len(), "target": {"node": node, "path": "weights"}}));
         samplers.push(json!({"input": times, "output": out, "interpolation": "LINEAR"}));
     }
     for (node, values) in &anim.rotations {
@@ -518,7 +533,8 @@ fn add_animation(b: &mut Builder, anim: &PatchAnimation) {
         let out = b.accessor(json!({
             "bufferView": v, "componentType": FLOAT, "count": values.len(), "type": "VEC4"
         }));
-        channels.push(json!({"sampler": samplers.len(), "target": {"node": node, "path": "rotation"}}));
+        channels
+            .push(json!({"sampler": samplers.len(), "target": {"node": node, "path": "rotation"}}));
         samplers.push(json!({"input": times, "output": out, "interpolation": "LINEAR"}));
     }
     b.array("animations").push(json!({
@@ -587,7 +603,10 @@ impl PatchedGltf {
     /// Copies images referenced by relative URIs from the source folder to the output's
     /// folder when the two differ (an existing file of the same name is left alone).
     fn copy_images(&self, path: &Path) -> Result<()> {
-        let out_dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let out_dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
         let same = match (out_dir.canonicalize(), self.source_dir.canonicalize()) {
             (Ok(a), Ok(b)) => a == b,
             _ => false,
@@ -596,7 +615,9 @@ impl PatchedGltf {
             return Ok(());
         }
         for img in self.json["images"].as_array().into_iter().flatten() {
-            let Some(uri) = img["uri"].as_str() else { continue };
+            let Some(uri) = img["uri"].as_str() else {
+                continue;
+            };
             if uri.starts_with("data:") || uri.contains("://") || uri.starts_with('/') {
                 continue;
             }

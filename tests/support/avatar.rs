@@ -37,7 +37,13 @@ pub struct Avatar {
     pub prims: Vec<Prim>,
 }
 
-fn sphere(centre: Vec3, r: f32, rings: usize, segs: usize, cap: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
+fn sphere(
+    centre: Vec3,
+    r: f32,
+    rings: usize,
+    segs: usize,
+    cap: f32,
+) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
     let (mut p, mut n, mut uv, mut t) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for i in 0..=rings {
         let th = cap * i as f32 / rings as f32;
@@ -72,38 +78,83 @@ pub fn body_prims() -> Vec<Prim> {
     let jaw = 3u8;
     let (p, n, uv, t) = sphere(HEAD_CENTRE, HEAD_RADIUS, 10, 16, std::f32::consts::PI);
     let skin_joints = vec![[(head, 1.0), (0, 0.0)]; p.len()];
-    let skin = Prim { name: "skin", positions: p, normals: n, uvs: uv, triangles: t, joints: skin_joints };
+    let skin = Prim {
+        name: "skin",
+        positions: p,
+        normals: n,
+        uvs: uv,
+        triangles: t,
+        joints: skin_joints,
+    };
     let mouth_c = HEAD_CENTRE + Vec3::new(0.0, -4.0, 7.0);
     let (p, n, uv, t) = sphere(mouth_c, 2.0, 3, 8, 1.2);
     let mouth_joints = vec![[(jaw, 0.7), (head, 0.3)]; p.len()];
-    let mouth = Prim { name: "mouth", positions: p, normals: n, uvs: uv, triangles: t, joints: mouth_joints };
-    let mut eyes = Prim { name: "eyes", positions: vec![], normals: vec![], uvs: vec![], triangles: vec![], joints: vec![] };
+    let mouth = Prim {
+        name: "mouth",
+        positions: p,
+        normals: n,
+        uvs: uv,
+        triangles: t,
+        joints: mouth_joints,
+    };
+    let mut eyes = Prim {
+        name: "eyes",
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        triangles: vec![],
+        joints: vec![],
+    };
     for x in [-3.2f32, 3.2] {
-        let (p, n, uv, t) = sphere(HEAD_CENTRE + Vec3::new(x, 2.0, 7.5), 1.2, 4, 8, std::f32::consts::PI);
+        let (p, n, uv, t) = sphere(
+            HEAD_CENTRE + Vec3::new(x, 2.0, 7.5),
+            1.2,
+            4,
+            8,
+            std::f32::consts::PI,
+        );
         let base = eyes.positions.len() as u16;
-        eyes.triangles.extend(t.iter().map(|tr| tr.map(|i| i + base)));
-        eyes.joints.extend(std::iter::repeat_n([(head, 1.0), (0, 0.0)], p.len()));
+        eyes.triangles
+            .extend(t.iter().map(|tr| tr.map(|i| i + base)));
+        eyes.joints
+            .extend(std::iter::repeat_n([(head, 1.0), (0, 0.0)], p.len()));
         eyes.positions.extend(p);
         eyes.normals.extend(n);
         eyes.uvs.extend(uv);
     }
-    let mut lashes = Prim { name: "lashes", positions: vec![], normals: vec![], uvs: vec![], triangles: vec![], joints: vec![] };
+    let mut lashes = Prim {
+        name: "lashes",
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        triangles: vec![],
+        joints: vec![],
+    };
     for x in [-3.2f32, 3.2] {
         let base = lashes.positions.len() as u16;
         for k in 0..4 {
             let dx = (k as f32 - 1.5) * 0.8;
             for h in [0.0f32, 0.4] {
-                lashes.positions.push(HEAD_CENTRE + Vec3::new(x + dx, 3.3 + h, 8.6));
+                lashes
+                    .positions
+                    .push(HEAD_CENTRE + Vec3::new(x + dx, 3.3 + h, 8.6));
                 lashes.normals.push(Vec3::Z);
                 lashes.uvs.push(Vec2::new(k as f32 / 3.0, h / 0.4));
             }
         }
         for k in 0..3u16 {
-            let (a, b, c, d) = (base + 2 * k, base + 2 * k + 1, base + 2 * k + 2, base + 2 * k + 3);
+            let (a, b, c, d) = (
+                base + 2 * k,
+                base + 2 * k + 1,
+                base + 2 * k + 2,
+                base + 2 * k + 3,
+            );
             lashes.triangles.push([a, c, b]);
             lashes.triangles.push([b, c, d]);
         }
-        lashes.joints.extend(std::iter::repeat_n([(head, 1.0), (0, 0.0)], 8));
+        lashes
+            .joints
+            .extend(std::iter::repeat_n([(head, 1.0), (0, 0.0)], 8));
     }
     vec![skin, mouth, eyes, lashes]
 }
@@ -132,12 +183,19 @@ impl Bin {
         self.accessors.len() - 1
     }
     fn vec3(&mut self, v: &[Vec3], minmax: bool) -> usize {
-        let bytes: Vec<u8> = v.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
+        let bytes: Vec<u8> = v
+            .iter()
+            .flat_map(|p| p.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
         let view = self.view(&bytes, Some(34962));
-        let mut a = json!({"bufferView": view, "componentType": 5126, "count": v.len(), "type": "VEC3"});
+        let mut a =
+            json!({"bufferView": view, "componentType": 5126, "count": v.len(), "type": "VEC3"});
         if minmax {
             let min = v.iter().fold(Vec3::splat(f32::INFINITY), |m, p| m.min(*p));
-            let max = v.iter().fold(Vec3::splat(f32::NEG_INFINITY), |m, p| m.max(*p));
+            let max = v
+                .iter()
+                .fold(Vec3::splat(f32::NEG_INFINITY), |m, p| m.max(*p));
             a["min"] = json!(min.to_array());
             a["max"] = json!(max.to_array());
         }
@@ -146,8 +204,15 @@ impl Bin {
     fn floats(&mut self, v: &[f32], ty: &str, minmax: bool) -> usize {
         let bytes: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
         let view = self.view(&bytes, None);
-        let per = match ty { "SCALAR" => 1, "VEC2" => 2, "VEC4" => 4, "MAT4" => 16, _ => 3 };
-        let mut a = json!({"bufferView": view, "componentType": 5126, "count": v.len() / per, "type": ty});
+        let per = match ty {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC4" => 4,
+            "MAT4" => 16,
+            _ => 3,
+        };
+        let mut a =
+            json!({"bufferView": view, "componentType": 5126, "count": v.len() / per, "type": ty});
         if minmax {
             let min = v.iter().copied().fold(f32::INFINITY, f32::min);
             let max = v.iter().copied().fold(f32::NEG_INFINITY, f32::max);
@@ -180,31 +245,59 @@ fn joint_worlds() -> [Mat4; 4] {
 /// Builds the avatar.
 pub fn build() -> Avatar {
     let prims = body_prims();
-    let mut b = Bin { bin: Vec::new(), views: Vec::new(), accessors: Vec::new() };
+    let mut b = Bin {
+        bin: Vec::new(),
+        views: Vec::new(),
+        accessors: Vec::new(),
+    };
     let png = png();
     let image_view = b.view(&png, None);
     let mut primitives = Vec::new();
     for (k, p) in prims.iter().enumerate() {
         let pos = b.vec3(&p.positions, true);
         let nrm = b.vec3(&p.normals, false);
-        let uv_bytes: Vec<u8> = p.uvs.iter().flat_map(|v| v.to_array()).flat_map(f32::to_le_bytes).collect();
+        let uv_bytes: Vec<u8> = p
+            .uvs
+            .iter()
+            .flat_map(|v| v.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
         let uv_view = b.view(&uv_bytes, Some(34962));
         let uv = b.acc(json!({"bufferView": uv_view, "componentType": 5126, "count": p.uvs.len(), "type": "VEC2"}));
-        let jb: Vec<u8> = p.joints.iter().flat_map(|j| [j[0].0, j[1].0, 0, 0]).collect();
+        let jb: Vec<u8> = p
+            .joints
+            .iter()
+            .flat_map(|j| [j[0].0, j[1].0, 0, 0])
+            .collect();
         let jv = b.view(&jb, Some(34962));
         let joints = b.acc(json!({"bufferView": jv, "componentType": 5121, "count": p.joints.len(), "type": "VEC4"}));
-        let wf: Vec<f32> = p.joints.iter().flat_map(|j| [j[0].1, j[1].1, 0.0, 0.0]).collect();
+        let wf: Vec<f32> = p
+            .joints
+            .iter()
+            .flat_map(|j| [j[0].1, j[1].1, 0.0, 0.0])
+            .collect();
         let wb: Vec<u8> = wf.iter().flat_map(|x| x.to_le_bytes()).collect();
         let wv = b.view(&wb, Some(34962));
         let weights = b.acc(json!({"bufferView": wv, "componentType": 5126, "count": p.joints.len(), "type": "VEC4"}));
-        let ib: Vec<u8> = p.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+        let ib: Vec<u8> = p
+            .triangles
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
         let iv = b.view(&ib, Some(34963));
         let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": p.triangles.len() * 3, "type": "SCALAR"}));
         // The user's own `Blink`: lashes move down, every other primitive stays (dense zeros).
         let blink: Vec<Vec3> = p
             .positions
             .iter()
-            .map(|_| if p.name == "lashes" { Vec3::new(0.0, -0.6, 0.0) } else { Vec3::ZERO })
+            .map(|_| {
+                if p.name == "lashes" {
+                    Vec3::new(0.0, -0.6, 0.0)
+                } else {
+                    Vec3::ZERO
+                }
+            })
             .collect();
         let blink = b.vec3(&blink, true);
         primitives.push(json!({
@@ -217,13 +310,20 @@ pub fn build() -> Avatar {
     }
     // Hat: a square pyramid above the head (not skinned, under the Head joint).
     let hat_p = vec![
-        Vec3::new(-8.0, 8.0, -8.0), Vec3::new(8.0, 8.0, -8.0), Vec3::new(8.0, 8.0, 8.0),
-        Vec3::new(-8.0, 8.0, 8.0), Vec3::new(0.0, 20.0, 0.0),
+        Vec3::new(-8.0, 8.0, -8.0),
+        Vec3::new(8.0, 8.0, -8.0),
+        Vec3::new(8.0, 8.0, 8.0),
+        Vec3::new(-8.0, 8.0, 8.0),
+        Vec3::new(0.0, 20.0, 0.0),
     ];
     let hat_pos = b.vec3(&hat_p, true);
-    let hat_i: Vec<u8> = [0u16, 4, 1, 1, 4, 2, 2, 4, 3, 3, 4, 0].iter().flat_map(|i| i.to_le_bytes()).collect();
+    let hat_i: Vec<u8> = [0u16, 4, 1, 1, 4, 2, 2, 4, 3, 3, 4, 0]
+        .iter()
+        .flat_map(|i| i.to_le_bytes())
+        .collect();
     let hat_iv = b.view(&hat_i, Some(34963));
-    let hat_idx = b.acc(json!({"bufferView": hat_iv, "componentType": 5123, "count": 12, "type": "SCALAR"}));
+    let hat_idx =
+        b.acc(json!({"bufferView": hat_iv, "componentType": 5123, "count": 12, "type": "SCALAR"}));
     // Inverse bind matrices: each joint's world inverse times the armature (the mesh's bind
     // frame); the jaw's bind half a centimetre above its rest.
     let worlds = joint_worlds();
@@ -241,7 +341,13 @@ pub fn build() -> Avatar {
     // The user's animation: the head nods, Blink closes and opens.
     let times = b.floats(&[0.0, 0.5, 1.0], "SCALAR", true);
     let nod = glam::Quat::from_rotation_x(0.2);
-    let rot = b.floats(&[0.0, 0.0, 0.0, 1.0, nod.x, nod.y, nod.z, nod.w, 0.0, 0.0, 0.0, 1.0], "VEC4", false);
+    let rot = b.floats(
+        &[
+            0.0, 0.0, 0.0, 1.0, nod.x, nod.y, nod.z, nod.w, 0.0, 0.0, 0.0, 1.0,
+        ],
+        "VEC4",
+        false,
+    );
     let blinkw = b.floats(&[0.0, 1.0, 0.0], "SCALAR", false);
     let mat = |name: &str, tex: bool| {
         let mut m = json!({"name": name, "pbrMetallicRoughness": {"baseColorFactor": [1.0, 0.9, 0.8, 1.0], "metallicFactor": 0.0}, "extras": {"shader": name}});
@@ -311,7 +417,13 @@ impl Avatar {
         }
         let total = 12 + 8 + text.len() + 8 + self.bin.len();
         let mut out = Vec::new();
-        for w in [0x4654_6C67u32, 2, total as u32, text.len() as u32, 0x4E4F_534A] {
+        for w in [
+            0x4654_6C67u32,
+            2,
+            total as u32,
+            text.len() as u32,
+            0x4E4F_534A,
+        ] {
             out.extend_from_slice(&w.to_le_bytes());
         }
         out.extend_from_slice(&text);
@@ -329,7 +441,10 @@ impl Avatar {
         // The image moves out of the buffer into a file (its view stays, unused by images).
         let view = json["images"][0]["bufferView"].as_u64().unwrap() as usize;
         let v = &json["bufferViews"][view];
-        let (o, l) = (v["byteOffset"].as_u64().unwrap() as usize, v["byteLength"].as_u64().unwrap() as usize);
+        let (o, l) = (
+            v["byteOffset"].as_u64().unwrap() as usize,
+            v["byteLength"].as_u64().unwrap() as usize,
+        );
         std::fs::create_dir_all(dir.join("textures")).unwrap();
         std::fs::write(dir.join("textures/skin.png"), &self.bin[o..o + l]).unwrap();
         json["images"][0] = json!({"uri": "textures/skin.png", "name": "skin_basecolor"});

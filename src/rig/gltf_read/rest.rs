@@ -99,16 +99,28 @@ impl Placement {
         if let Some(m) = common(joints) {
             return Ok((m, None));
         }
-        let (Some(ja), Some(wa)) = (prim.get(&Semantic::Joints(0)), prim.get(&Semantic::Weights(0)))
-        else {
+        let (Some(ja), Some(wa)) = (
+            prim.get(&Semantic::Joints(0)),
+            prim.get(&Semantic::Weights(0)),
+        ) else {
             reader.rig.warnings.push(Diagnostic::warning(format!(
                 "{}: {at}: skinned without JOINTS_0/WEIGHTS_0; read in its bind pose",
                 reader.file.display()
             )));
             return Ok((Mat4::IDENTITY, None));
         };
-        reader.check_plain(&ja, &format!("{at}.attributes.JOINTS_0"), Dimensions::Vec4, n)?;
-        reader.check_plain(&wa, &format!("{at}.attributes.WEIGHTS_0"), Dimensions::Vec4, n)?;
+        reader.check_plain(
+            &ja,
+            &format!("{at}.attributes.JOINTS_0"),
+            Dimensions::Vec4,
+            n,
+        )?;
+        reader.check_plain(
+            &wa,
+            &format!("{at}.attributes.WEIGHTS_0"),
+            Dimensions::Vec4,
+            n,
+        )?;
         let buffers = reader.buffers;
         let r = prim.reader(|b| buffers.get(b.index()).map(|v| v.as_slice()));
         let (Some(js), Some(ws)) = (r.read_joints(0), r.read_weights(0)) else {
@@ -180,16 +192,15 @@ impl Reader<'_> {
         let type_ok = acc.dimensions() == dims
             && match dims {
                 Dimensions::Mat4 => acc.data_type() == DataType::F32,
-                _ => matches!(acc.data_type(), DataType::U8 | DataType::U16 | DataType::F32),
+                _ => matches!(
+                    acc.data_type(),
+                    DataType::U8 | DataType::U16 | DataType::F32
+                ),
             };
         if !type_ok {
             return Err(self.err(
                 &at,
-                format!(
-                    "unexpected {:?} of {:?}",
-                    acc.dimensions(),
-                    acc.data_type()
-                ),
+                format!("unexpected {:?} of {:?}", acc.dimensions(), acc.data_type()),
             ));
         }
         let n = acc.count();
@@ -197,12 +208,22 @@ impl Reader<'_> {
             return Err(self.err(&at, format!("count {n}, expected {count}")));
         }
         if let Some(view) = acc.view() {
-            self.check_range(&at, view.length(), view.stride(), acc.offset(), n, acc.size())?;
+            self.check_range(
+                &at,
+                view.length(),
+                view.stride(),
+                acc.offset(),
+                n,
+                acc.size(),
+            )?;
         }
         if let Some(sparse) = acc.sparse() {
             let k = sparse.count();
             if k == 0 || k > n {
-                return Err(self.err(&format!("{at}.sparse"), format!("count {k} outside 1..={n}")));
+                return Err(self.err(
+                    &format!("{at}.sparse"),
+                    format!("count {k} outside 1..={n}"),
+                ));
             }
             let idx = sparse.indices();
             self.check_range(
