@@ -349,6 +349,38 @@ fn patched_avatar_plays_into_its_own_document() {
     assert_eq!(anims[1]["name"], "play");
     let ch = &anims[1]["channels"][0];
     assert_eq!(ch["target"]["node"], 5, "weights on the Body node");
+    // The stream's head pitch and yaw turn the node named Head (the FAT has no table for them).
+    let head: Vec<&Value> = anims[1]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["target"]["path"] == "rotation")
+        .collect();
+    assert_eq!(head.len(), 1);
+    assert_eq!(head[0]["target"]["node"], 3);
+    // Named nodes: the hat turns instead.
+    let hat = dir.path().join("hat.glb");
+    let out = command()
+        .args([
+            "play".as_ref(),
+            patched.as_os_str(),
+            sample.as_os_str(),
+            "-o".as_ref(),
+            hat.as_os_str(),
+            "--head-node".as_ref(),
+            "Hat".as_ref(),
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let y2 = json_of(&hat);
+    let rot: Vec<&Value> = y2["animations"][1]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["target"]["path"] == "rotation")
+        .collect();
+    assert_eq!(rot[0]["target"]["node"], 6);
     // Played from a patched file: the targets are not added a second time.
     assert_eq!(
         x["meshes"][0]["extras"]["targetNames"],

@@ -66,7 +66,9 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         return export_arkit(&a, &face);
     }
     let mut warnings = Vec::new();
-    if let Some(export) = fbakit::export::gltf_patch::patch_if_fits(&face, None, &mut warnings)? {
+    if let Some(export) =
+        fbakit::export::gltf_patch::patch_if_fits(&face, None, &Default::default(), &mut warnings)?
+    {
         return export_patch(&a, &face, export);
     }
     let mut export = export_face_with_units(&face, None, a.units)?;

@@ -18,10 +18,11 @@
 
 use std::collections::BTreeMap;
 
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, Quat, Vec3};
 use serde_json::Map;
 
 use super::gltf::FaceMorphs;
+use super::gltf_rotations::{rotated_nodes, same_hemisphere, RotationNodes};
 use crate::error::{Diagnostic, Result};
 use crate::face::gltf_fat::{self, TargetRecord};
 use crate::face::FaceModel;
@@ -147,6 +148,7 @@ pub fn mismatch(face: &FaceModel, source: &GltfSource) -> Option<String> {
 pub fn patch_if_fits(
     face: &FaceModel,
     frames: Option<&[AnimationFrame]>,
+    nodes: &RotationNodes,
     warnings: &mut Vec<Diagnostic>,
 ) -> Result<Option<GltfPatchExport>> {
     let Some(source) = &face.gltf_source else {
@@ -159,14 +161,16 @@ pub fn patch_if_fits(
         )));
         return Ok(None);
     }
-    patch_face(face, source, frames).map(Some)
+    patch_face(face, source, frames, nodes).map(Some)
 }
 
-/// `face` (read from `source`) patched into that document; with `frames`, its animation.
+/// `face` (read from `source`) patched into that document; with `frames`, its animation
+/// (head and eye rotations on `nodes`, or on the nodes found by their usual names).
 pub fn patch_face(
     face: &FaceModel,
     source: &GltfSource,
     frames: Option<&[AnimationFrame]>,
+    nodes: &RotationNodes,
 ) -> Result<GltfPatchExport> {
     face.check_structure()?;
     let mut warnings = Vec::new();
@@ -303,6 +307,20 @@ pub fn patch_face(
     patch.scene_extras = gltf_fat::scene_record(face, 1.0);
     if let Some(frames) = frames.filter(|f| !f.is_empty()) {
         patch.animation = animation(source, &meshes, &layouts, frames);
+        let turned = rotated_nodes(source, &face.fat, nodes);
+        if !turned.is_empty() {
+            let anim = patch
+                .animation
+                .get_or_insert_with(|| empty_animation(frames));
+            for n in &turned {
+                let mut values: Vec<Quat> = keyed_frames(frames)
+                    .iter()
+                    .map(|f| n.rotation(&f.activations))
+                    .collect();
+                same_hemisphere(&mut values);
+                anim.rotations.push((n.node, values));
+            }
+        }
     }
     let document = patch.apply(source)?;
     warnings.extend(document.warnings.iter().cloned());
@@ -492,6 +510,31 @@ fn bake_transforms(
     Ok(())
 }
 
+/// The played frames with a closing key one frame after the last that holds it (the rule of
+/// `export::gltf`: the clip lasts frames / fps).
+fn keyed_frames(frames: &[AnimationFrame]) -> Vec<&AnimationFrame> {
+    let closing = frames.len() >= 2;
+    frames
+        .iter()
+        .chain(closing.then(|| &frames[frames.len() - 1]))
+        .collect()
+}
+
+/// The `play` animation with its key times and no channels yet.
+fn empty_animation(frames: &[AnimationFrame]) -> PatchAnimation {
+    let t0 = frames[0].time;
+    let mut times: Vec<f32> = frames.iter().map(|f| (f.time - t0) as f32).collect();
+    if frames.len() >= 2 {
+        let last = frames[frames.len() - 1].time - t0;
+        times.push((last + last / (frames.len() - 1) as f64) as f32);
+    }
+    PatchAnimation {
+        name: "play".into(),
+        times,
+        ..PatchAnimation::default()
+    }
+}
+
 /// One weights channel per patched mesh, on the first node that shows it.
 fn animation(
     source: &GltfSource,
@@ -499,23 +542,8 @@ fn animation(
     layouts: &BTreeMap<usize, TargetLayout>,
     frames: &[AnimationFrame],
 ) -> Option<PatchAnimation> {
-    let t0 = frames[0].time;
-    let mut times: Vec<f32> = frames.iter().map(|f| (f.time - t0) as f32).collect();
-    // A closing key one frame after the last holds it (the rule of `export::gltf`).
-    let closing = frames.len() >= 2;
-    if closing {
-        let last = frames[frames.len() - 1].time - t0;
-        times.push((last + last / (frames.len() - 1) as f64) as f32);
-    }
-    let keyed: Vec<&AnimationFrame> = frames
-        .iter()
-        .chain(closing.then(|| &frames[frames.len() - 1]))
-        .collect();
-    let mut anim = PatchAnimation {
-        name: "play".into(),
-        times,
-        ..PatchAnimation::default()
-    };
+    let keyed = keyed_frames(frames);
+    let mut anim = empty_animation(frames);
     let mut scratch = Vec::new();
     for (&m, t) in meshes {
         if t.pieces.is_empty() {

@@ -18,6 +18,7 @@ pub mod budget;
 mod error;
 pub mod gltf;
 pub mod gltf_patch;
+pub mod gltf_rotations;
 pub mod movie;
 pub mod obj_sequence;
 pub mod picture;
@@ -39,7 +40,9 @@ pub fn write_face(path: &Path, face: &FaceModel) -> Result<Vec<crate::error::Dia
     match OutputFormat::resolve(path, OutputFormat::FACES, "a face file")? {
         OutputFormat::Glb | OutputFormat::Gltf => {
             let mut warnings = Vec::new();
-            if let Some(export) = gltf_patch::patch_if_fits(face, None, &mut warnings)? {
+            if let Some(export) =
+                gltf_patch::patch_if_fits(face, None, &Default::default(), &mut warnings)?
+            {
                 export.document.write(path)?;
                 warnings.extend(export.warnings);
                 return Ok(warnings);
