@@ -384,6 +384,24 @@ fn report_text(r: &PlayReport) -> String {
     o
 }
 
+/// `--eye-nodes LEFT,RIGHT`.
+fn parse_node_pair(s: &str) -> std::result::Result<(String, String), String> {
+    match s.split_once(',') {
+        Some((l, r)) if !l.trim().is_empty() && !r.trim().is_empty() => {
+            Ok((l.trim().to_string(), r.trim().to_string()))
+        }
+        _ => Err(format!("`{s}`: expected LEFT,RIGHT node names")),
+    }
+}
+
+/// The rotation nodes the options name.
+fn rotation_nodes(a: &PlayArgs) -> fbakit::export::gltf_rotations::RotationNodes {
+    fbakit::export::gltf_rotations::RotationNodes {
+        head: a.head_node.clone(),
+        eyes: a.eye_nodes.clone(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -420,23 +438,5 @@ mod tests {
             output_format(Path::new("x.txt"), Some(PlayFormat::Obj)).unwrap(),
             PlayFormat::Obj
         );
-    }
-}
-
-/// `--eye-nodes LEFT,RIGHT`.
-fn parse_node_pair(s: &str) -> std::result::Result<(String, String), String> {
-    match s.split_once(',') {
-        Some((l, r)) if !l.trim().is_empty() && !r.trim().is_empty() => {
-            Ok((l.trim().to_string(), r.trim().to_string()))
-        }
-        _ => Err(format!("`{s}`: expected LEFT,RIGHT node names")),
-    }
-}
-
-/// The rotation nodes the options name.
-fn rotation_nodes(a: &PlayArgs) -> fbakit::export::gltf_rotations::RotationNodes {
-    fbakit::export::gltf_rotations::RotationNodes {
-        head: a.head_node.clone(),
-        eyes: a.eye_nodes.clone(),
     }
 }

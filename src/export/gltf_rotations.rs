@@ -249,9 +249,10 @@ mod tests {
 
     #[test]
     fn usual_names_are_found_and_rotations_are_in_the_face_frame() {
+        let turn = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
         let json = serde_json::json!({
             "nodes": [
-                {"name": "Armature", "rotation": [0.0, 0.7071068, 0.0, 0.7071068], "children": [1]},
+                {"name": "Armature", "rotation": turn.to_array(), "children": [1]},
                 {"name": "mixamorig:Head", "children": [2]},
                 {"name": "eye.L"}
             ]
@@ -270,9 +271,8 @@ mod tests {
             value: 10_000.0,
         }];
         let local = nodes[0].rotation(&a);
-        let world = Quat::from_xyzw(0.0, 0.7071068, 0.0, 0.7071068) * local;
-        let want =
-            Quat::from_axis_angle(Vec3::Y, 0.1) * Quat::from_xyzw(0.0, 0.7071068, 0.0, 0.7071068);
+        let world = turn * local;
+        let want = Quat::from_axis_angle(Vec3::Y, 0.1) * turn;
         assert!(world.abs_diff_eq(want, 1e-5) || world.abs_diff_eq(-want, 1e-5));
         // A FAT table for head yaw leaves yaw to the table.
         let mut fat = Fat::default();
