@@ -95,3 +95,18 @@ fn avatar_30mb_glb(bencher: divan::Bencher) {
             .unwrap()
     });
 }
+
+/// Writing the same avatar back as a patch (buffers merged, JSON copied, GLB assembled).
+#[divan::bench(sample_count = 5)]
+fn avatar_30mb_patch_write(bencher: divan::Bencher) {
+    let bytes = avatar_glb();
+    let rig = fbakit::rig::gltf_read::read_gltf_bytes(&bytes, Path::new("avatar.glb")).unwrap();
+    let face = rig.to_face();
+    let source = face.gltf_source.clone().unwrap();
+    bencher.bench(|| {
+        let export =
+            fbakit::export::gltf_patch::patch_face(&face, &source, None, &Default::default())
+                .unwrap();
+        export.document.to_glb().unwrap()
+    });
+}

@@ -8,7 +8,7 @@
 //! eye sockets, gums, tongue, teeth and eyeballs (vertices 0–24590 of the neutral: ICT's
 //! lacrimal fluid, eye blend, eye occlusion and eyelash layers are dropped), the shapes the
 //! ARKit-52 map turns into FAT tables, and shape motion above 0.1 mm (ICT is in cm). It
-//! writes the rig as `ict-head.glb` (sparse morph targets, ARKit names), its MPEG-4 feature
+//! writes the rig in metres as `ict-head.glb` (sparse morph targets, ARKit names), its MPEG-4 feature
 //! points derived from ICT's iBUG-68 landmarks as `ict-head-fp.csv` (with provenance), and
 //! ICT's licence. `fbakit face info samples/faces/ict-head/ict-head.glb --fp
 //! samples/faces/ict-head/ict-head-fp.csv` (or the bundled name `ict`) builds its FAT.
@@ -25,6 +25,9 @@ const FIRST_OVERLAY_VERTEX: usize = 24591;
 
 /// Shape motion at or below this is dropped (cm: 0.1 mm).
 const MIN_MOTION_CM: f32 = 0.01;
+
+/// Metres per centimetre: the sample is written in metres.
+const CM_TO_M: f32 = 0.01;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -58,6 +61,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let unused: Vec<String> = report.unused_shapes.clone();
     rig.retain_shapes(|name| !unused.iter().any(|u| u == name));
     let dropped = rig.drop_motion_below(MIN_MOTION_CM);
+    // glTF is in metres: ICT's centimetres are scaled once here, so viewers show a 34 cm
+    // head, not a 34 m one (vertex order and ids are untouched, so the feature points hold).
+    for m in &mut rig.meshes {
+        for p in &mut m.mesh.positions {
+            *p *= CM_TO_M;
+        }
+    }
+    for s in &mut rig.shapes {
+        for d in &mut s.deltas {
+            for o in &mut d.offsets {
+                *o *= CM_TO_M;
+            }
+        }
+    }
 
     let glb = out.join("ict-head.glb");
     fbakit::rig::gltf_write::write_rig_gltf(&rig, &glb)?;

@@ -145,6 +145,7 @@ fn synthetic_rig() -> (Rig, FeaturePointSet) {
             shape("eyeBlink_L", &[(2, [0.0, -5.0, 0.0])]),
         ],
         warnings: vec![],
+        source: None,
     };
     let mut set = FeaturePointSet::new();
     for (i, (label, p)) in points.iter().enumerate() {

@@ -23,7 +23,7 @@ const GLB: &str = "samples/faces/ict-head/ict-head.glb";
 const FP: &str = "samples/faces/ict-head/ict-head-fp.csv";
 
 #[test]
-fn bundled_real_head_has_a_compliant_fat_in_centimetres() {
+fn bundled_real_head_has_a_compliant_fat_in_metres() {
     let face = fbakit::face::read("ict").unwrap();
     assert_eq!(face.vertex_count(), 24591);
     assert!(face.fat.tables.len() >= 50, "{}", face.fat.tables.len());
@@ -40,7 +40,7 @@ fn bundled_real_head_has_a_compliant_fat_in_centimetres() {
     assert_eq!(from_file.fat, face.fat);
     let info: serde_json::Value =
         serde_json::from_slice(&ok(&["face", "info", "ict", "--json"]).stdout).unwrap();
-    assert_eq!(info["units"]["unit"], "cm");
+    assert_eq!(info["units"]["unit"], "m");
 }
 
 #[test]

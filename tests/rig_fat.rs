@@ -84,6 +84,7 @@ fn synthetic_rig() -> (Rig, FeaturePointSet) {
             shape("tailWag", &[(4, [1.0, 0.0, 0.0])]),
         ],
         warnings: vec![],
+        source: None,
     };
     let mut points = FeaturePointSet::new();
     for (i, (label, p)) in POINTS.iter().enumerate() {

@@ -65,7 +65,15 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
     if a.names == NamesArg::Arkit {
         return export_arkit(&a, &face);
     }
-    let export = export_face_with_units(&face, None, a.units)?;
+    let mut warnings = Vec::new();
+    if let Some(export) =
+        fbakit::export::gltf_patch::patch_if_fits(&face, None, &Default::default(), &mut warnings)?
+    {
+        return export_patch(&a, &face, export);
+    }
+    let mut export = export_face_with_units(&face, None, a.units)?;
+    warnings.append(&mut export.warnings);
+    export.warnings = warnings;
     if format == OutputFormat::Glb {
         export.document.write_glb(&a.output)?;
     } else {
@@ -90,6 +98,35 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
     } else {
         println!(
             "wrote {}: {} meshes, {} morph targets",
+            report.output, report.meshes, report.morph_targets
+        );
+        super::print_warnings(&report.warnings);
+    }
+    Ok(EXIT_OK)
+}
+
+/// `face export` of a face read from glTF: its own document, patched with the FAT.
+fn export_patch(
+    a: &FaceExportArgs,
+    face: &fbakit::face::FaceModel,
+    export: fbakit::export::gltf_patch::GltfPatchExport,
+) -> Result<u8> {
+    export.document.write(&a.output)?;
+    let report = Report {
+        face: face.name.clone(),
+        output: a.output.display().to_string(),
+        meshes: export.document.json["meshes"]
+            .as_array()
+            .map_or(0, Vec::len),
+        morph_targets: export.morph_targets,
+        warnings: export.warnings,
+        arkit: None,
+    };
+    if a.json {
+        print_json(&report)?;
+    } else {
+        println!(
+            "wrote {}: {} meshes, {} morph targets added",
             report.output, report.meshes, report.morph_targets
         );
         super::print_warnings(&report.warnings);

@@ -70,6 +70,14 @@ pub struct PlayArgs {
     /// Read the stream strictly.
     #[arg(long)]
     pub strict: bool,
+    /// glTF face: the node head pitch, yaw and roll (FAPs 48-50) turn (default: found by the
+    /// usual names such as `Head`, or the VRM humanoid head bone).
+    #[arg(long, value_name = "NODE")]
+    pub head_node: Option<String>,
+    /// glTF face: the left and right eye nodes eyeball yaw and pitch (FAPs 23-26) turn, as
+    /// `LEFT,RIGHT` (default: `LeftEye`/`RightEye`, `eye.L`/`eye.R` or the VRM eye bones).
+    #[arg(long, value_name = "LEFT,RIGHT", value_parser = parse_node_pair)]
+    pub eye_nodes: Option<(String, String)>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -216,11 +224,22 @@ pub fn run(a: PlayArgs) -> Result<u8> {
         PlayFormat::Glb | PlayFormat::Gltf => {
             let anim = player.animation()?;
             bar.set_position(anim.len() as u64);
-            let export = export_face_with_units(&face, Some(&anim), a.units)?;
-            warnings.extend(export.warnings);
-            match format {
-                PlayFormat::Glb => export.document.write_glb(&a.output)?,
-                _ => export.document.write_gltf(&a.output)?,
+            // A glTF face plays into its own document, which keeps its units.
+            if let Some(export) = fbakit::export::gltf_patch::patch_if_fits(
+                &face,
+                Some(&anim),
+                &rotation_nodes(&a),
+                &mut warnings,
+            )? {
+                warnings.extend(export.warnings);
+                export.document.write(&a.output)?;
+            } else {
+                let export = export_face_with_units(&face, Some(&anim), a.units)?;
+                warnings.extend(export.warnings);
+                match format {
+                    PlayFormat::Glb => export.document.write_glb(&a.output)?,
+                    _ => export.document.write_gltf(&a.output)?,
+                }
             }
             1
         }
@@ -364,6 +383,24 @@ fn report_text(r: &PlayReport) -> String {
         }
     }
     o
+}
+
+/// `--eye-nodes LEFT,RIGHT`.
+fn parse_node_pair(s: &str) -> std::result::Result<(String, String), String> {
+    match s.split_once(',') {
+        Some((l, r)) if !l.trim().is_empty() && !r.trim().is_empty() => {
+            Ok((l.trim().to_string(), r.trim().to_string()))
+        }
+        _ => Err(format!("`{s}`: expected LEFT,RIGHT node names")),
+    }
+}
+
+/// The rotation nodes the options name.
+fn rotation_nodes(a: &PlayArgs) -> fbakit::export::gltf_rotations::RotationNodes {
+    fbakit::export::gltf_rotations::RotationNodes {
+        head: a.head_node.clone(),
+        eyes: a.eye_nodes.clone(),
+    }
 }
 
 #[cfg(test)]

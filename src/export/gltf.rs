@@ -339,13 +339,55 @@ pub fn export_face_with_units(
             })?;
         }
     }
+    let mut document = scene.build()?;
+    add_fat_records(&mut document, face, &morphs, &mesh_nodes, k);
     Ok(GltfExport {
-        document: scene.build()?,
+        document,
         warnings: warnings
             .into_iter()
             .map(crate::error::Diagnostic::warning)
             .collect(),
     })
+}
+
+/// fbakit's FAT and feature-point records (`specs/gltf-fat.md`), so the document reads back
+/// as the face: per written mesh its targets' tables, on the scene the feature points.
+fn add_fat_records(
+    document: &mut GltfDocument,
+    face: &FaceModel,
+    morphs: &FaceMorphs,
+    mesh_nodes: &[Option<NodeId>],
+    k: f32,
+) {
+    use crate::face::gltf_fat::{scene_record, targets_record, TargetRecord, KEY};
+    let written = mesh_nodes
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.is_some())
+        .map(|(mi, _)| mi);
+    for (mesh, mi) in document.root.meshes.iter_mut().zip(written) {
+        let records: Vec<TargetRecord> = morphs.meshes[mi]
+            .iter()
+            .map(|p| TargetRecord {
+                target: p.name.clone(),
+                key: p.key,
+                borders: p.borders.clone(),
+                interval: p.interval,
+                span: p.span,
+            })
+            .collect();
+        if records.is_empty() {
+            continue;
+        }
+        let extras = mesh.extras.get_or_insert_with(|| serde_json::json!({}));
+        if let Some(o) = extras.as_object_mut() {
+            o.insert(KEY.into(), targets_record(&records));
+        }
+    }
+    let record = scene_record(face, k);
+    if let (Some(scene), false) = (document.root.scenes.first_mut(), record.is_empty()) {
+        scene.extras = Some(serde_json::Value::Object(record));
+    }
 }
 
 fn animation_channels(

@@ -17,6 +17,8 @@
 pub mod budget;
 mod error;
 pub mod gltf;
+pub mod gltf_patch;
+pub mod gltf_rotations;
 pub mod movie;
 pub mod obj_sequence;
 pub mod obj_shapes;
@@ -42,9 +44,18 @@ pub fn write_face(
     let path = path.as_ref();
     match OutputFormat::resolve(path, OutputFormat::FACES, "a face file")? {
         OutputFormat::Glb | OutputFormat::Gltf => {
+            let mut warnings = Vec::new();
+            if let Some(export) =
+                gltf_patch::patch_if_fits(face, None, &Default::default(), &mut warnings)?
+            {
+                export.document.write(path)?;
+                warnings.extend(export.warnings);
+                return Ok(warnings);
+            }
             let export = gltf::export_face(face, None)?;
             export.document.write(path)?;
-            Ok(export.warnings)
+            warnings.extend(export.warnings);
+            Ok(warnings)
         }
         _ => crate::face::write(path, face).map(|()| Vec::new()),
     }

@@ -125,10 +125,10 @@ mod tests {
     }
 
     #[test]
-    fn ict_is_a_real_head_in_centimetres() {
+    fn ict_is_a_real_head_in_metres() {
         let face = BundledFace::Ict.read().unwrap().0;
         assert_eq!(face.vertex_count(), 24591);
         let unit = crate::face::units::unit_of(&face, None).unwrap();
-        assert_eq!(unit.unit, crate::face::units::LengthUnit::Cm, "{unit:?}");
+        assert_eq!(unit.unit, crate::face::units::LengthUnit::M, "{unit:?}");
     }
 }

@@ -35,6 +35,12 @@ pub(crate) fn rig_face(
     let Some(fp) = feature_points else {
         let mut face = rig.to_face();
         face.name = super::format::face_name(path);
+        // A glTF fbakit wrote carries its FAT and feature points (specs/gltf-fat.md).
+        if let Some((points, fat)) = super::gltf_fat::read_records(rig)? {
+            face.feature_points = points;
+            face.fat = fat;
+            return Ok((face, report));
+        }
         if !rig.shapes.is_empty() {
             report.diagnostics.push(note(format!(
                 "{}: a rig with {} shapes read as its neutral meshes only; give its feature \

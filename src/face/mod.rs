@@ -17,6 +17,7 @@ pub mod candide;
 mod error;
 pub mod format;
 mod from_rig;
+pub mod gltf_fat;
 pub mod morphs;
 pub mod mouth;
 pub mod parts;
@@ -157,6 +158,9 @@ pub struct FaceModel {
     /// The OBJ text it was read from, kept so OBJ outputs keep the user's file (groups,
     /// materials, `vt`, `vn`, comments) and rewrite only its `v` lines ([`obj_patch`]).
     pub obj_source: Option<std::sync::Arc<str>>,
+    /// The glTF document it was read from, kept so glTF outputs patch it (mesh names match
+    /// [`crate::gltf::source::SourcePart::face_mesh`]).
+    pub gltf_source: Option<std::sync::Arc<crate::gltf::source::GltfSource>>,
 }
 
 impl PartialEq for FaceModel {
@@ -188,6 +192,7 @@ impl FaceModel {
             fat: Fat::default(),
             scene: None,
             obj_source: None,
+            gltf_source: None,
         }
     }
 

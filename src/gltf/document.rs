@@ -46,6 +46,7 @@ pub(super) fn assemble(
     root.scenes.push(json::Scene {
         name: name_opt(scene_name),
         nodes: roots,
+        extras: None,
     });
     for a in animations {
         root.animations.push(animation_json(&mut out, a));

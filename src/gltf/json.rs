@@ -76,6 +76,9 @@ pub struct Scene {
     /// Root node indices.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub nodes: Vec<u32>,
+    /// Application data (fbakit's feature-point record, `specs/gltf-fat.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extras: Option<Value>,
 }
 
 /// A node of the scene hierarchy.

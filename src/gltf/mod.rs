@@ -80,7 +80,9 @@ mod error;
 pub mod json;
 mod layout;
 mod normals;
+pub mod patch;
 mod scene_data;
+pub mod source;
 
 pub use builder::SceneBuilder;
 pub use container::{parse_glb, GlbChunks, GltfDocument};

@@ -136,6 +136,7 @@ pub fn face_to_arkit_rig(
         meshes,
         shapes,
         warnings: Vec::new(),
+        source: None,
     };
     Ok((rig, report))
 }

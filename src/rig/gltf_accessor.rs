@@ -127,7 +127,7 @@ impl AccessorData<'_> {
     }
 
     /// `count` elements of `elem` bytes every `stride` bytes from `offset` fit in `len` bytes.
-    fn check_range(
+    pub(super) fn check_range(
         &self,
         at: &str,
         len: usize,

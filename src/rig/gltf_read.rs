@@ -32,6 +32,7 @@ use serde_json::Value;
 use super::gltf_accessor::{AccessorData, Want};
 use super::{BlendShape, Rig, RigError, RigMesh, ShapeDelta, MAX_RIG_SHAPES, MAX_RIG_VERTICES};
 use crate::error::{Diagnostic, Error, Result};
+use crate::gltf::source::{GltfSource, RestPose, SourcePart};
 use crate::mesh::{FaceGroup, Mesh, Polygons};
 
 /// Largest glTF file (and each external buffer) read: 1 GiB.
@@ -53,7 +54,7 @@ pub fn read_gltf(path: &Path) -> Result<Rig> {
 /// Reads a glTF rig from memory; `path` names the file in errors and locates external buffers.
 pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
     check_glb_header(bytes, path)?;
-    let (gltf, buffers, warnings) = open_decoded(bytes, path)?;
+    let (gltf, buffers, json, warnings) = open_decoded(bytes, path)?;
     check_attribute_indices(&gltf, path)?;
     validate(&gltf, path)?;
     let mut reader = Reader {
@@ -69,12 +70,16 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
             meshes: Vec::new(),
             shapes: Vec::new(),
             warnings,
+            source: None,
         },
         shape_by_name: HashMap::new(),
         vertices: 0,
         mesh_names: HashMap::new(),
+        parts: Vec::new(),
+        node_world: Vec::new(),
     };
     reader.check_views()?;
+    reader.node_world = rest::node_world_matrices(&gltf);
     let roots = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
         None => sceneless_roots(&gltf, path, &mut reader.rig.warnings)?,
@@ -83,6 +88,7 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
         roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     stack.reverse();
     let mut seen = vec![false; gltf.nodes().len()];
+    let mut instanced = vec![false; gltf.meshes().len()];
     while let Some((node, parent, depth)) = stack.pop() {
         let at = format!("nodes[{}]", node.index());
         if std::mem::replace(&mut seen[node.index()], true) {
@@ -96,22 +102,36 @@ pub fn read_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Rig> {
             return Err(located(path, &at, "non-finite transform"));
         }
         if let Some(mesh) = node.mesh() {
+            instanced[mesh.index()] = true;
             // A skinned mesh ignores its node's transform (glTF 2.0, 3.7.3): its vertices are
-            // read in the bind pose.
-            let placed = if node.skin().is_some() {
-                Mat4::IDENTITY
-            } else {
-                world
+            // placed by its joints at rest.
+            let placed = match node.skin() {
+                Some(skin) => reader.skin_rest(&skin)?,
+                None => rest::Placement::Matrix(world),
             };
-            reader.mesh_instance(&node, &mesh, placed)?;
+            reader.mesh_instance(Some(&node), &mesh, placed)?;
         }
         let children: Vec<_> = node.children().collect();
         for c in children.into_iter().rev() {
             stack.push((c, world, depth + 1));
         }
     }
+    if gltf.scenes().len() == 0 {
+        // A file without scenes (nor nodes for some meshes): those meshes as they are.
+        for mesh in gltf.meshes().filter(|m| !instanced[m.index()]) {
+            reader.mesh_instance(None, &mesh, rest::Placement::Matrix(Mat4::IDENTITY))?;
+        }
+    }
     reader.rig.check()?;
-    Ok(reader.rig)
+    let parts = std::mem::take(&mut reader.parts);
+    let mut rig = reader.rig;
+    rig.source = Some(std::sync::Arc::new(GltfSource {
+        path: path.to_path_buf(),
+        json,
+        buffers,
+        parts,
+    }));
+    Ok(rig)
 }
 
 /// The roots of a document without a scene: every node that is no other's child, with a
@@ -141,7 +161,13 @@ fn sceneless_roots<'a>(
 
 /// The document of `bytes` (`.glb` or `.gltf` JSON) with its buffers loaded and compressed
 /// data decoded ([`crate::gltf::decode::decode_document`]), and the decoder's warnings.
-fn open_decoded(bytes: &[u8], file: &Path) -> Result<(Document, Vec<Vec<u8>>, Vec<Diagnostic>)> {
+/// The JSON returned is the decoded document's (what a patch writes back: decoded, the
+/// compression extensions dropped).
+#[allow(clippy::type_complexity)]
+fn open_decoded(
+    bytes: &[u8],
+    file: &Path,
+) -> Result<(Document, Vec<Vec<u8>>, Value, Vec<Diagnostic>)> {
     let (json_bytes, bin) = if bytes.starts_with(b"glTF") {
         let glb = ::gltf::Glb::from_slice(bytes).map_err(|e| gltf_error(file, e))?;
         (glb.json, glb.bin.map(|b| b.into_owned()))
@@ -161,13 +187,13 @@ fn open_decoded(bytes: &[u8], file: &Path) -> Result<(Document, Vec<Vec<u8>>, Ve
         let text = serde_json::to_vec(&json).map_err(unreadable)?;
         ::gltf::json::deserialize::from_slice(&text)
     } else {
-        drop(json);
         ::gltf::json::deserialize::from_slice(&json_bytes)
     }
     .map_err(|e| gltf_error(file, ::gltf::Error::Deserialize(e)))?;
     Ok((
         Document::from_json_without_validation(root),
         buffers,
+        json,
         report.warnings,
     ))
 }
@@ -386,6 +412,8 @@ fn percent_decode(s: &str) -> Option<String> {
     String::from_utf8(out).ok()
 }
 
+mod rest;
+
 struct Reader<'a> {
     file: &'a Path,
     doc: &'a Document,
@@ -395,6 +423,10 @@ struct Reader<'a> {
     shape_by_name: HashMap<String, usize>,
     vertices: usize,
     mesh_names: HashMap<String, usize>,
+    /// Where each rig mesh came from, for writing the document back.
+    parts: Vec<SourcePart>,
+    /// World matrix of every node at rest (joints need them whether in the scene or not).
+    node_world: Vec<Mat4>,
 }
 
 impl Reader<'_> {
@@ -481,9 +513,9 @@ impl Reader<'_> {
 
     fn mesh_instance(
         &mut self,
-        node: &::gltf::Node,
+        node: Option<&::gltf::Node>,
         mesh: &::gltf::Mesh,
-        world: Mat4,
+        placed: rest::Placement,
     ) -> Result<()> {
         let m = mesh.index();
         let prims: Vec<_> = mesh.primitives().collect();
@@ -523,10 +555,11 @@ impl Reader<'_> {
                 ));
             }
         }
-        let weights = match node.weights().or(mesh.weights()) {
+        let node_weights = node.and_then(|n| n.weights());
+        let weights = match node_weights.or(mesh.weights()) {
             Some(w) if w.len() != targets => {
-                let at = if node.weights().is_some() {
-                    format!("nodes[{}].weights", node.index())
+                let at = if let (Some(n), Some(_)) = (node, node_weights) {
+                    format!("nodes[{}].weights", n.index())
                 } else {
                     format!("meshes[{m}].weights")
                 };
@@ -566,7 +599,7 @@ impl Reader<'_> {
             shape_ids.push(id);
         }
         let base = node
-            .name()
+            .and_then(|n| n.name())
             .or(mesh.name())
             .map_or_else(|| format!("mesh{m}"), str::to_string);
         for (p, prim) in prims.iter().enumerate() {
@@ -576,7 +609,28 @@ impl Reader<'_> {
             } else {
                 base.clone()
             };
+            let before = self.rig.meshes.len();
+            let vertex_count = prim.get(&Semantic::Positions).map_or(0, |a| a.count());
+            let (world, per_vertex) = placed.for_primitive(self, prim, &at, vertex_count)?;
             self.primitive(prim, &at, name, world, &shape_ids)?;
+            if self.rig.meshes.len() == before {
+                continue;
+            }
+            let rest = match per_vertex {
+                Some(list) => {
+                    self.place_per_vertex(before, &list);
+                    RestPose::PerVertex(list)
+                }
+                None => RestPose::Matrix(world),
+            };
+            self.parts.push(SourcePart {
+                face_mesh: self.rig.meshes[before].name.clone(),
+                node: node.map(|n| n.index()),
+                mesh: m,
+                primitive: p,
+                vertex_count,
+                rest,
+            });
         }
         Ok(())
     }

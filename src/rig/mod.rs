@@ -118,6 +118,9 @@ pub struct Rig {
     pub shapes: Vec<BlendShape>,
     /// Things the reader skipped or worked around (printed as warnings).
     pub warnings: Vec<Diagnostic>,
+    /// The glTF document the rig was read from (kept so outputs patch it), if any.
+    #[serde(skip)]
+    pub source: Option<std::sync::Arc<crate::gltf::source::GltfSource>>,
 }
 
 impl Rig {
@@ -257,6 +260,7 @@ impl Rig {
                 color: None,
             })
             .collect();
+        face.gltf_source = self.source.clone();
         face
     }
 }

@@ -147,6 +147,7 @@ pub fn read_obj_rig_with(neutral: &Path, shapes_dir: &Path) -> Result<Rig> {
         }],
         shapes,
         warnings: Vec::new(),
+        source: None,
     };
     rig.check()?;
     Ok(rig)

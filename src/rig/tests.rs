@@ -73,6 +73,7 @@ pub(crate) fn small_rig() -> Rig {
             },
         ],
         warnings: vec![],
+        source: None,
     }
 }
 
@@ -441,6 +442,7 @@ fn arb_rig() -> impl Strategy<Value = Rig> {
                 }],
                 shapes,
                 warnings: vec![],
+                source: None,
             }
         })
     })

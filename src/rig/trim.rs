@@ -204,6 +204,7 @@ mod tests {
                 }],
             }],
             warnings: Vec::new(),
+            source: None,
         }
     }
 

@@ -412,6 +412,7 @@ impl SynthFace {
             fat: face.fat.clone(),
             scene: None,
             obj_source: None,
+            gltf_source: None,
         }
     }
 

@@ -1,0 +1,648 @@
+//! A face read from glTF, written back into its own document ([`crate::gltf::patch`]).
+//!
+//! The FAT becomes morph targets of the user's meshes, with the same pieces as
+//! [`super::gltf`] makes (one target per interval of a table entry, shown at its span), but
+//! grouped per glTF mesh: a target is one `(key, interval borders, interval)` and every
+//! primitive of the mesh carries every target of the mesh (zeros where the primitive does not
+//! move), so one weight per target drives all primitives alike. Offsets are computed in the
+//! file's world frame and mapped back into each primitive's own space through the rest pose
+//! it was read with ([`crate::gltf::source::RestPose`]); the file's units are kept.
+//!
+//! FAT motion of transforms (rigid parts turned by the cloner) has no node of its own in
+//! the user's document: it is baked into per-vertex targets, piecewise linear over
+//! `±2 V` in 8 intervals for rotations (`V` the key's reference value), one interval for
+//! translations and scales (linear in the FAP value).
+//!
+//! With frames, one animation `play` drives the weights of the first node showing each
+//! patched mesh (the user's own targets held at their default weights).
+
+use std::collections::BTreeMap;
+
+use glam::{Affine3A, Quat, Vec3};
+use serde_json::Map;
+
+use super::gltf::FaceMorphs;
+use super::gltf_rotations::{rotated_nodes, same_hemisphere, RotationNodes};
+use crate::error::{Diagnostic, Result};
+use crate::face::gltf_fat::{self, TargetRecord};
+use crate::face::FaceModel;
+use crate::fat::eval::Activation;
+use crate::fat::morph::default_value;
+use crate::fat::{interval_weights, Fat, TableKey, TransformField};
+use crate::gltf::patch::{GltfPatch, MeshPatch, PatchAnimation, PatchedGltf, SparseOffsets};
+use crate::gltf::source::GltfSource;
+use crate::player::AnimationFrame;
+
+/// Rotation bake: intervals over `±ROTATION_REACH × V`.
+const ROTATION_INTERVALS: usize = 8;
+const ROTATION_REACH: f64 = 2.0;
+
+/// A patched document and what was worked around.
+#[derive(Clone, Debug)]
+pub struct GltfPatchExport {
+    /// The document to write.
+    pub document: PatchedGltf,
+    /// Number of morph targets added over all meshes.
+    pub morph_targets: usize,
+    /// Things that could not be written exactly.
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// Which table motion a glTF target shows (the same on every primitive of a mesh).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetPiece {
+    /// The table key.
+    pub key: TableKey,
+    /// Interval borders of the entry.
+    pub borders: Vec<f64>,
+    /// Which interval.
+    pub interval: usize,
+    /// The value span the target shows.
+    pub span: f64,
+}
+
+impl TargetPiece {
+    fn same(&self, o: &TargetPiece) -> bool {
+        self.key == o.key
+            && self.interval == o.interval
+            && self.borders.len() == o.borders.len()
+            && self
+                .borders
+                .iter()
+                .zip(&o.borders)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+    }
+
+    /// Weight of this target for `activations`.
+    pub fn weight(&self, activations: &[Activation], scratch: &mut Vec<f64>) -> f32 {
+        let mut w = 0.0;
+        for a in activations.iter().filter(|a| a.key == self.key) {
+            if a.value == 0.0 || !a.value.is_finite() {
+                continue;
+            }
+            interval_weights(&self.borders, a.value, scratch);
+            w += scratch.get(self.interval).copied().unwrap_or(0.0) / self.span;
+        }
+        w as f32
+    }
+}
+
+/// World-frame motion of one face mesh under one piece.
+struct FaceMeshPiece {
+    piece: TargetPiece,
+    vertices: Vec<u32>,
+    world: Vec<Vec3>,
+}
+
+/// The targets of one glTF mesh under construction.
+#[derive(Default)]
+struct MeshTargets {
+    pieces: Vec<TargetPiece>,
+    /// Per primitive, per target index, vertex → local offset.
+    prims: BTreeMap<usize, BTreeMap<usize, BTreeMap<u32, Vec3>>>,
+}
+
+impl MeshTargets {
+    fn index_of(&mut self, p: &TargetPiece) -> usize {
+        match self.pieces.iter().position(|q| q.same(p)) {
+            Some(i) => i,
+            None => {
+                self.pieces.push(p.clone());
+                self.pieces.len() - 1
+            }
+        }
+    }
+}
+
+/// Why `face` no longer fits the document it was read from, if it does not: a mesh the
+/// FAT moves that the document lacks, or one whose vertex count changed (a cloner that cut
+/// parts out of a mesh). Callers then write a new document instead of losing that motion.
+pub fn mismatch(face: &FaceModel, source: &GltfSource) -> Option<String> {
+    let moved: std::collections::HashSet<&str> = face
+        .fat
+        .tables
+        .iter()
+        .flat_map(|t| t.meshes.iter().map(|m| m.mesh.as_str()))
+        .collect();
+    for m in &face.meshes {
+        match source.part(&m.name) {
+            None if moved.contains(m.name.as_str()) || m.transform.is_some() => {
+                return Some(format!("mesh `{}` is not in the document", m.name))
+            }
+            Some(p) if p.vertex_count != m.mesh.vertex_count() => {
+                return Some(format!(
+                    "mesh `{}` has {} vertices, its glTF primitive {}",
+                    m.name,
+                    m.mesh.vertex_count(),
+                    p.vertex_count
+                ))
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// The face's glTF output: its own document patched when it was read from glTF and still
+/// fits it ([`mismatch`]), else `None` with the reason as a warning in `warnings`.
+pub fn patch_if_fits(
+    face: &FaceModel,
+    frames: Option<&[AnimationFrame]>,
+    nodes: &RotationNodes,
+    warnings: &mut Vec<Diagnostic>,
+) -> Result<Option<GltfPatchExport>> {
+    let Some(source) = &face.gltf_source else {
+        return Ok(None);
+    };
+    if let Some(why) = mismatch(face, source) {
+        warnings.push(Diagnostic::warning(format!(
+            "{} cannot be patched ({why}): written as a new document",
+            source.path.display()
+        )));
+        return Ok(None);
+    }
+    patch_face(face, source, frames, nodes).map(Some)
+}
+
+/// `face` (read from `source`) patched into that document; with `frames`, its animation
+/// (head and eye rotations on `nodes`, or on the nodes found by their usual names).
+pub fn patch_face(
+    face: &FaceModel,
+    source: &GltfSource,
+    frames: Option<&[AnimationFrame]>,
+    nodes: &RotationNodes,
+) -> Result<GltfPatchExport> {
+    face.check_structure()?;
+    let mut warnings = Vec::new();
+    let world_pieces = face_pieces(face)?;
+    let mut meshes: BTreeMap<usize, MeshTargets> = BTreeMap::new();
+    // A glTF mesh shown by several nodes is patched once: from its first instance.
+    let mut taken: BTreeMap<(usize, usize), String> = BTreeMap::new();
+    for (mi, fm) in face.meshes.iter().enumerate() {
+        let Some(part) = source.part(&fm.name) else {
+            if !world_pieces[mi].is_empty() {
+                warnings.push(Diagnostic::warning(format!(
+                    "mesh `{}` is not part of {}: its motion is not written",
+                    fm.name,
+                    source.path.display()
+                )));
+            }
+            continue;
+        };
+        if part.vertex_count != fm.mesh.vertex_count() {
+            warnings.push(Diagnostic::warning(format!(
+                "mesh `{}` has {} vertices but its glTF primitive has {}: its motion is not written",
+                fm.name,
+                fm.mesh.vertex_count(),
+                part.vertex_count
+            )));
+            continue;
+        }
+        if let Some(first) = taken.get(&(part.mesh, part.primitive)) {
+            if first != &fm.name && !world_pieces[mi].is_empty() {
+                warnings.push(Diagnostic::warning(format!(
+                    "mesh `{}` shows the same glTF mesh as `{first}`: one target list is \
+                     written, from `{first}`",
+                    fm.name
+                )));
+            }
+            continue;
+        }
+        taken.insert((part.mesh, part.primitive), fm.name.clone());
+        let targets = meshes.entry(part.mesh).or_default();
+        for wp in &world_pieces[mi] {
+            let t = targets.index_of(&wp.piece);
+            let slot = targets
+                .prims
+                .entry(part.primitive)
+                .or_default()
+                .entry(t)
+                .or_default();
+            for (&v, &d) in wp.vertices.iter().zip(&wp.world) {
+                let local = part.rest.to_local(v as usize, d);
+                *slot.entry(v).or_insert(Vec3::ZERO) += local;
+            }
+        }
+    }
+    let mut patch = GltfPatch::default();
+    let mut morph_targets = 0;
+    let mut layouts: BTreeMap<usize, TargetLayout> = BTreeMap::new();
+    for (&m, t) in &meshes {
+        if t.pieces.is_empty() {
+            continue;
+        }
+        morph_targets += t.pieces.len();
+        let existing = existing_names(source, m);
+        let recorded = recorded_pieces(source, m, &existing);
+        let mut names = piece_names(&t.pieces, &existing);
+        let mut replaces = vec![None; t.pieces.len()];
+        let mut final_index = Vec::with_capacity(t.pieces.len());
+        let mut appended = 0;
+        for (pi, p) in t.pieces.iter().enumerate() {
+            match recorded.iter().find(|(_, q)| q.same(p)) {
+                Some(&(i, _)) => {
+                    replaces[pi] = Some(i);
+                    names[pi] = existing[i].clone();
+                    final_index.push(i);
+                }
+                None => {
+                    final_index.push(existing.len() + appended);
+                    appended += 1;
+                }
+            }
+        }
+        let zeroed: Vec<usize> = recorded
+            .iter()
+            .map(|(i, _)| *i)
+            .filter(|i| !replaces.contains(&Some(*i)))
+            .collect();
+        layouts.insert(
+            m,
+            TargetLayout {
+                final_index,
+                total: existing.len() + appended,
+            },
+        );
+        let mut primitives = BTreeMap::new();
+        for (&p, per_target) in &t.prims {
+            let list = (0..t.pieces.len())
+                .map(|ti| {
+                    let mut s = SparseOffsets::default();
+                    for (&v, &o) in per_target.get(&ti).into_iter().flatten() {
+                        if o != Vec3::ZERO && o.is_finite() {
+                            s.vertices.push(v);
+                            s.offsets.push(o);
+                        }
+                    }
+                    s
+                })
+                .collect();
+            primitives.insert(p, list);
+        }
+        let records: Vec<TargetRecord> = t
+            .pieces
+            .iter()
+            .zip(&names)
+            .map(|(p, name)| TargetRecord {
+                target: name.clone(),
+                key: p.key,
+                borders: p.borders.clone(),
+                interval: p.interval,
+                span: p.span,
+            })
+            .collect();
+        let mut extras = Map::new();
+        extras.insert(gltf_fat::KEY.into(), gltf_fat::targets_record(&records));
+        patch.meshes.insert(
+            m,
+            MeshPatch {
+                names,
+                replaces,
+                zeroed,
+                primitives,
+                extras,
+            },
+        );
+    }
+    patch.scene_extras = gltf_fat::scene_record(face, 1.0);
+    if let Some(frames) = frames.filter(|f| !f.is_empty()) {
+        patch.animation = animation(source, &meshes, &layouts, frames);
+        let turned = rotated_nodes(source, &face.fat, nodes);
+        if !turned.is_empty() {
+            let anim = patch
+                .animation
+                .get_or_insert_with(|| empty_animation(frames));
+            for n in &turned {
+                let mut values: Vec<Quat> = keyed_frames(frames)
+                    .iter()
+                    .map(|f| n.rotation(&f.activations))
+                    .collect();
+                same_hemisphere(&mut values);
+                anim.rotations.push((n.node, values));
+            }
+        }
+    }
+    let document = patch.apply(source)?;
+    warnings.extend(document.warnings.iter().cloned());
+    Ok(GltfPatchExport {
+        document,
+        morph_targets,
+        warnings,
+    })
+}
+
+/// Where a mesh's pieces land among its targets after the patch.
+struct TargetLayout {
+    /// Per piece, its target index.
+    final_index: Vec<usize>,
+    /// Targets of the mesh after the patch.
+    total: usize,
+}
+
+/// fbakit's targets recorded on mesh `m` by an earlier write: `(target index, piece)`.
+fn recorded_pieces(source: &GltfSource, m: usize, names: &[String]) -> Vec<(usize, TargetPiece)> {
+    let mut out = Vec::new();
+    let list = &source.json["meshes"][m]["extras"][gltf_fat::KEY]["targets"];
+    for r in list.as_array().into_iter().flatten() {
+        let (Some(target), Some(key), Some(borders), Some(interval), Some(span)) = (
+            r["target"].as_str(),
+            r["key"].as_str().and_then(TableKey::from_name),
+            r["borders"]
+                .as_array()
+                .and_then(|a| a.iter().map(|v| v.as_f64()).collect::<Option<Vec<f64>>>()),
+            r["interval"].as_u64(),
+            r["span"].as_f64(),
+        ) else {
+            continue;
+        };
+        if let Some(i) = names.iter().position(|n| n == target) {
+            out.push((
+                i,
+                TargetPiece {
+                    key,
+                    borders,
+                    interval: interval as usize,
+                    span,
+                },
+            ));
+        }
+    }
+    out
+}
+
+/// Names of mesh `m`'s own targets.
+fn existing_names(source: &GltfSource, m: usize) -> Vec<String> {
+    let mesh = &source.json["meshes"][m];
+    mesh["extras"]["targetNames"]
+        .as_array()
+        .or_else(|| mesh["primitives"][0]["extras"]["targetNames"].as_array())
+        .map(|a| {
+            a.iter()
+                .filter_map(|v| v.as_str().map(str::to_string))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Target names: the key's name, `#j` appended when the key has several targets, and
+/// `_fbakit` when the mesh already has a target of that name.
+fn piece_names(pieces: &[TargetPiece], taken: &[String]) -> Vec<String> {
+    let mut per_key: BTreeMap<TableKey, usize> = BTreeMap::new();
+    for p in pieces {
+        *per_key.entry(p.key).or_default() += 1;
+    }
+    let mut seen: BTreeMap<TableKey, usize> = BTreeMap::new();
+    pieces
+        .iter()
+        .map(|p| {
+            let j = seen.entry(p.key).or_default();
+            let mut name = if per_key[&p.key] == 1 {
+                p.key.name()
+            } else {
+                format!("{}#{j}", p.key.name())
+            };
+            *j += 1;
+            while taken.contains(&name) {
+                name.push_str("_fbakit");
+            }
+            name
+        })
+        .collect()
+}
+
+/// Per face mesh, the world-frame motion of every piece: the FAT's vertex tables, then its
+/// transform motion baked.
+fn face_pieces(face: &FaceModel) -> Result<Vec<Vec<FaceMeshPiece>>> {
+    let morphs = FaceMorphs::new(face)?;
+    let frames = face.frames();
+    let mut out: Vec<Vec<FaceMeshPiece>> = Vec::with_capacity(face.meshes.len());
+    for (mi, pieces) in morphs.meshes.iter().enumerate() {
+        let linear = frames.meshes.get(mi).copied().unwrap_or(Affine3A::IDENTITY);
+        out.push(
+            pieces
+                .iter()
+                .map(|p| FaceMeshPiece {
+                    piece: TargetPiece {
+                        key: p.key,
+                        borders: p.borders.clone(),
+                        interval: p.interval,
+                        span: p.span,
+                    },
+                    vertices: p.vertices.clone(),
+                    world: p
+                        .offsets
+                        .iter()
+                        .map(|&o| linear.transform_vector3(o))
+                        .collect(),
+                })
+                .collect(),
+        );
+    }
+    for table in face.fat.tables.iter().filter(|t| !t.transforms.is_empty()) {
+        bake_transforms(face, table, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// The transform motion of `table` as per-vertex pieces of the meshes it moves.
+fn bake_transforms(
+    face: &FaceModel,
+    table: &crate::fat::FaceDefTable,
+    out: &mut [Vec<FaceMeshPiece>],
+) -> Result<()> {
+    let mut only = face.clone();
+    only.fat = Fat::default();
+    let mut t = table.clone();
+    t.meshes.clear();
+    let rotates = t
+        .transforms
+        .iter()
+        .any(|x| x.field == TransformField::Rotation);
+    only.fat.tables.push(t);
+    let v = default_value(table.key);
+    let borders: Vec<f64> = if rotates {
+        let n = ROTATION_INTERVALS as f64;
+        (0..=ROTATION_INTERVALS)
+            .map(|i| (i as f64 / n * 2.0 - 1.0) * ROTATION_REACH * v)
+            .collect()
+    } else {
+        vec![0.0, v]
+    };
+    let at: Vec<Vec<Vec<Vec3>>> = borders
+        .iter()
+        .map(|&b| {
+            only.pose(&[Activation {
+                key: table.key,
+                value: b,
+            }])
+        })
+        .collect::<Result<_>>()?;
+    for j in 0..borders.len() - 1 {
+        let (lo, hi) = (borders[j], borders[j + 1]);
+        let span = if hi <= 0.0 { lo - hi } else { hi - lo };
+        for (mi, list) in out.iter_mut().enumerate() {
+            let mut vertices = Vec::new();
+            let mut world = Vec::new();
+            let (lo_at, hi_at) = (&at[j][mi], &at[j + 1][mi]);
+            for (v, (a, b)) in lo_at.iter().zip(hi_at).enumerate() {
+                // Offsets at the span: the change across the interval, signed towards zero's
+                // far side (the rule of `FaceMorphs`).
+                let d = if hi <= 0.0 { *a - *b } else { *b - *a };
+                if d.length_squared() > 0.0 && d.is_finite() {
+                    vertices.push(v as u32);
+                    world.push(d);
+                }
+            }
+            if !vertices.is_empty() {
+                list.push(FaceMeshPiece {
+                    piece: TargetPiece {
+                        key: table.key,
+                        borders: borders.clone(),
+                        interval: j,
+                        span,
+                    },
+                    vertices,
+                    world,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The played frames with a closing key one frame after the last that holds it (the rule of
+/// `export::gltf`: the clip lasts frames / fps).
+fn keyed_frames(frames: &[AnimationFrame]) -> Vec<&AnimationFrame> {
+    let closing = frames.len() >= 2;
+    frames
+        .iter()
+        .chain(closing.then(|| &frames[frames.len() - 1]))
+        .collect()
+}
+
+/// The `play` animation with its key times and no channels yet.
+fn empty_animation(frames: &[AnimationFrame]) -> PatchAnimation {
+    let t0 = frames[0].time;
+    let mut times: Vec<f32> = frames.iter().map(|f| (f.time - t0) as f32).collect();
+    if frames.len() >= 2 {
+        let last = frames[frames.len() - 1].time - t0;
+        times.push((last + last / (frames.len() - 1) as f64) as f32);
+    }
+    PatchAnimation {
+        name: "play".into(),
+        times,
+        ..PatchAnimation::default()
+    }
+}
+
+/// One weights channel per patched mesh, on the first node that shows it.
+fn animation(
+    source: &GltfSource,
+    meshes: &BTreeMap<usize, MeshTargets>,
+    layouts: &BTreeMap<usize, TargetLayout>,
+    frames: &[AnimationFrame],
+) -> Option<PatchAnimation> {
+    let keyed = keyed_frames(frames);
+    let mut anim = empty_animation(frames);
+    let mut scratch = Vec::new();
+    for (&m, t) in meshes {
+        if t.pieces.is_empty() {
+            continue;
+        }
+        let Some(node) = source
+            .parts
+            .iter()
+            .find(|p| p.mesh == m)
+            .and_then(|p| p.node)
+        else {
+            continue;
+        };
+        let mesh = &source.json["meshes"][m];
+        let old: Vec<f32> = source.json["nodes"][node]["weights"]
+            .as_array()
+            .or_else(|| mesh["weights"].as_array())
+            .map(|w| w.iter().map(|x| x.as_f64().unwrap_or(0.0) as f32).collect())
+            .unwrap_or_else(|| {
+                let n = mesh["primitives"][0]["targets"]
+                    .as_array()
+                    .map_or(0, Vec::len);
+                vec![0.0; n]
+            });
+        let Some(layout) = layouts.get(&m) else {
+            continue;
+        };
+        let mut key = old.clone();
+        key.resize(layout.total, 0.0);
+        // fbakit's earlier targets are driven below or stay at zero.
+        for i in recorded_pieces(source, m, &existing_names(source, m))
+            .iter()
+            .map(|r| r.0)
+        {
+            if let Some(w) = key.get_mut(i) {
+                *w = 0.0;
+            }
+        }
+        let mut values = Vec::with_capacity(keyed.len() * layout.total);
+        for f in &keyed {
+            for (p, &i) in t.pieces.iter().zip(&layout.final_index) {
+                key[i] = p.weight(&f.activations, &mut scratch);
+            }
+            values.extend_from_slice(&key);
+        }
+        anim.weights.push((node, values));
+    }
+    (!anim.weights.is_empty()).then_some(anim)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Baked transform motion reproduces the posed face at the bake's borders, where the
+    /// piecewise-linear targets are exact.
+    #[test]
+    fn baked_transforms_reproduce_the_pose_at_their_borders() {
+        let face = crate::synth::alma().to_face_model();
+        let table = face
+            .fat
+            .tables
+            .iter()
+            .find(|t| {
+                t.transforms
+                    .iter()
+                    .any(|x| x.field == TransformField::Rotation)
+            })
+            .expect("alma turns something by a transform");
+        let mut only = face.clone();
+        only.fat.tables = vec![crate::fat::FaceDefTable {
+            meshes: Vec::new(),
+            ..table.clone()
+        }];
+        let mut pieces: Vec<Vec<FaceMeshPiece>> =
+            (0..face.meshes.len()).map(|_| Vec::new()).collect();
+        bake_transforms(&face, table, &mut pieces).unwrap();
+        assert!(pieces.iter().any(|p| !p.is_empty()));
+        let v = default_value(table.key);
+        let neutral = only.pose(&[]).unwrap();
+        let mut scratch = Vec::new();
+        for value in [-2.0 * v, -0.5 * v, 0.5 * v, v, 2.0 * v] {
+            let a = [Activation {
+                key: table.key,
+                value,
+            }];
+            let want = only.pose(&a).unwrap();
+            for (mi, list) in pieces.iter().enumerate() {
+                let mut got = neutral[mi].clone();
+                for p in list {
+                    let w = p.piece.weight(&a, &mut scratch);
+                    for (&vi, d) in p.vertices.iter().zip(&p.world) {
+                        got[vi as usize] += *d * w;
+                    }
+                }
+                for (g, w) in got.iter().zip(&want[mi]) {
+                    assert!(g.distance(*w) < 1e-4, "{value}: {g} vs {w}");
+                }
+            }
+        }
+    }
+}

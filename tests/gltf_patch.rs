@@ -1,0 +1,569 @@
+//! A glTF face written back is the user's document, whole, plus fbakit's morph targets,
+//! records and animation (issue 19 §2).
+
+mod support;
+
+use std::path::Path;
+
+use fbakit::face::FaceModel;
+use fbakit::fat::{FaceDefMesh, FaceDefTable, TableKey};
+use fbakit::spec::FapId;
+use glam::Vec3;
+use serde_json::Value;
+use support::avatar;
+use support::cli::{command, text};
+
+fn key(name: &str) -> TableKey {
+    TableKey::LowLevel(FapId::from_name(name).unwrap())
+}
+
+/// The JSON of a `.glb` or `.gltf` file.
+fn json_of(path: &Path) -> Value {
+    let bytes = std::fs::read(path).unwrap();
+    if bytes.starts_with(b"glTF") {
+        let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+        serde_json::from_slice(chunks.json).unwrap()
+    } else {
+        serde_json::from_slice(&bytes).unwrap()
+    }
+}
+
+/// A FAT on the avatar's face: the jaw (three intervals) moves the lower skin and the whole
+/// mouth, the upper eyelid (one interval) moves the lashes.
+fn with_fat(mut face: FaceModel) -> FaceModel {
+    let skin = face.mesh_index("Body.0").expect("skin primitive");
+    let centre_y = avatar::HEAD_CENTRE.y * 0.01;
+    let lower: Vec<u32> = face.meshes[skin]
+        .mesh
+        .positions
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.y < centre_y - 0.03)
+        .map(|(i, _)| i as u32)
+        .collect();
+    assert!(!lower.is_empty());
+    let jaw_entry = |mesh: &str, vertices: Vec<u32>| {
+        let n = 3;
+        let displacements = vertices
+            .iter()
+            .flat_map(|&v| {
+                (0..n).map(move |j| Vec3::new(0.0, -1e-5 * (1.0 + j as f32), 2e-6 * (v % 3) as f32))
+            })
+            .collect();
+        FaceDefMesh {
+            mesh: mesh.into(),
+            interval_borders: vec![-512.0, 0.0, 512.0, 1024.0],
+            coord_index: vertices,
+            displacements,
+        }
+    };
+    let mouth: Vec<u32> = (0..face.meshes[face.mesh_index("Body.1").unwrap()]
+        .mesh
+        .vertex_count() as u32)
+        .collect();
+    let lashes: Vec<u32> = (0..face.meshes[face.mesh_index("Body.3").unwrap()]
+        .mesh
+        .vertex_count() as u32)
+        .collect();
+    face.fat.tables = vec![
+        FaceDefTable {
+            key: key("open_jaw"),
+            meshes: vec![jaw_entry("Body.0", lower), jaw_entry("Body.1", mouth)],
+            transforms: vec![],
+        },
+        FaceDefTable {
+            key: key("close_t_l_eyelid"),
+            meshes: vec![FaceDefMesh {
+                mesh: "Body.3".into(),
+                interval_borders: vec![0.0, 1000.0],
+                displacements: vec![Vec3::new(0.0, -4e-6, 0.0); lashes.len()],
+                coord_index: lashes,
+            }],
+            transforms: vec![],
+        },
+    ];
+    face
+}
+
+/// Everything `input` has is in `output` unchanged, except what a patch may change: merged
+/// buffers (offsets of views), appended accessors/views/targets/animations, mesh
+/// `extras`/`weights` grown, the user's weight channels re-pointed, scene extras added.
+fn assert_kept(input: &Value, output: &Value) {
+    let obj = input.as_object().unwrap();
+    for (k, v) in obj {
+        match k.as_str() {
+            "buffers" => assert_eq!(output["buffers"].as_array().unwrap().len(), 1),
+            "bufferViews" | "accessors" => {
+                let (a, b) = (v.as_array().unwrap(), output[k].as_array().unwrap());
+                assert!(b.len() >= a.len(), "{k} shrank");
+                for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                    let (mut x, mut y) = (x.clone(), y.clone());
+                    if k == "bufferViews" {
+                        for o in [&mut x, &mut y] {
+                            let o = o.as_object_mut().unwrap();
+                            o.remove("buffer");
+                            o.remove("byteOffset");
+                        }
+                    }
+                    assert_eq!(x, y, "{k}[{i}] changed");
+                }
+            }
+            "meshes" => {
+                for (m, (x, y)) in v
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .zip(output[k].as_array().unwrap())
+                    .enumerate()
+                {
+                    for (f, xv) in x.as_object().unwrap() {
+                        match f.as_str() {
+                            "primitives" => {
+                                for (p, (xp, yp)) in xv
+                                    .as_array()
+                                    .unwrap()
+                                    .iter()
+                                    .zip(y[f].as_array().unwrap())
+                                    .enumerate()
+                                {
+                                    for (pf, pv) in xp.as_object().unwrap() {
+                                        if pf == "targets" {
+                                            let yt = yp[pf].as_array().unwrap();
+                                            assert_eq!(
+                                                &yt[..pv.as_array().unwrap().len()],
+                                                &pv.as_array().unwrap()[..],
+                                                "meshes[{m}].primitives[{p}] targets"
+                                            );
+                                        } else {
+                                            assert_eq!(
+                                                pv, &yp[pf],
+                                                "meshes[{m}].primitives[{p}].{pf}"
+                                            );
+                                        }
+                                    }
+                                }
+                            }
+                            "extras" => {
+                                for (ek, ev) in xv.as_object().unwrap() {
+                                    if ek == "targetNames" {
+                                        let ya = y[f][ek].as_array().unwrap();
+                                        assert_eq!(
+                                            &ya[..ev.as_array().unwrap().len()],
+                                            &ev.as_array().unwrap()[..]
+                                        );
+                                    } else {
+                                        assert_eq!(ev, &y[f][ek], "meshes[{m}].extras.{ek}");
+                                    }
+                                }
+                            }
+                            "weights" => {
+                                let ya = y[f].as_array().unwrap();
+                                assert_eq!(
+                                    &ya[..xv.as_array().unwrap().len()],
+                                    &xv.as_array().unwrap()[..]
+                                );
+                            }
+                            _ => assert_eq!(xv, &y[f], "meshes[{m}].{f}"),
+                        }
+                    }
+                }
+            }
+            "animations" => {
+                let b = output[k].as_array().unwrap();
+                for (i, x) in v.as_array().unwrap().iter().enumerate() {
+                    assert_eq!(x["channels"], b[i]["channels"], "animations[{i}].channels");
+                    assert_eq!(x["name"], b[i]["name"]);
+                    for (s, (xs, ys)) in x["samplers"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .zip(b[i]["samplers"].as_array().unwrap())
+                        .enumerate()
+                    {
+                        assert_eq!(xs["input"], ys["input"], "animations[{i}].samplers[{s}]");
+                        assert_eq!(xs["interpolation"], ys["interpolation"]);
+                    }
+                }
+            }
+            "scenes" => {
+                for (s, (x, y)) in v
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .zip(output[k].as_array().unwrap())
+                    .enumerate()
+                {
+                    for (f, xv) in x.as_object().unwrap() {
+                        if f == "extras" {
+                            for (ek, ev) in xv.as_object().unwrap() {
+                                assert_eq!(ev, &y[f][ek], "scenes[{s}].extras.{ek}");
+                            }
+                        } else {
+                            assert_eq!(xv, &y[f], "scenes[{s}].{f}");
+                        }
+                    }
+                }
+            }
+            _ => assert_eq!(v, &output[k], "`{k}` changed"),
+        }
+    }
+}
+
+fn fat_close(a: &fbakit::fat::Fat, b: &fbakit::fat::Fat) {
+    assert_eq!(a.tables.len(), b.tables.len());
+    for (x, y) in a.tables.iter().zip(&b.tables) {
+        assert_eq!(x.key, y.key);
+        assert_eq!(x.meshes.len(), y.meshes.len(), "{:?}", x.key);
+        for (p, q) in x.meshes.iter().zip(&y.meshes) {
+            assert_eq!(p.mesh, q.mesh);
+            assert_eq!(p.interval_borders, q.interval_borders);
+            assert_eq!(p.coord_index, q.coord_index, "{} {:?}", p.mesh, x.key);
+            for (d, e) in p.displacements.iter().zip(&q.displacements) {
+                assert!(
+                    (*d - *e).length() <= 1e-4 * d.length().max(1e-6),
+                    "{} {d} {e}",
+                    p.mesh
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn avatar_reads_in_its_rest_pose() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("avatar.glb");
+    let a = avatar::build();
+    std::fs::write(&path, a.to_glb()).unwrap();
+    let face = fbakit::face::read(&path).unwrap();
+    let names: Vec<&str> = face.meshes.iter().map(|m| m.name.as_str()).collect();
+    // Depth first: the hat hangs under the head joint, before the armature's Body node.
+    assert_eq!(names, ["Hat", "Body.0", "Body.1", "Body.2", "Body.3"]);
+    // The 0.01-scaled armature places the skin in metres.
+    let skin = &face.meshes[1].mesh.positions;
+    assert!((skin[0] - a.prims[0].positions[0] * 0.01).length() < 1e-5);
+    // The mouth follows the jaw's rest, 70 % of half a centimetre below its bind.
+    let mouth = &face.meshes[2].mesh.positions;
+    let want = a.prims[1].positions[0] * 0.01 - Vec3::new(0.0, 0.7 * 0.005, 0.0);
+    assert!((mouth[0] - want).length() < 1e-5, "{} {}", mouth[0], want);
+    // The hat hangs under the head joint: (0, 160, 0) cm + its own 8 cm.
+    let hat = &face.meshes[0].mesh.positions;
+    assert!(
+        (hat[4] - Vec3::new(0.0, 1.8, 0.0)).length() < 1e-5,
+        "{}",
+        hat[4]
+    );
+    let source = face.gltf_source.as_ref().expect("document kept");
+    assert_eq!(source.parts.len(), 5);
+}
+
+#[test]
+fn avatar_comes_back_whole_with_its_fat() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("avatar.glb");
+    let a = avatar::build();
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let face = with_fat(fbakit::face::read(&input).unwrap());
+    let out = dir.path().join("out.glb");
+    let warnings = fbakit::export::write_face(&out, &face).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let (x, y) = (json_of(&input), json_of(&out));
+    assert_kept(&x, &y);
+    // Every primitive of Body carries the same list: Blink + the new targets.
+    let names = y["meshes"][0]["extras"]["targetNames"].as_array().unwrap();
+    assert_eq!(names[0], "Blink");
+    assert!(names.len() > 1);
+    for p in y["meshes"][0]["primitives"].as_array().unwrap() {
+        assert_eq!(p["targets"].as_array().unwrap().len(), names.len());
+    }
+    assert_eq!(
+        y["meshes"][0]["weights"].as_array().unwrap().len(),
+        names.len()
+    );
+    // The user's Blink channel got one zero per new target.
+    let widened = &y["animations"][0]["samplers"][1]["output"];
+    let count = y["accessors"][widened.as_u64().unwrap() as usize]["count"]
+        .as_u64()
+        .unwrap();
+    assert_eq!(count as usize, 3 * names.len());
+    // Read back: same meshes in the same order, same positions, same FAT.
+    let back = fbakit::face::read(&out).unwrap();
+    assert_eq!(back.meshes.len(), face.meshes.len());
+    for (p, q) in face.meshes.iter().zip(&back.meshes) {
+        assert_eq!(p.name, q.name);
+        assert_eq!(p.mesh.positions, q.mesh.positions);
+        assert_eq!(p.mesh.polygons, q.mesh.polygons);
+    }
+    fat_close(&face.fat, &back.fat);
+    // Written again, the second patch appends nothing the first did not have.
+    let again = dir.path().join("again.glb");
+    fbakit::export::write_face(&again, &back).unwrap();
+    let third = fbakit::face::read(&again).unwrap();
+    fat_close(&face.fat, &third.fat);
+}
+
+#[test]
+fn external_gltf_gets_its_own_bin_and_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("in");
+    std::fs::create_dir_all(&src).unwrap();
+    let input = avatar::build().write_gltf(&src, "avatar");
+    let face = with_fat(fbakit::face::read(&input).unwrap());
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let out = out_dir.join("patched.gltf");
+    fbakit::export::write_face(&out, &face).unwrap();
+    let y = json_of(&out);
+    assert_eq!(y["buffers"][0]["uri"], "patched.bin");
+    assert!(out_dir.join("patched.bin").is_file());
+    assert!(out_dir.join("textures/skin.png").is_file());
+    assert_kept(&json_of(&input), &y);
+    let back = fbakit::face::read(&out).unwrap();
+    fat_close(&face.fat, &back.fat);
+}
+
+#[test]
+fn patched_avatar_plays_into_its_own_document() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("avatar.glb");
+    std::fs::write(&input, avatar::build().to_glb()).unwrap();
+    let face = with_fat(fbakit::face::read(&input).unwrap());
+    let patched = dir.path().join("patched.glb");
+    fbakit::export::write_face(&patched, &face).unwrap();
+    let played = dir.path().join("played.glb");
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/lowlevel.fap");
+    let out = command()
+        .args([
+            "play".as_ref(),
+            patched.as_os_str(),
+            sample.as_os_str(),
+            "-o".as_ref(),
+            played.as_os_str(),
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (x, y) = (json_of(&patched), json_of(&played));
+    let anims = y["animations"].as_array().unwrap();
+    assert_eq!(anims.len(), 2, "the user's animation and `play`");
+    assert_eq!(anims[1]["name"], "play");
+    let ch = &anims[1]["channels"][0];
+    assert_eq!(ch["target"]["node"], 5, "weights on the Body node");
+    // The stream's head pitch and yaw turn the node named Head (the FAT has no table for them).
+    let head: Vec<&Value> = anims[1]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["target"]["path"] == "rotation")
+        .collect();
+    assert_eq!(head.len(), 1);
+    assert_eq!(head[0]["target"]["node"], 3);
+    // Named nodes: the hat turns instead.
+    let hat = dir.path().join("hat.glb");
+    let out = command()
+        .args([
+            "play".as_ref(),
+            patched.as_os_str(),
+            sample.as_os_str(),
+            "-o".as_ref(),
+            hat.as_os_str(),
+            "--head-node".as_ref(),
+            "Hat".as_ref(),
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let y2 = json_of(&hat);
+    let rot: Vec<&Value> = y2["animations"][1]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["target"]["path"] == "rotation")
+        .collect();
+    assert_eq!(rot[0]["target"]["node"], 6);
+    // Played from a patched file: the targets are not added a second time.
+    assert_eq!(
+        x["meshes"][0]["extras"]["targetNames"],
+        y["meshes"][0]["extras"]["targetNames"]
+    );
+}
+
+#[test]
+fn validator_finds_no_new_issue() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("avatar.glb");
+    std::fs::write(&input, avatar::build().to_glb()).unwrap();
+    let face = with_fat(fbakit::face::read(&input).unwrap());
+    let out = dir.path().join("out.glb");
+    fbakit::export::write_face(&out, &face).unwrap();
+    let ext = avatar::build().write_gltf(dir.path(), "ext");
+    let face = with_fat(fbakit::face::read(&ext).unwrap());
+    let out2 = dir.path().join("out2.gltf");
+    fbakit::export::write_face(&out2, &face).unwrap();
+    let Some(reports) =
+        support::validator::validate(&[input.clone(), out.clone(), ext.clone(), out2.clone()])
+    else {
+        return;
+    };
+    // Errors and warnings (severities 0 and 1) by code.
+    let issues = |r: &Value| {
+        let mut codes: Vec<String> = r["messages"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|m| {
+                let mut words = m.as_str()?.split_whitespace();
+                let severity: u8 = words.next()?.parse().ok()?;
+                (severity <= 1).then(|| words.next().unwrap_or("").to_string())
+            })
+            .collect();
+        codes.sort();
+        codes
+    };
+    if std::env::var_os("FBAKIT_SHOW_VALIDATOR").is_some() {
+        for r in &reports {
+            eprintln!("{r}");
+        }
+    }
+    assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
+    assert_eq!(issues(&reports[2]), issues(&reports[3]), "{}", reports[3]);
+}
+
+#[test]
+fn generated_glb_reads_back_with_its_fat() {
+    let dir = tempfile::tempdir().unwrap();
+    let face = fbakit::synth::alma().to_face_model();
+    let glb = dir.path().join("alma.glb");
+    fbakit::export::write_face(&glb, &face).unwrap();
+    let back = fbakit::face::read(&glb).unwrap();
+    let (k, _) = fbakit::face::units::metres_factor(&face, None);
+    let frames = face.frames();
+    // Feature points come back (in metres) without --fp.
+    assert_eq!(back.feature_points.len(), face.feature_points.len());
+    let mut compared = 0;
+    for table in &face.fat.tables {
+        let Some(got) = back.fat.tables.iter().find(|t| t.key == table.key) else {
+            assert!(table.meshes.is_empty(), "{:?} lost", table.key);
+            continue;
+        };
+        for m in &table.meshes {
+            let mi = face.mesh_index(&m.mesh).unwrap();
+            let g = got
+                .meshes
+                .iter()
+                .find(|g| g.mesh == m.mesh)
+                .expect("entry kept");
+            assert_eq!(g.interval_borders, m.interval_borders);
+            let n = m.interval_count();
+            for (slot, v) in m.coord_index.iter().enumerate() {
+                let Ok(gs) = g.coord_index.binary_search(v) else {
+                    // Not moved in any interval: nothing to write.
+                    assert!((0..n).all(|j| m.displacements[slot * n + j] == Vec3::ZERO));
+                    continue;
+                };
+                for j in 0..n {
+                    let want =
+                        frames.meshes[mi].transform_vector3(m.displacements[slot * n + j]) * k;
+                    let have = g.displacements[gs * n + j];
+                    assert!(
+                        (want - have).length() <= 1e-4 * want.length() + 1e-9,
+                        "{:?} {} {want} {have}",
+                        table.key,
+                        m.mesh
+                    );
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert!(compared > 1000, "{compared}");
+}
+
+#[test]
+fn exported_ict_keeps_its_vertices_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ict.glb");
+    let run = command()
+        .args([
+            "face".as_ref(),
+            "export".as_ref(),
+            "ict".as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/faces/ict-head/ict-head.glb");
+    let (x, y) = (json_of(&input), json_of(&out));
+    assert_kept(&x, &y);
+    let (a, b) = (
+        fbakit::face::read(&input).unwrap(),
+        fbakit::face::read(&out).unwrap(),
+    );
+    assert_eq!(a.meshes.len(), b.meshes.len());
+    for (p, q) in a.meshes.iter().zip(&b.meshes) {
+        assert_eq!(p.mesh.positions, q.mesh.positions);
+        assert_eq!(p.mesh.polygons, q.mesh.polygons);
+    }
+    // The FAT built from ICT's shapes (with its feature points) came along in the extras.
+    let ict = fbakit::face::read("ict").unwrap();
+    assert_eq!(
+        b.fat.tables.len(),
+        ict.fat
+            .tables
+            .iter()
+            .filter(|t| !t.meshes.is_empty())
+            .count()
+    );
+    assert_eq!(b.feature_points.len(), ict.feature_points.len());
+}
+
+#[test]
+fn target_names_that_do_not_match_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = avatar::build();
+    a.json["meshes"][0]["extras"]["targetNames"] = serde_json::json!(["Blink", "Extra"]);
+    let input = dir.path().join("bad.glb");
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let out = dir.path().join("out.glb");
+    let run = command()
+        .args([
+            "face".as_ref(),
+            "export".as_ref(),
+            input.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
+    let err = text(&run.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("bad.glb") && err.contains("meshes[0].extras.targetNames"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = avatar::build();
+    let o = a.json.as_object_mut().unwrap();
+    o.remove("scene");
+    o.remove("scenes");
+    let input = dir.path().join("noscene.glb");
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let (face, report) = fbakit::face::read_with(&input, &Default::default()).unwrap();
+    assert_eq!(face.meshes.len(), 5);
+    assert!(
+        report
+            .diagnostics
+            .iter()
+            .any(|d| d.message.contains("no scene")),
+        "{:?}",
+        report.diagnostics
+    );
+}

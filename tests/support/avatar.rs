@@ -1,0 +1,456 @@
+//! A test avatar as artists hand them over: one skinned mesh `Body` with four primitives
+//! (skin, mouth, eyes, lashes) in centimetres under a 0.01-scaled `Armature` node (the FBX
+//! habit), a joint hierarchy (`Root` → `Neck` → `Head` → `Jaw`) with an animation, a
+//! base-colour texture (an embedded PNG), a camera, a `Hat` mesh on the head, one morph
+//! target of the user's own (`Blink`, animated), a material extension and extras on the
+//! asset, nodes and materials.
+//!
+//! The jaw's inverse bind matrix was taken half a centimetre higher than the jaw rests, so the
+//! mouth's vertices (weighted to jaw and head) are placed per vertex at rest; the other joints
+//! agree and place their vertices with the armature's one matrix.
+
+use glam::{Mat4, Vec2, Vec3};
+use serde_json::{json, Value};
+
+/// Centre of the head sphere, in the armature's centimetres.
+pub const HEAD_CENTRE: Vec3 = Vec3::new(0.0, 160.0, 0.0);
+/// Head sphere radius (cm).
+pub const HEAD_RADIUS: f32 = 10.0;
+/// Offset between the jaw's rest and bind positions (cm).
+pub const JAW_BIND_OFFSET: f32 = 0.5;
+
+/// One primitive's data.
+pub struct Prim {
+    pub name: &'static str,
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    pub triangles: Vec<[u16; 3]>,
+    /// Per vertex (joint slot, weight) pairs (at most 4).
+    pub joints: Vec<[(u8, f32); 2]>,
+}
+
+/// The avatar: JSON and its binary buffer.
+pub struct Avatar {
+    pub json: Value,
+    pub bin: Vec<u8>,
+    pub prims: Vec<Prim>,
+}
+
+fn sphere(
+    centre: Vec3,
+    r: f32,
+    rings: usize,
+    segs: usize,
+    cap: f32,
+) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
+    let (mut p, mut n, mut uv, mut t) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for i in 0..=rings {
+        let th = cap * i as f32 / rings as f32;
+        for j in 0..=segs {
+            let ph = std::f32::consts::TAU * j as f32 / segs as f32;
+            // +z is the face's front: the pole points forward.
+            let d = Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+            p.push(centre + d * r);
+            n.push(d);
+            uv.push(Vec2::new(j as f32 / segs as f32, i as f32 / rings as f32));
+        }
+    }
+    let w = segs + 1;
+    for i in 0..rings {
+        for j in 0..segs {
+            let a = (i * w + j) as u16;
+            let b = (i * w + j + 1) as u16;
+            let c = ((i + 1) * w + j) as u16;
+            let d = ((i + 1) * w + j + 1) as u16;
+            if i > 0 {
+                t.push([a, c, b]);
+            }
+            t.push([b, c, d]);
+        }
+    }
+    (p, n, uv, t)
+}
+
+/// The four primitives of `Body`.
+pub fn body_prims() -> Vec<Prim> {
+    let head = 2u8; // joint slots: 0 Root, 1 Neck, 2 Head, 3 Jaw
+    let jaw = 3u8;
+    let (p, n, uv, t) = sphere(HEAD_CENTRE, HEAD_RADIUS, 10, 16, std::f32::consts::PI);
+    let skin_joints = vec![[(head, 1.0), (0, 0.0)]; p.len()];
+    let skin = Prim {
+        name: "skin",
+        positions: p,
+        normals: n,
+        uvs: uv,
+        triangles: t,
+        joints: skin_joints,
+    };
+    let mouth_c = HEAD_CENTRE + Vec3::new(0.0, -4.0, 7.0);
+    let (p, n, uv, t) = sphere(mouth_c, 2.0, 3, 8, 1.2);
+    let mouth_joints = vec![[(jaw, 0.7), (head, 0.3)]; p.len()];
+    let mouth = Prim {
+        name: "mouth",
+        positions: p,
+        normals: n,
+        uvs: uv,
+        triangles: t,
+        joints: mouth_joints,
+    };
+    let mut eyes = Prim {
+        name: "eyes",
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        triangles: vec![],
+        joints: vec![],
+    };
+    for x in [-3.2f32, 3.2] {
+        let (p, n, uv, t) = sphere(
+            HEAD_CENTRE + Vec3::new(x, 2.0, 7.5),
+            1.2,
+            4,
+            8,
+            std::f32::consts::PI,
+        );
+        let base = eyes.positions.len() as u16;
+        eyes.triangles
+            .extend(t.iter().map(|tr| tr.map(|i| i + base)));
+        eyes.joints
+            .extend(std::iter::repeat_n([(head, 1.0), (0, 0.0)], p.len()));
+        eyes.positions.extend(p);
+        eyes.normals.extend(n);
+        eyes.uvs.extend(uv);
+    }
+    let mut lashes = Prim {
+        name: "lashes",
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        triangles: vec![],
+        joints: vec![],
+    };
+    for x in [-3.2f32, 3.2] {
+        let base = lashes.positions.len() as u16;
+        for k in 0..4 {
+            let dx = (k as f32 - 1.5) * 0.8;
+            for h in [0.0f32, 0.4] {
+                lashes
+                    .positions
+                    .push(HEAD_CENTRE + Vec3::new(x + dx, 3.3 + h, 8.6));
+                lashes.normals.push(Vec3::Z);
+                lashes.uvs.push(Vec2::new(k as f32 / 3.0, h / 0.4));
+            }
+        }
+        for k in 0..3u16 {
+            let (a, b, c, d) = (
+                base + 2 * k,
+                base + 2 * k + 1,
+                base + 2 * k + 2,
+                base + 2 * k + 3,
+            );
+            lashes.triangles.push([a, c, b]);
+            lashes.triangles.push([b, c, d]);
+        }
+        lashes
+            .joints
+            .extend(std::iter::repeat_n([(head, 1.0), (0, 0.0)], 8));
+    }
+    vec![skin, mouth, eyes, lashes]
+}
+
+struct Bin {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Bin {
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(t) = target {
+            v["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(v);
+        self.views.len() - 1
+    }
+    fn acc(&mut self, a: Value) -> usize {
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+    fn vec3(&mut self, v: &[Vec3], minmax: bool) -> usize {
+        let bytes: Vec<u8> = v
+            .iter()
+            .flat_map(|p| p.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        let view = self.view(&bytes, Some(34962));
+        let mut a =
+            json!({"bufferView": view, "componentType": 5126, "count": v.len(), "type": "VEC3"});
+        if minmax {
+            let min = v.iter().fold(Vec3::splat(f32::INFINITY), |m, p| m.min(*p));
+            let max = v
+                .iter()
+                .fold(Vec3::splat(f32::NEG_INFINITY), |m, p| m.max(*p));
+            a["min"] = json!(min.to_array());
+            a["max"] = json!(max.to_array());
+        }
+        self.acc(a)
+    }
+    fn floats(&mut self, v: &[f32], ty: &str, minmax: bool) -> usize {
+        let bytes: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let view = self.view(&bytes, None);
+        let per = match ty {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC4" => 4,
+            "MAT4" => 16,
+            _ => 3,
+        };
+        let mut a =
+            json!({"bufferView": view, "componentType": 5126, "count": v.len() / per, "type": ty});
+        if minmax {
+            let min = v.iter().copied().fold(f32::INFINITY, f32::min);
+            let max = v.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            a["min"] = json!([min]);
+            a["max"] = json!([max]);
+        }
+        self.acc(a)
+    }
+}
+
+/// A 4×4 checker PNG.
+fn png() -> Vec<u8> {
+    let mut img = fbakit::render::Image::new(4, 4, [200, 160, 140, 255]);
+    img.fill_rect(0, 0, 2, 2, [120, 80, 60, 255]);
+    let mut out = Vec::new();
+    img.encode_png(&mut out).unwrap();
+    out
+}
+
+/// Local matrices of the nodes (cm): Armature (0.01), Root, Neck, Head, Jaw.
+fn joint_worlds() -> [Mat4; 4] {
+    let armature = Mat4::from_scale(Vec3::splat(0.01));
+    let root = armature;
+    let neck = root * Mat4::from_translation(Vec3::new(0.0, 150.0, 0.0));
+    let head = neck * Mat4::from_translation(Vec3::new(0.0, 10.0, 0.0));
+    let jaw = head * Mat4::from_translation(Vec3::new(0.0, -3.0, 2.0));
+    [root, neck, head, jaw]
+}
+
+/// Builds the avatar.
+pub fn build() -> Avatar {
+    let prims = body_prims();
+    let mut b = Bin {
+        bin: Vec::new(),
+        views: Vec::new(),
+        accessors: Vec::new(),
+    };
+    let png = png();
+    let image_view = b.view(&png, None);
+    let mut primitives = Vec::new();
+    for (k, p) in prims.iter().enumerate() {
+        let pos = b.vec3(&p.positions, true);
+        let nrm = b.vec3(&p.normals, false);
+        let uv_bytes: Vec<u8> = p
+            .uvs
+            .iter()
+            .flat_map(|v| v.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        let uv_view = b.view(&uv_bytes, Some(34962));
+        let uv = b.acc(json!({"bufferView": uv_view, "componentType": 5126, "count": p.uvs.len(), "type": "VEC2"}));
+        let jb: Vec<u8> = p
+            .joints
+            .iter()
+            .flat_map(|j| [j[0].0, j[1].0, 0, 0])
+            .collect();
+        let jv = b.view(&jb, Some(34962));
+        let joints = b.acc(json!({"bufferView": jv, "componentType": 5121, "count": p.joints.len(), "type": "VEC4"}));
+        let wf: Vec<f32> = p
+            .joints
+            .iter()
+            .flat_map(|j| [j[0].1, j[1].1, 0.0, 0.0])
+            .collect();
+        let wb: Vec<u8> = wf.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let wv = b.view(&wb, Some(34962));
+        let weights = b.acc(json!({"bufferView": wv, "componentType": 5126, "count": p.joints.len(), "type": "VEC4"}));
+        let ib: Vec<u8> = p
+            .triangles
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        let iv = b.view(&ib, Some(34963));
+        let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": p.triangles.len() * 3, "type": "SCALAR"}));
+        // The user's own `Blink`: lashes move down, every other primitive stays (dense zeros).
+        let blink: Vec<Vec3> = p
+            .positions
+            .iter()
+            .map(|_| {
+                if p.name == "lashes" {
+                    Vec3::new(0.0, -0.6, 0.0)
+                } else {
+                    Vec3::ZERO
+                }
+            })
+            .collect();
+        let blink = b.vec3(&blink, true);
+        primitives.push(json!({
+            "attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv, "JOINTS_0": joints, "WEIGHTS_0": weights},
+            "indices": idx,
+            "material": k,
+            "targets": [{"POSITION": blink}],
+            "extras": {"part": p.name}
+        }));
+    }
+    // Hat: a square pyramid above the head (not skinned, under the Head joint).
+    let hat_p = vec![
+        Vec3::new(-8.0, 8.0, -8.0),
+        Vec3::new(8.0, 8.0, -8.0),
+        Vec3::new(8.0, 8.0, 8.0),
+        Vec3::new(-8.0, 8.0, 8.0),
+        Vec3::new(0.0, 20.0, 0.0),
+    ];
+    let hat_pos = b.vec3(&hat_p, true);
+    let hat_i: Vec<u8> = [0u16, 4, 1, 1, 4, 2, 2, 4, 3, 3, 4, 0]
+        .iter()
+        .flat_map(|i| i.to_le_bytes())
+        .collect();
+    let hat_iv = b.view(&hat_i, Some(34963));
+    let hat_idx =
+        b.acc(json!({"bufferView": hat_iv, "componentType": 5123, "count": 12, "type": "SCALAR"}));
+    // Inverse bind matrices: each joint's world inverse times the armature (the mesh's bind
+    // frame); the jaw's bind half a centimetre above its rest.
+    let worlds = joint_worlds();
+    let armature = Mat4::from_scale(Vec3::splat(0.01));
+    let mut ibm = Vec::new();
+    for (k, w) in worlds.iter().enumerate() {
+        let bind = if k == 3 {
+            *w * Mat4::from_translation(Vec3::new(0.0, JAW_BIND_OFFSET, 0.0))
+        } else {
+            *w
+        };
+        ibm.extend((bind.inverse() * armature).to_cols_array());
+    }
+    let ibm = b.floats(&ibm, "MAT4", false);
+    // The user's animation: the head nods, Blink closes and opens.
+    let times = b.floats(&[0.0, 0.5, 1.0], "SCALAR", true);
+    let nod = glam::Quat::from_rotation_x(0.2);
+    let rot = b.floats(
+        &[
+            0.0, 0.0, 0.0, 1.0, nod.x, nod.y, nod.z, nod.w, 0.0, 0.0, 0.0, 1.0,
+        ],
+        "VEC4",
+        false,
+    );
+    let blinkw = b.floats(&[0.0, 1.0, 0.0], "SCALAR", false);
+    let mat = |name: &str, tex: bool| {
+        let mut m = json!({"name": name, "pbrMetallicRoughness": {"baseColorFactor": [1.0, 0.9, 0.8, 1.0], "metallicFactor": 0.0}, "extras": {"shader": name}});
+        if tex {
+            m["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
+        }
+        m
+    };
+    let mut emissive = mat("eyes", false);
+    emissive["emissiveFactor"] = json!([0.1, 0.1, 0.1]);
+    emissive["extensions"] = json!({"KHR_materials_emissive_strength": {"emissiveStrength": 2.0}});
+    let json = json!({
+        "asset": {"version": "2.0", "generator": "fbakit test avatar", "extras": {"author": "tests", "licence": "CC0"}},
+        "extensionsUsed": ["KHR_materials_emissive_strength"],
+        "scene": 0,
+        "scenes": [{"name": "Scene", "nodes": [0, 7], "extras": {"lighting": "studio"}}],
+        "nodes": [
+            {"name": "Armature", "scale": [0.01, 0.01, 0.01], "children": [1, 5], "extras": {"fbx": true}},
+            {"name": "Root", "children": [2]},
+            {"name": "Neck", "translation": [0.0, 150.0, 0.0], "children": [3]},
+            {"name": "Head", "translation": [0.0, 10.0, 0.0], "children": [4, 6], "extras": {"bone": "head"}},
+            {"name": "Jaw", "translation": [0.0, -3.0, 2.0]},
+            {"name": "Body", "mesh": 0, "skin": 0, "extras": {"lod": 0}},
+            {"name": "Hat", "mesh": 1, "extras": {"removable": true}},
+            {"name": "Camera", "camera": 0, "translation": [0.0, 1.6, 0.6]}
+        ],
+        "meshes": [
+            {"name": "Body", "primitives": primitives, "weights": [0.0], "extras": {"targetNames": ["Blink"], "note": "user mesh"}},
+            {"name": "Hat", "primitives": [{"attributes": {"POSITION": hat_pos}, "indices": hat_idx, "material": 4}]}
+        ],
+        "skins": [{"name": "Rig", "joints": [1, 2, 3, 4], "skeleton": 1, "inverseBindMatrices": ibm}],
+        "materials": [mat("skin", true), mat("mouth", false), emissive, mat("lashes", false), mat("hat", false)],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 33071, "wrapT": 33071}],
+        "images": [{"bufferView": image_view, "mimeType": "image/png", "name": "skin_basecolor"}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01, "zfar": 100.0, "aspectRatio": 1.5}, "name": "Cam"}],
+        "animations": [{
+            "name": "Idle",
+            "samplers": [
+                {"input": times, "output": rot, "interpolation": "LINEAR"},
+                {"input": times, "output": blinkw, "interpolation": "LINEAR"}
+            ],
+            "channels": [
+                {"sampler": 0, "target": {"node": 3, "path": "rotation"}},
+                {"sampler": 1, "target": {"node": 5, "path": "weights"}}
+            ]
+        }],
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [{"byteLength": b.bin.len()}]
+    });
+    let mut bin = b.bin;
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    Avatar { json, bin, prims }
+}
+
+impl Avatar {
+    /// The avatar as `.glb` bytes.
+    pub fn to_glb(&self) -> Vec<u8> {
+        let mut json = self.json.clone();
+        json["buffers"][0]["byteLength"] = json!(self.bin.len());
+        let mut text = serde_json::to_vec(&json).unwrap();
+        while text.len() % 4 != 0 {
+            text.push(b' ');
+        }
+        let total = 12 + 8 + text.len() + 8 + self.bin.len();
+        let mut out = Vec::new();
+        for w in [
+            0x4654_6C67u32,
+            2,
+            total as u32,
+            text.len() as u32,
+            0x4E4F_534A,
+        ] {
+            out.extend_from_slice(&w.to_le_bytes());
+        }
+        out.extend_from_slice(&text);
+        out.extend_from_slice(&(self.bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
+        out.extend_from_slice(&self.bin);
+        out
+    }
+
+    /// Writes `dir/NAME.gltf` with its buffer in `dir/NAME.bin` and the texture as
+    /// `dir/textures/skin.png` (external files, as exporters write them).
+    pub fn write_gltf(&self, dir: &std::path::Path, name: &str) -> std::path::PathBuf {
+        let mut json = self.json.clone();
+        json["buffers"][0] = json!({"byteLength": self.bin.len(), "uri": format!("{name}.bin")});
+        // The image moves out of the buffer into a file (its view stays, unused by images).
+        let view = json["images"][0]["bufferView"].as_u64().unwrap() as usize;
+        let v = &json["bufferViews"][view];
+        let (o, l) = (
+            v["byteOffset"].as_u64().unwrap() as usize,
+            v["byteLength"].as_u64().unwrap() as usize,
+        );
+        std::fs::create_dir_all(dir.join("textures")).unwrap();
+        std::fs::write(dir.join("textures/skin.png"), &self.bin[o..o + l]).unwrap();
+        json["images"][0] = json!({"uri": "textures/skin.png", "name": "skin_basecolor"});
+        std::fs::write(dir.join(format!("{name}.bin")), &self.bin).unwrap();
+        let path = dir.join(format!("{name}.gltf"));
+        std::fs::write(&path, serde_json::to_string_pretty(&json).unwrap()).unwrap();
+        path
+    }
+}
