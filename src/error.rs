@@ -295,6 +295,9 @@ pub enum Error {
     /// The demo application.
     #[error(transparent)]
     Demo(#[from] crate::demo::DemoError),
+    /// Comparisons and snapshots.
+    #[error(transparent)]
+    Snapshot(#[from] crate::snapshot::SnapshotError),
 }
 
 impl Error {
@@ -344,6 +347,7 @@ impl Error {
             Error::Export(e) => e.is_input_error(),
             Error::Render(e) => e.is_input_error(),
             Error::Demo(e) => e.is_input_error(),
+            Error::Snapshot(e) => e.is_input_error(),
         }
     }
 }

@@ -33,6 +33,7 @@ pub mod play;
 mod render;
 mod rig;
 mod show;
+mod snapshot;
 mod speak;
 mod view;
 
