@@ -44,7 +44,7 @@ pub struct FaceDiffArgs {
     pub b: PathBuf,
     /// Differences up to this are equal: a distance in the face's units (0.001) or a
     /// fraction of face A's size, its neutral's bounding-box diagonal (1e-4x).
-    #[arg(long, value_name = "TOL", default_value = "1e-4x", value_parser = parse_tolerance)]
+    #[arg(long, value_name = "TOL", default_value = "1e-4x", value_parser = parse_tolerance, allow_negative_numbers = true)]
     pub tolerance: Tolerance,
     /// How vertices are paired: `index` (same layout) or `nearest` (nearest neutral vertex).
     #[arg(long = "match", value_enum, default_value_t)]
@@ -67,7 +67,7 @@ pub struct FaceSnapshotArgs {
     pub face: PathBuf,
     /// Numbers are printed on the grid of this tolerance: a distance (0.001) or a fraction of
     /// the face size (1e-4x).
-    #[arg(long, value_name = "TOL", default_value = "1e-4x", value_parser = parse_tolerance)]
+    #[arg(long, value_name = "TOL", default_value = "1e-4x", value_parser = parse_tolerance, allow_negative_numbers = true)]
     pub tolerance: Tolerance,
     /// Feature-point file for the face.
     #[arg(long, value_name = "FILE")]
@@ -85,7 +85,7 @@ pub struct FapDiffArgs {
     /// Stream B.
     pub b: PathBuf,
     /// Held values that differ by no more than this many FAP units are equal.
-    #[arg(long, value_name = "UNITS", default_value_t = fbakit::snapshot::DEFAULT_FAP_TOLERANCE, value_parser = parse_fap_tolerance)]
+    #[arg(long, value_name = "UNITS", default_value_t = fbakit::snapshot::DEFAULT_FAP_TOLERANCE, value_parser = parse_fap_tolerance, allow_negative_numbers = true)]
     pub tolerance: f64,
     /// Read strictly (deviations are errors instead of warnings).
     #[arg(long)]

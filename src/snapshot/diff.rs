@@ -458,14 +458,44 @@ fn index_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Result<Vec<u32>> {
     Ok(pairing)
 }
 
-/// A's global vertex → the nearest neutral vertex of B (face frames).
+/// A's global vertex → the nearest neutral vertex of B (face frames). Within a mesh B also
+/// has (by name) the search stays in that mesh; ties (coincident vertices, such as split
+/// lips) go to the same vertex number, then to the lowest, so the pairing is deterministic.
 fn nearest_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Vec<u32> {
-    let points: Vec<glam::Vec3> = mb.neutral.iter().map(|p| p.as_vec3()).collect();
-    let index = VertexIndex::new(&points);
-    ma.neutral
-        .iter()
-        .map(|p| index.nearest_vertex(p.as_vec3()).map_or(0, |(v, _)| v))
-        .collect()
+    let (a, b) = (ma.face, mb.face);
+    let index_of = |range: std::ops::Range<usize>| {
+        let points: Vec<glam::Vec3> = mb.neutral[range].iter().map(|p| p.as_vec3()).collect();
+        VertexIndex::new(&points)
+    };
+    let whole = index_of(0..mb.vertex_count());
+    let mut pairing = Vec::with_capacity(ma.vertex_count());
+    for (i, m) in a.meshes.iter().enumerate() {
+        let own = b.mesh_index(&m.name).map(|j| {
+            let start = mb.offsets[j];
+            (start, index_of(start..start + b.meshes[j].mesh.vertex_count()))
+        });
+        let (start, index) = match &own {
+            Some((s, idx)) if !idx.is_empty() => (*s, idx),
+            _ => (0, &whole),
+        };
+        let first = ma.offsets[i];
+        for (k, p) in ma.neutral[first..first + m.mesh.vertex_count()].iter().enumerate() {
+            let p = p.as_vec3();
+            let Some((_, d)) = index.nearest_vertex(p) else {
+                pairing.push(0);
+                continue;
+            };
+            let ties = index.within(p, d);
+            let same = (start + k) as u32;
+            let pick = ties
+                .iter()
+                .map(|(v, _)| start as u32 + v)
+                .min_by_key(|v| (*v != same, *v))
+                .unwrap_or(start as u32);
+            pairing.push(pick);
+        }
+    }
+    pairing
 }
 
 fn neutral_diff(

@@ -1,7 +1,6 @@
 //! The stable text of a face: what matters about its meshes, feature points, FAP units and
 //! tables, every number on the tolerance's grid, the displacements as digests.
 
-use std::collections::BTreeMap;
 use std::fmt::Write;
 
 use glam::DVec3;
@@ -50,6 +49,24 @@ pub struct TransformSnapshot {
     pub parent: Option<String>,
 }
 
+/// One feature point of a snapshot.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FeaturePointSnapshot {
+    /// The label, e.g. `3.5`.
+    pub id: String,
+    /// Position in the face frame, on the grid.
+    pub position: [f64; 3],
+}
+
+/// One FAP unit of a snapshot.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FapuSnapshot {
+    /// `IRISD`, `ES`, `ENS`, `MNS` or `MW`.
+    pub unit: String,
+    /// The neutral distance behind it (IRISD0, ...), on the grid.
+    pub distance: f64,
+}
+
 /// One table key of a snapshot.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TableSnapshot {
@@ -87,11 +104,11 @@ pub struct FaceSnapshot {
     pub meshes: Vec<MeshSnapshot>,
     /// Transforms in order.
     pub transforms: Vec<TransformSnapshot>,
-    /// Feature point label → position (face frame, on the grid).
-    pub feature_points: BTreeMap<String, [f64; 3]>,
-    /// FAP unit → its neutral distance (IRISD0, ES0, ENS0, MNS0, MW0; on the grid), `null`
-    /// when the face has none.
-    pub fapu: Option<BTreeMap<String, f64>>,
+    /// Feature points with a position, in label order (2.1, 2.2, ..., 11.6).
+    pub feature_points: Vec<FeaturePointSnapshot>,
+    /// The FAP units' neutral distances (IRISD0, ES0, ENS0, MNS0, MW0), `null` when the
+    /// face has none.
+    pub fapu: Option<Vec<FapuSnapshot>>,
     /// Every table key, FAPs by number, then visemes, then expressions.
     pub tables: Vec<TableSnapshot>,
 }
@@ -141,7 +158,12 @@ pub fn face_snapshot(face: &FaceModel, options: &SnapshotOptions) -> Result<Face
     let feature_points = face
         .feature_points
         .iter()
-        .filter_map(|p| Some((p.id.to_string(), snap3(p.position?.as_dvec3()))))
+        .filter_map(|p| {
+            Some(FeaturePointSnapshot {
+                id: p.id.to_string(),
+                position: snap3(p.position?.as_dvec3()),
+            })
+        })
         .collect();
     let fapu = face.fapu().ok().map(|f| {
         [
@@ -152,7 +174,12 @@ pub fn face_snapshot(face: &FaceModel, options: &SnapshotOptions) -> Result<Face
             FapuKind::Mw,
         ]
         .into_iter()
-        .filter_map(|k| Some((k.abbreviation().to_string(), grid.snap(f.distance(k)?))))
+        .filter_map(|k| {
+            Some(FapuSnapshot {
+                unit: k.abbreviation().to_string(),
+                distance: grid.snap(f.distance(k)?),
+            })
+        })
         .collect()
     });
 
@@ -271,16 +298,16 @@ impl FaceSnapshot {
             o.push_str("feature_points: {}\n");
         } else {
             o.push_str("feature_points:\n");
-            for (id, p) in &self.feature_points {
-                let _ = writeln!(o, "  {}: {}", quote(id), triple(*p));
+            for p in &self.feature_points {
+                let _ = writeln!(o, "  {}: {}", quote(&p.id), triple(p.position));
             }
         }
         match &self.fapu {
             None => o.push_str("fapu: null\n"),
             Some(f) => {
                 o.push_str("fapu:\n");
-                for (k, v) in f {
-                    let _ = writeln!(o, "  {k}: {}", num(*v));
+                for u in f {
+                    let _ = writeln!(o, "  {}: {}", u.unit, num(u.distance));
                 }
             }
         }

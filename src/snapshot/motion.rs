@@ -191,11 +191,13 @@ pub(crate) fn bounding_diagonal(points: &[DVec3]) -> f64 {
     (hi - lo).length()
 }
 
-/// The angle between two rotations in degrees (0..=180).
+/// The angle between two rotations in degrees (0..=180): exactly 0 for equal ones (the
+/// vector part of `a⁻¹·b` cancels exactly, where `acos` of a `w` a rounding below 1 would not).
 pub(crate) fn rotation_difference_degrees(a: Quat, b: Quat) -> f64 {
-    let d = a.as_dquat().inverse() * b.as_dquat();
-    let w = d.w.abs().min(1.0);
-    (2.0 * w.acos()).to_degrees()
+    let (a, b) = (a.as_dquat(), b.as_dquat());
+    let d = a.conjugate() * b;
+    let v = glam::DVec3::new(d.x, d.y, d.z).length();
+    (2.0 * v.atan2(d.w.abs())).to_degrees()
 }
 
 /// Length of the difference of two vectors, in f64.
