@@ -276,8 +276,11 @@ pub fn diff(a: &FaceModel, b: &FaceModel, options: &DiffOptions) -> Result<FaceD
         }
         values.sort_by(f64::total_cmp);
         values.dedup();
+        // Driven transforms both faces have; where one face has no such node (an OBJ
+        // morph set bakes it), its effect is judged by the vertex motion it causes.
         let mut names: Vec<&str> = ma.driven_transforms(key);
         names.extend(mb.driven_transforms(key));
+        names.retain(|n| a.transform_index(n).is_some() && b.transform_index(n).is_some());
         names.sort_unstable();
         names.dedup();
 
@@ -474,11 +477,12 @@ fn nearest_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Vec<u32> {
             let start = mb.offsets[j];
             (start, index_of(start..start + b.meshes[j].mesh.vertex_count()))
         });
-        let (start, index) = match &own {
-            Some((s, idx)) if !idx.is_empty() => (*s, idx),
-            _ => (0, &whole),
-        };
         let first = ma.offsets[i];
+        // Ties prefer the vertex of the same number: within the mesh, or over the face.
+        let (start, index, same_base) = match &own {
+            Some((s, idx)) if !idx.is_empty() => (*s, idx, *s),
+            _ => (0, &whole, first),
+        };
         for (k, p) in ma.neutral[first..first + m.mesh.vertex_count()].iter().enumerate() {
             let p = p.as_vec3();
             let Some((_, d)) = index.nearest_vertex(p) else {
@@ -486,7 +490,7 @@ fn nearest_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Vec<u32> {
                 continue;
             };
             let ties = index.within(p, d);
-            let same = (start + k) as u32;
+            let same = (same_base + k) as u32;
             let pick = ties
                 .iter()
                 .map(|(v, _)| start as u32 + v)
