@@ -156,13 +156,20 @@ fn snapshots_survive_a_write_and_a_read() {
     };
     let first = morphs(alma(), "first");
     let second = morphs(&first, "second");
-    assert_eq!(snapshot(&first, &opts).unwrap(), snapshot(&second, &opts).unwrap());
+    assert_eq!(
+        snapshot(&first, &opts).unwrap(),
+        snapshot(&second, &opts).unwrap()
+    );
     let nearest = DiffOptions {
         vertex_match: VertexMatch::Nearest,
         ..DiffOptions::default()
     };
     let report = diff(alma(), &first, &nearest).unwrap();
-    let worst = report.tables.iter().map(|t| t.max_difference).fold(0.0, f64::max);
+    let worst = report
+        .tables
+        .iter()
+        .map(|t| t.max_difference)
+        .fold(0.0, f64::max);
     assert!(
         report.tables.iter().all(|t| t.only_in.is_none()),
         "{report}"

@@ -51,7 +51,10 @@ fn perturb(face: &mut FaceModel, name: &str, delta: f64) -> u32 {
     for r in &mut m.displacements[..n] {
         *r += change;
     }
-    let offset: usize = face.meshes[..mesh].iter().map(|x| x.mesh.vertex_count()).sum();
+    let offset: usize = face.meshes[..mesh]
+        .iter()
+        .map(|x| x.mesh.vertex_count())
+        .sum();
     (offset + m.coord_index[0] as usize) as u32
 }
 
@@ -88,8 +91,16 @@ fn one_table_perturbed_below_the_tolerance_is_equal_and_above_it_is_not() {
     perturb(&mut below, "open_jaw", 0.5 * tol);
     let report = diff(alma(), &below, &abs(tol)).unwrap();
     assert!(report.is_equal(), "{report}");
-    let jaw = report.tables.iter().find(|t| t.table == "open_jaw").unwrap();
-    assert!((jaw.max_difference - 0.5 * tol).abs() < 1e-3 * tol, "{}", jaw.max_difference);
+    let jaw = report
+        .tables
+        .iter()
+        .find(|t| t.table == "open_jaw")
+        .unwrap();
+    assert!(
+        (jaw.max_difference - 0.5 * tol).abs() < 1e-3 * tol,
+        "{}",
+        jaw.max_difference
+    );
 
     let mut above = alma().clone();
     let vertex = perturb(&mut above, "open_jaw", 2.0 * tol);
@@ -99,7 +110,11 @@ fn one_table_perturbed_below_the_tolerance_is_equal_and_above_it_is_not() {
     assert_eq!(worst.table, "open_jaw");
     assert_eq!(worst.fap, Some(3));
     assert_eq!(worst.only_in, None);
-    assert!((worst.max_difference - 2.0 * tol).abs() < 1e-3 * tol, "{}", worst.max_difference);
+    assert!(
+        (worst.max_difference - 2.0 * tol).abs() < 1e-3 * tol,
+        "{}",
+        worst.max_difference
+    );
     assert_eq!(worst.differing_vertices, 1);
     assert_eq!(worst.worst_vertex, Some(vertex));
     // open_jaw moves in MNS units: the FAPU figure is the difference over one unit.
@@ -133,24 +148,41 @@ fn tables_only_in_one_face_are_listed_once_and_first() {
     assert!(!report.is_equal());
     let json = serde_json::to_value(&report).unwrap();
     let tables = json["tables"].as_array().unwrap();
-    let mut names: Vec<&str> = tables.iter().map(|t| t["table"].as_str().unwrap()).collect();
+    let mut names: Vec<&str> = tables
+        .iter()
+        .map(|t| t["table"].as_str().unwrap())
+        .collect();
     assert_eq!(tables[0]["table"], "joy");
     assert_eq!(tables[0]["only_in"], "a");
     assert_eq!(tables[0]["fap"], serde_json::Value::Null);
     assert_eq!(tables[0]["equal"], false);
-    assert!(tables[1..].iter().all(|t| t["equal"] == true && t["only_in"].is_null()));
+    assert!(tables[1..]
+        .iter()
+        .all(|t| t["equal"] == true && t["only_in"].is_null()));
     let n = names.len();
     names.sort_unstable();
     names.dedup();
     assert_eq!(names.len(), n, "every table once");
     assert_eq!(n, a.fat.keys().len());
     // The contract's other fields.
-    for field in ["equal", "tolerance", "tables", "neutral", "feature_points", "fapu"] {
+    for field in [
+        "equal",
+        "tolerance",
+        "tables",
+        "neutral",
+        "feature_points",
+        "fapu",
+    ] {
         assert!(json.get(field).is_some(), "{field}");
     }
     let jaw = tables.iter().find(|t| t["table"] == "open_jaw").unwrap();
     assert_eq!(jaw["fap"], 3);
-    for field in ["max_difference", "max_difference_fapu", "mean_difference", "differing_vertices"] {
+    for field in [
+        "max_difference",
+        "max_difference_fapu",
+        "mean_difference",
+        "differing_vertices",
+    ] {
         assert!(jaw.get(field).is_some(), "{field}");
     }
     // Swapped, the table is only in B.
@@ -189,7 +221,10 @@ fn faces_without_a_fat_and_bad_tolerances_are_input_errors() {
     let mut bare = alma().clone();
     bare.fat = Default::default();
     let e = diff(alma(), &bare, &DiffOptions::default()).unwrap_err();
-    assert!(e.is_input_error() && e.to_string().contains("no FAT"), "{e}");
+    assert!(
+        e.is_input_error() && e.to_string().contains("no FAT"),
+        "{e}"
+    );
     let e = snapshot(&bare, &SnapshotOptions::default()).unwrap_err();
     assert!(e.is_input_error(), "{e}");
     for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
@@ -223,7 +258,10 @@ fn a_change_above_the_tolerance_always_changes_the_snapshot() {
             .zip(after.lines())
             .filter(|(x, y)| x != y)
             .collect();
-        assert!(!differing.is_empty() && differing.len() <= 4, "{name}: {differing:?}");
+        assert!(
+            !differing.is_empty() && differing.len() <= 4,
+            "{name}: {differing:?}"
+        );
     }
 }
 
@@ -233,7 +271,10 @@ fn snapshots_are_identical_across_thread_counts() {
     let texts: Vec<String> = [1, 2, 8]
         .into_iter()
         .map(|n| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .unwrap();
             pool.install(|| snapshot(alma(), &opts).unwrap())
         })
         .collect();
@@ -255,13 +296,19 @@ fn fap_streams_perturbed_below_and_above_the_tolerance() {
 
     let change = |delta: f64| {
         let mut b = a.clone();
-        let frame = b.frames.iter_mut().find(|f| f.low_level().next().is_some()).unwrap();
+        let frame = b
+            .frames
+            .iter_mut()
+            .find(|f| f.low_level().next().is_some())
+            .unwrap();
         let (fap, v) = frame.low_level().next().unwrap();
         frame.set(fap, v + delta);
         (b, fap)
     };
     let (b, _) = change(0.4);
-    assert!(fap_diff(&a, &b, &FapDiffOptions::default()).unwrap().is_equal());
+    assert!(fap_diff(&a, &b, &FapDiffOptions::default())
+        .unwrap()
+        .is_equal());
     let (b, fap) = change(3.0);
     let report = fap_diff(&a, &b, &FapDiffOptions::default()).unwrap();
     assert!(!report.is_equal());
@@ -275,7 +322,9 @@ fn fap_streams_perturbed_below_and_above_the_tolerance() {
     // A stream at another rate differs as a whole.
     let mut c = a.clone();
     c.frame_rate *= 2.0;
-    assert!(!fap_diff(&a, &c, &FapDiffOptions::default()).unwrap().is_equal());
+    assert!(!fap_diff(&a, &c, &FapDiffOptions::default())
+        .unwrap()
+        .is_equal());
 }
 
 #[test]
@@ -305,7 +354,11 @@ fn cli_face_diff_exit_codes_and_json() {
 
     let bad = fbakit(&["face", "diff", "alma", "alma", "--tolerance", "-1"]);
     assert_eq!(bad.status.code(), Some(2));
-    assert!(text(&bad.stderr).contains("--tolerance"), "{}", text(&bad.stderr));
+    assert!(
+        text(&bad.stderr).contains("--tolerance"),
+        "{}",
+        text(&bad.stderr)
+    );
     let missing = fbakit(&["face", "diff", "alma", "no/such/face.wrl"]);
     assert_eq!(missing.status.code(), Some(2));
     assert!(text(&missing.stderr).contains("no/such/face.wrl"));
@@ -315,7 +368,10 @@ fn cli_face_diff_exit_codes_and_json() {
 fn cli_face_snapshot_and_fap_diff() {
     let out = fbakit(&["face", "snapshot", "alma"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    assert_eq!(text(&out.stdout), snapshot(alma(), &SnapshotOptions::default()).unwrap());
+    assert_eq!(
+        text(&out.stdout),
+        snapshot(alma(), &SnapshotOptions::default()).unwrap()
+    );
     let json = fbakit(&["face", "snapshot", "alma", "--json", "--tolerance", "0.01"]);
     let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
     assert_eq!(v["grid"], 0.01);
@@ -326,11 +382,55 @@ fn cli_face_snapshot_and_fap_diff() {
 
     let same = fbakit(&["fap", "diff", "samples/speech.fap", "samples/speech.fap"]);
     assert_eq!(same.status.code(), Some(0), "{}", text(&same.stderr));
-    let other = fbakit(&["fap", "diff", "samples/speech.fap", "samples/lowlevel.fap", "--json"]);
+    let other = fbakit(&[
+        "fap",
+        "diff",
+        "samples/speech.fap",
+        "samples/lowlevel.fap",
+        "--json",
+    ]);
     assert_eq!(other.status.code(), Some(1));
     let v: serde_json::Value = serde_json::from_slice(&other.stdout).unwrap();
     assert_eq!(v["equal"], false);
-    let bad = fbakit(&["fap", "diff", "samples/speech.fap", "samples/speech.fap", "--tolerance", "nan"]);
+    let bad = fbakit(&[
+        "fap",
+        "diff",
+        "samples/speech.fap",
+        "samples/speech.fap",
+        "--tolerance",
+        "nan",
+    ]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(text(&bad.stderr).contains("--tolerance"));
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(8))]
+
+    /// The snapshot's promise on a whole face: any one displacement changed by more than the
+    /// tolerance changes the text (in that table's lines only).
+    #[test]
+    fn any_change_above_the_tolerance_changes_the_snapshot(
+        table in 0usize..86, factor in 1.001f64..20.0, tol in 1e-3f64..1e-1
+    ) {
+        let keys = alma().fat.keys();
+        let name = keys[table % keys.len()].name();
+        let opts = SnapshotOptions { tolerance: Tolerance::Absolute(tol) };
+        let before = snapshot(alma(), &opts).unwrap();
+        let mut changed = alma().clone();
+        perturb(&mut changed, &name, factor * tol);
+        let after = snapshot(&changed, &opts).unwrap();
+        proptest::prop_assert_ne!(&before, &after, "{}", name);
+        let table_line = format!("  - table: \"{name}\"");
+        let section = |text: &str| {
+            let start = text.find(&table_line).unwrap();
+            let end = text[start + 1..]
+                .find("  - table:")
+                .map_or(text.len(), |e| start + 1 + e);
+            (start, end)
+        };
+        let ((sb, eb), (sa, ea)) = (section(&before), section(&after));
+        proptest::prop_assert_eq!(&before[..sb], &after[..sa]);
+        proptest::prop_assert_eq!(&before[eb..], &after[ea..]);
+    }
 }

@@ -31,7 +31,9 @@ fn parse_tolerance(s: &str) -> std::result::Result<Tolerance, String> {
 fn parse_fap_tolerance(s: &str) -> std::result::Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("`{s}` is not a positive finite number of FAP units")),
+        _ => Err(format!(
+            "`{s}` is not a positive finite number of FAP units"
+        )),
     }
 }
 
@@ -119,13 +121,22 @@ pub fn face_diff(a: FaceDiffArgs) -> Result<u8> {
     } else {
         print_text(&report.to_string());
     }
-    Ok(if report.is_equal() { EXIT_OK } else { EXIT_FAILURE })
+    Ok(if report.is_equal() {
+        EXIT_OK
+    } else {
+        EXIT_FAILURE
+    })
 }
 
 /// Runs `face snapshot`.
 pub fn face_snapshot_cmd(a: FaceSnapshotArgs) -> Result<u8> {
     let face = read_named(&a.face, a.fp.as_deref())?;
-    let snap = face_snapshot(&face, &SnapshotOptions { tolerance: a.tolerance })?;
+    let snap = face_snapshot(
+        &face,
+        &SnapshotOptions {
+            tolerance: a.tolerance,
+        },
+    )?;
     if a.json {
         print_json(&snap)?;
     } else {
@@ -140,7 +151,13 @@ pub fn fap_diff_cmd(a: FapDiffArgs) -> Result<u8> {
     let (sb, wb) = super::inputs::read_stream(&a.b, a.strict)?;
     print_warnings(&wa);
     print_warnings(&wb);
-    let mut report = fap_diff(&sa, &sb, &FapDiffOptions { tolerance: a.tolerance })?;
+    let mut report = fap_diff(
+        &sa,
+        &sb,
+        &FapDiffOptions {
+            tolerance: a.tolerance,
+        },
+    )?;
     report.a = a.a.display().to_string();
     report.b = a.b.display().to_string();
     if a.json {
@@ -148,5 +165,9 @@ pub fn fap_diff_cmd(a: FapDiffArgs) -> Result<u8> {
     } else {
         print_text(&report.to_string());
     }
-    Ok(if report.is_equal() { EXIT_OK } else { EXIT_FAILURE })
+    Ok(if report.is_equal() {
+        EXIT_OK
+    } else {
+        EXIT_FAILURE
+    })
 }

@@ -224,7 +224,7 @@ impl fmt::Display for FaceDiff {
 ///
 /// let a = fbakit::face::read("alma")?;
 /// let mut b = a.clone();
-/// b.fat.tables[0].meshes[0].displacements[0] *= 1.5; // one vertex of one table moves more
+/// b.fat.tables[0].meshes[0].displacements[0].x += 0.01; // one vertex of one table
 /// let report = diff(&a, &b, &DiffOptions::default())?;
 /// assert!(!report.is_equal(), "{report}");
 /// assert_eq!(report.worst_table().unwrap().key, a.fat.tables[0].key);
@@ -384,7 +384,8 @@ pub fn diff(a: &FaceModel, b: &FaceModel, options: &DiffOptions) -> Result<FaceD
     let neutral = neutral_diff(&ma, &mb, &pairing, tol, rot_tol_deg, radius);
     let feature_points = feature_points_diff(a, b, tol);
     let fapu = fapu_diff(fapu_a.as_ref(), b.fapu().ok().as_ref(), tol);
-    let equal = tables.iter().all(|t| t.equal) && neutral.equal && feature_points.equal && fapu.equal;
+    let equal =
+        tables.iter().all(|t| t.equal) && neutral.equal && feature_points.equal && fapu.equal;
     Ok(FaceDiff {
         equal,
         a: a.name.clone(),
@@ -475,7 +476,10 @@ fn nearest_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Vec<u32> {
     for (i, m) in a.meshes.iter().enumerate() {
         let own = b.mesh_index(&m.name).map(|j| {
             let start = mb.offsets[j];
-            (start, index_of(start..start + b.meshes[j].mesh.vertex_count()))
+            (
+                start,
+                index_of(start..start + b.meshes[j].mesh.vertex_count()),
+            )
         });
         let first = ma.offsets[i];
         // Ties prefer the vertex of the same number: within the mesh, or over the face.
@@ -483,7 +487,10 @@ fn nearest_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Vec<u32> {
             Some((s, idx)) if !idx.is_empty() => (*s, idx, *s),
             _ => (0, &whole, first),
         };
-        for (k, p) in ma.neutral[first..first + m.mesh.vertex_count()].iter().enumerate() {
+        for (k, p) in ma.neutral[first..first + m.mesh.vertex_count()]
+            .iter()
+            .enumerate()
+        {
             let p = p.as_vec3();
             let Some((_, d)) = index.nearest_vertex(p) else {
                 pairing.push(0);
@@ -544,18 +551,14 @@ fn neutral_diff(
                 let d = TransformDiff {
                     name: t.name.clone(),
                     only_in: None,
-                    rotation_degrees: rotation_difference_degrees(t.rotation, u.rotation)
-                        .max(rotation_difference_degrees(
-                            t.scale_orientation,
-                            u.scale_orientation,
-                        )),
+                    rotation_degrees: rotation_difference_degrees(t.rotation, u.rotation).max(
+                        rotation_difference_degrees(t.scale_orientation, u.scale_orientation),
+                    ),
                     translation: vec_difference(t.translation, u.translation)
                         .max(vec_difference(t.center, u.center)),
                     scale: vec_difference(t.scale, u.scale),
                 };
-                if d.rotation_degrees > rot_tol_deg
-                    || d.translation > tol
-                    || d.scale * radius > tol
+                if d.rotation_degrees > rot_tol_deg || d.translation > tol || d.scale * radius > tol
                 {
                     transforms.push(d);
                 }
@@ -651,7 +654,7 @@ fn fapu_diff(a: Option<&Fapu>, b: Option<&Fapu>, tol: f64) -> FapuDiff {
             let da = a.and_then(|f| f.distance(unit));
             let db = b.and_then(|f| f.distance(unit));
             let difference = da.zip(db).map(|(x, y)| (x - y).abs());
-            if difference.is_some_and(|d| !(d <= tol)) {
+            if difference.is_some_and(|d| d.is_nan() || d > tol) {
                 equal = false;
             }
             FapuUnitDiff {

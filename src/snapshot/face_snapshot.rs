@@ -152,7 +152,10 @@ pub fn face_snapshot(face: &FaceModel, options: &SnapshotOptions) -> Result<Face
         .iter()
         .map(|t| TransformSnapshot {
             name: t.name.clone(),
-            parent: t.parent.and_then(|p| face.transforms.get(p)).map(|p| p.name.clone()),
+            parent: t
+                .parent
+                .and_then(|p| face.transforms.get(p))
+                .map(|p| p.name.clone()),
         })
         .collect();
     let feature_points = face
@@ -314,7 +317,11 @@ impl FaceSnapshot {
         o.push_str("tables:\n");
         for t in &self.tables {
             let _ = writeln!(o, "  - table: {}", quote(&t.table));
-            let _ = writeln!(o, "    fap: {}", t.fap.map_or("null".to_string(), |f| f.to_string()));
+            let _ = writeln!(
+                o,
+                "    fap: {}",
+                t.fap.map_or("null".to_string(), |f| f.to_string())
+            );
             let _ = writeln!(o, "    borders: {}", list(&t.borders));
             let _ = writeln!(o, "    values: {}", list(&t.values));
             let _ = writeln!(o, "    vertices: {}", t.vertices);

@@ -184,10 +184,14 @@ pub fn fap_diff(
             }
         }
     }
-    let transmitted = |s: &FapStream, fap: FapId| s.frames.iter().filter(|f| f.mask().contains(fap)).count();
+    let transmitted =
+        |s: &FapStream, fap: FapId| s.frames.iter().filter(|f| f.mask().contains(fap)).count();
     let mut faps: Vec<FapValueDiff> = FapId::all()
         .filter(|id| {
-            a.frames.iter().chain(&b.frames).any(|f| f.mask().contains(*id))
+            a.frames
+                .iter()
+                .chain(&b.frames)
+                .any(|f| f.mask().contains(*id))
         })
         .map(|id| {
             let e = acc.remove(&id.number()).unwrap_or_default();
@@ -214,11 +218,8 @@ pub fn fap_diff(
             }
         })
     });
-    let equal = same_rate
-        && only_a == 0
-        && only_b == 0
-        && masks == 0
-        && faps.iter().all(|f| f.equal);
+    let equal =
+        same_rate && only_a == 0 && only_b == 0 && masks == 0 && faps.iter().all(|f| f.equal);
     Ok(FapDiff {
         equal,
         a: a.name.clone(),
@@ -231,7 +232,11 @@ pub fn fap_diff(
         frames_only_in_a: only_a,
         frames_only_in_b: only_b,
         mask_differences: masks,
-        first_difference: if same_rate { first } else { Some(first.unwrap_or(0)) },
+        first_difference: if same_rate {
+            first
+        } else {
+            Some(first.unwrap_or(0))
+        },
         compared_frames: times.len(),
         faps,
     })

@@ -68,7 +68,8 @@ pub use diff::{
 };
 pub use error::{Side, SnapshotError};
 pub use face_snapshot::{
-    face_snapshot, FaceSnapshot, FapuSnapshot, FeaturePointSnapshot, MeshSnapshot, SnapshotOptions, TableSnapshot, TransformSnapshot,
+    face_snapshot, FaceSnapshot, FapuSnapshot, FeaturePointSnapshot, MeshSnapshot, SnapshotOptions,
+    TableSnapshot, TransformSnapshot,
 };
 pub use fap_diff::{fap_diff, FapDiff, FapDiffOptions, FapValueDiff, DEFAULT_FAP_TOLERANCE};
 pub use tolerance::{ResolvedTolerance, Tolerance, DEFAULT_RELATIVE};

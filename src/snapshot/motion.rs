@@ -155,9 +155,16 @@ impl<'f> FaceMotion<'f> {
             } else {
                 let posed = to_f64(posed);
                 let base = self.offsets[mi];
-                into.extend(m.mesh.positions.iter().zip(d).enumerate().map(|(k, (p, v))| {
-                    posed.transform_point3((*p + *v).as_dvec3()) - self.neutral[base + k]
-                }));
+                into.extend(
+                    m.mesh
+                        .positions
+                        .iter()
+                        .zip(d)
+                        .enumerate()
+                        .map(|(k, (p, v))| {
+                            posed.transform_point3((*p + *v).as_dvec3()) - self.neutral[base + k]
+                        }),
+                );
             }
         }
     }

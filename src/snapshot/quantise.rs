@@ -163,7 +163,11 @@ mod tests {
         ];
         for (tol, step, one) in cases {
             let g = Grid::for_tolerance(tol);
-            assert!((g.step() - step).abs() < step * 1e-12, "{tol}: {}", g.step());
+            assert!(
+                (g.step() - step).abs() < step * 1e-12,
+                "{tol}: {}",
+                g.step()
+            );
             assert!(g.step() <= tol);
             assert_eq!(g.format_index(1), one);
         }

@@ -105,7 +105,12 @@ pub fn face_diff_text(d: &FaceDiff) -> String {
         for t in &n.transforms {
             match t.only_in {
                 Some(side) => {
-                    let _ = writeln!(o, "  transform {}: only in {}", t.name, side.to_string().to_uppercase());
+                    let _ = writeln!(
+                        o,
+                        "  transform {}: only in {}",
+                        t.name,
+                        side.to_string().to_uppercase()
+                    );
                 }
                 None => {
                     let _ = writeln!(
@@ -147,7 +152,11 @@ pub fn face_diff_text(d: &FaceDiff) -> String {
             "feature points: {} differ: {}{}",
             fp.differing.len(),
             list.join(", "),
-            if more > 0 { format!(", and {more} more") } else { String::new() }
+            if more > 0 {
+                format!(", and {more} more")
+            } else {
+                String::new()
+            }
         );
     }
     if d.fapu.equal {
@@ -205,8 +214,9 @@ pub fn fap_diff_text(d: &FapDiff) -> String {
         d.frames_only_in_a,
         d.frames_only_in_b,
         d.mask_differences,
-        d.first_difference
-            .map_or(String::new(), |f| format!("; first difference at frame {f}"))
+        d.first_difference.map_or(String::new(), |f| format!(
+            "; first difference at frame {f}"
+        ))
     );
     if !differing.is_empty() {
         let _ = writeln!(

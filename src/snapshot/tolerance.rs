@@ -105,9 +105,18 @@ mod tests {
 
     #[test]
     fn parses_absolute_and_relative() {
-        assert_eq!("0.5".parse::<Tolerance>().unwrap(), Tolerance::Absolute(0.5));
-        assert_eq!("1e-4x".parse::<Tolerance>().unwrap(), Tolerance::Relative(1e-4));
-        assert_eq!(" 2X ".parse::<Tolerance>().unwrap(), Tolerance::Relative(2.0));
+        assert_eq!(
+            "0.5".parse::<Tolerance>().unwrap(),
+            Tolerance::Absolute(0.5)
+        );
+        assert_eq!(
+            "1e-4x".parse::<Tolerance>().unwrap(),
+            Tolerance::Relative(1e-4)
+        );
+        assert_eq!(
+            " 2X ".parse::<Tolerance>().unwrap(),
+            Tolerance::Relative(2.0)
+        );
         assert_eq!(Tolerance::Relative(1e-4).absolute(30.0), 30.0 * 1e-4);
     }
 
