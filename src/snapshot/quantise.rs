@@ -110,8 +110,11 @@ impl Grid {
     }
 }
 
-/// 64-bit FNV-1a: small, fixed forever (unlike `std`'s hasher) and the same on every
-/// platform, which is all a snapshot digest needs (it is not a defence against forgery).
+/// 64-bit FNV-1a over bytes (names), and its xor-multiply step over whole 64-bit words
+/// (numbers, eight times faster): small, fixed forever (unlike `std`'s hasher) and the same
+/// on every platform, which is all a snapshot digest needs (it is not a defence against
+/// forgery). Each step is a bijection of the state for a fixed input and of the input for a
+/// fixed state, so changing any one fed value always changes the digest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Digest(u64);
 
@@ -130,14 +133,19 @@ impl Digest {
         }
     }
 
-    /// Feeds an integer (little-endian).
+    /// Feeds a 64-bit word in one step.
+    pub fn word(&mut self, v: u64) {
+        self.0 = (self.0 ^ v).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+
+    /// Feeds an integer.
     pub fn i64(&mut self, v: i64) {
-        self.bytes(&v.to_le_bytes());
+        self.word(v as u64);
     }
 
     /// Feeds an f64's exact bits.
     pub fn f64_bits(&mut self, v: f64) {
-        self.bytes(&v.to_bits().to_le_bytes());
+        self.word(v.to_bits());
     }
 
     /// Sixteen hex digits.
@@ -187,6 +195,23 @@ mod tests {
     }
 
     proptest! {
+        /// Changing any one fed word changes the digest.
+        #[test]
+        fn one_changed_word_always_changes_the_digest(
+            words in proptest::collection::vec(any::<u64>(), 1..40), at in any::<usize>(), other in any::<u64>()
+        ) {
+            let at = at % words.len();
+            prop_assume!(words[at] != other);
+            let digest = |w: &[u64]| {
+                let mut d = Digest::default();
+                w.iter().for_each(|x| d.word(*x));
+                d
+            };
+            let mut changed = words.clone();
+            changed[at] = other;
+            prop_assert_ne!(digest(&words), digest(&changed));
+        }
+
         /// A change larger than the tolerance always moves a value to another grid point.
         #[test]
         fn changes_above_tolerance_always_change_the_index(
