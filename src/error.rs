@@ -295,6 +295,9 @@ pub enum Error {
     /// The demo application.
     #[error(transparent)]
     Demo(#[from] crate::demo::DemoError),
+    /// Comparisons and snapshots.
+    #[error(transparent)]
+    Snapshot(#[from] crate::snapshot::SnapshotError),
     /// An error of a step that works on named files, with the file (or option) it concerns:
     /// a layer's error that cannot know the file (a player limit, a degenerate feature-point
     /// set, a face without skin) reads `playing speech.fap on alma.wrl: …`.
@@ -369,6 +372,7 @@ impl Error {
             Error::Export(e) => e.is_input_error(),
             Error::Render(e) => e.is_input_error(),
             Error::Demo(e) => e.is_input_error(),
+            Error::Snapshot(e) => e.is_input_error(),
             Error::Context { source, .. } => source.is_input_error(),
         }
     }

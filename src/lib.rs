@@ -24,6 +24,8 @@
 //!   rendered pictures (contact sheets, turntables, the cloning grid), the one-file HTML
 //!   viewer (`fbakit view`), videos (MP4 through `ffmpeg`, GIF, PNG frames).
 //! - [`demo`]: the end-to-end demo application (`fbakit demo`).
+//! - [`snapshot`]: FATs compared as animation (`diff`), FAP streams compared, and a stable
+//!   text of a face to pin in snapshot tests.
 //! - [`speech`]: text to a FAP stream: phoneme timing from espeak-ng, visemes, blending.
 //! - [`error`]: located parse errors and diagnostics shared by every reader.
 //! - [`io`]: bounded reads (plain and gzip) and atomic writes.
@@ -74,6 +76,7 @@ pub mod player;
 pub mod prelude;
 pub mod render;
 pub mod rig;
+pub mod snapshot;
 pub mod spec;
 pub mod speech;
 pub mod synth;

@@ -98,6 +98,38 @@ pub enum FaceCommand {
                       fbakit face from-rig head/ --map my-map.csv --fp head.csv -o head.wrl"
     )]
     FromRig(super::face_from_rig::FromRigArgs),
+    /// Compare two faces' FATs as animation, table by table, within a tolerance.
+    #[command(
+        long_about = "Compare two faces' Facial Animation Tables as animation, not as bytes: \
+                      each table (FAP, viseme, expression) is evaluated alone at every non-zero \
+                      interval border and at its reference value, and every vertex's \
+                      displacement (face frame, transform motion included) is compared. \
+                      Reports per table the largest and mean difference (face units and FAP \
+                      units), how many vertices differ, tables only in one face, transform \
+                      differences, and the neutral geometry, feature points and FAP units. \
+                      Faces with different vertex layouts need --match nearest. \
+                      Exit codes: 0 equal within the tolerance, 1 different, 2 bad input \
+                      (unreadable file, face without a FAT, layouts differ without --match).",
+        after_help = "Examples:\n  fbakit face diff expected.wrl out.wrl\n  \
+                      fbakit face diff a.wrl b.wrl --tolerance 0.01 --json\n  \
+                      fbakit face diff face.wrl rebuilt.wrl --tolerance 1e-3x --match nearest"
+    )]
+    Diff(super::snapshot::FaceDiffArgs),
+    /// Print a deterministic, diff-friendly YAML snapshot of a face and its FAT.
+    #[command(
+        long_about = "Print a deterministic YAML text of what matters about a face: meshes \
+                      (names, vertex and polygon counts, bounds, a digest of the neutral), \
+                      transforms, feature points, FAP units, and per table its borders, the \
+                      values it is evaluated at, moving vertices, largest and mean \
+                      displacement and a digest of its displacements, every number on a grid \
+                      of 1, 2 or 5 x 10^n not above --tolerance. A change above the tolerance \
+                      always changes the text; noise far below it changes it only for values \
+                      lying that close to a grid midpoint (see the library docs of \
+                      fbakit::snapshot); compare noisy faces with `face diff` instead.",
+        after_help = "Examples:\n  fbakit face snapshot out.wrl > out.snap.yaml\n  \
+                      fbakit face snapshot alma --tolerance 0.001 --json"
+    )]
+    Snapshot(super::snapshot::FaceSnapshotArgs),
 }
 
 /// Arguments of `face info`.
@@ -193,6 +225,8 @@ pub fn run(cmd: FaceCommand) -> Result<u8> {
         FaceCommand::ToMorphs(a) => to_morphs(a),
         FaceCommand::Export(a) => super::face_export::run_face_export(a),
         FaceCommand::FromRig(a) => super::face_from_rig::run(a),
+        FaceCommand::Diff(a) => super::snapshot::face_diff(a),
+        FaceCommand::Snapshot(a) => super::snapshot::face_snapshot_cmd(a),
     }
 }
 

@@ -53,6 +53,12 @@ pub enum FapCommand {
                       fbakit fap to-arkit samples/speech.fap --face head.wrl -o speech-arkit.csv"
     )]
     ToArkit(super::fap_arkit::ToArkitArgs),
+    /// Compare two FAP streams: frame rate, transmitted frames and masks, and every FAP's
+    /// held value at every frame either stream transmits, within a tolerance in FAP units.
+    /// Exit codes: 0 equal, 1 different, 2 unreadable input or bad --tolerance.
+    #[command(after_help = "Examples:\n  fbakit fap diff expected.fap out.fap\n  \
+                            fbakit fap diff a.fap b.json --tolerance 2 --json")]
+    Diff(super::snapshot::FapDiffArgs),
 }
 
 /// Arguments of `fap info`.
@@ -101,6 +107,7 @@ pub fn run(cmd: FapCommand) -> Result<u8> {
         FapCommand::Convert(a) => convert(a),
         FapCommand::FromArkit(a) => super::fap_arkit::from_arkit(a),
         FapCommand::ToArkit(a) => super::fap_arkit::to_arkit(a),
+        FapCommand::Diff(a) => super::snapshot::fap_diff_cmd(a),
     }
 }
 

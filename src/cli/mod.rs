@@ -34,6 +34,7 @@ pub mod play;
 mod render;
 mod rig;
 mod show;
+mod snapshot;
 mod speak;
 mod view;
 
