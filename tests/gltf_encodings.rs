@@ -35,7 +35,10 @@ fn points(rig: &Rig) -> Vec<Vec3> {
 /// Each mesh's world positions and its shapes' dense offsets (by shape name), keyed by rank
 /// in (vertex count, centroid) order: tools write meshes and nodes in another order and may
 /// move a mesh to a new unnamed node (quantize does, to carry the dequantisation transform).
-struct Meshes(BTreeMap<String, (Vec<Vec3>, BTreeMap<String, Vec<Vec3>>)>);
+struct Meshes(BTreeMap<String, (Vec<Vec3>, Shapes)>);
+
+/// Dense offsets per shape name.
+type Shapes = BTreeMap<String, Vec<Vec3>>;
 
 fn meshes(rig: &Rig) -> Meshes {
     let mut order: Vec<(usize, usize, [i64; 3])> = rig

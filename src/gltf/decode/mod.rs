@@ -4,10 +4,10 @@
 //!
 //! [`decode_document`] works on the document's JSON and its loaded buffers, in place, so a
 //! writer that hands the user's document back writes it decoded:
-//! - `EXT_meshopt_compression` ([`meshopt`]): compressed buffer views are decoded into their
+//! - `EXT_meshopt_compression` (`meshopt.rs`): compressed buffer views are decoded into their
 //!   fallback buffer, the extension is removed from the views and buffers and from
 //!   `extensionsUsed`/`extensionsRequired`, with a warning (Blender cannot import meshopt).
-//! - `KHR_draco_mesh_compression` ([`draco`]): no maintained Rust decoder exists, so a file that
+//! - `KHR_draco_mesh_compression` (`draco.rs`): no maintained Rust decoder exists, so a file that
 //!   requires it is refused (exit 2) with the command that decompresses it.
 //! - `KHR_mesh_quantization` needs no pass: the accessor reader dequantises integer
 //!   attributes (glTF 2.0 §3.11: normalised values by the spec's rules).
