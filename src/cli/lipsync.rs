@@ -301,8 +301,20 @@ pub fn run(a: LipsyncArgs) -> Result<u8> {
         report.audio_seconds,
         report.confidence
     );
-    let labels: Vec<&str> = sync.keys.iter().map(|k| k.viseme.label()).collect();
-    println!("visemes: {}", labels.join(" "));
+    // A long recording has thousands of keys: the line is for a glance, --json has them all.
+    let labels: Vec<&str> = sync
+        .keys
+        .iter()
+        .take(60)
+        .map(|k| k.viseme.label())
+        .collect();
+    let more = sync.keys.len().saturating_sub(labels.len());
+    let tail = if more > 0 {
+        format!(" … ({more} more)")
+    } else {
+        String::new()
+    };
+    println!("visemes: {}{tail}", labels.join(" "));
     Ok(EXIT_OK)
 }
 

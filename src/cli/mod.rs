@@ -114,6 +114,7 @@ pub const EXIT_BAD_INPUT: u8 = 2;
                   fbakit play alma samples/speech.fap -o a.glb      play a stream as animated glTF\n  \
                   fbakit view alma samples/speech.fap -o a.html     a viewer page that plays on load\n  \
                   fbakit speak \"Hello world\" -o hi.mp4              a real head says what you type, with sound\n  \
+                  fbakit lipsync v.wav --text-file v.txt -o v.mp4  a real head says your recording\n  \
                   fbakit render alma s.fap --audio s.wav -o s.mp4   a stream (and its sound) as video\n  \
                   fbakit face from-rig RIG --fp fp.csv -o face.wrl  a FAP-compliant FAT from ARKit shapes\n  \
                   fbakit completions bash > fbakit.bash             shell completions (man: fbakit man -o DIR)\n\n\

@@ -118,8 +118,8 @@ fn project(coarse: &[(u32, u32)], n: usize, m: usize, radius: usize) -> Vec<(usi
         let (ci, cj) = (ci as usize, cj as usize);
         let lo = (2 * cj).saturating_sub(radius);
         let hi = (2 * cj + 1 + radius).min(m - 1);
-        for i in (2 * ci).saturating_sub(radius)..=(2 * ci + 1 + radius).min(n - 1) {
-            let r = &mut band[i];
+        let rows = (2 * ci).saturating_sub(radius)..=(2 * ci + 1 + radius).min(n - 1);
+        for r in &mut band[rows] {
             r.0 = r.0.min(lo);
             r.1 = r.1.max(hi);
         }

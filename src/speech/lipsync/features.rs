@@ -135,7 +135,7 @@ impl FeatureExtractor {
         let mut re = [0f32; FFT];
         let mut im = [0f32; FFT];
         let mut energy = 0f64;
-        for n in 0..WINDOW {
+        for (n, (out, w)) in re.iter_mut().zip(&self.window).enumerate() {
             let x = self.pending[start + n];
             let before = if start + n == 0 {
                 self.previous
@@ -143,7 +143,7 @@ impl FeatureExtractor {
                 self.pending[start + n - 1]
             };
             energy += f64::from(x) * f64::from(x);
-            re[n] = (x - 0.97 * before) * self.window[n];
+            *out = (x - 0.97 * before) * w;
         }
         self.fft.run(&mut re, &mut im);
         let mut logmel = [0f32; MELS];
@@ -206,8 +206,8 @@ pub fn normalise(frames: &[FeatureFrame]) -> Vec<[f32; CEPS - 1]> {
     let mut mean = [0f64; CEPS - 1];
     let mut var = [0f64; CEPS - 1];
     for f in frames {
-        for c in 0..CEPS - 1 {
-            mean[c] += f64::from(f.mfcc[c + 1]);
+        for (m, v) in mean.iter_mut().zip(&f.mfcc[1..]) {
+            *m += f64::from(*v);
         }
     }
     for m in &mut mean {
