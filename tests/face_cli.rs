@@ -43,11 +43,8 @@ fn committed_sample_faces_match_the_generator() {
         ("alma.wrl.gz", fbakit::synth::alma as fn() -> _),
         ("bruno.wrl.gz", fbakit::synth::bruno),
     ] {
-        let (read, report) = read_with(
-            &root().join("samples/faces").join(file),
-            &Default::default(),
-        )
-        .unwrap();
+        let (read, report) =
+            read_with(root().join("samples/faces").join(file), &Default::default()).unwrap();
         assert!(
             report.diagnostics.is_empty(),
             "{file}: {:?}",
@@ -410,7 +407,7 @@ fn hostile_inputs_are_clear_errors() {
     let o = run();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(stderr(&o).contains("ignored"), "{}", stderr(&o));
-    let (f, _) = read_with(&p("out.wrl"), &Default::default()).unwrap();
+    let (f, _) = read_with(p("out.wrl"), &Default::default()).unwrap();
     assert_eq!(f.fat.tables[0].meshes[0].coord_index, vec![0]);
 
     std::fs::write(m.join("open_jaws.obj"), "v 0 0 0\n").unwrap();
@@ -492,7 +489,7 @@ fn hostile_inputs_are_clear_errors() {
     std::fs::write(p("m.json"), r#"{"open_jaw": 1024}"#).unwrap();
     let o = fbakit(&args);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let (f, _) = read_with(&p("out.wrl"), &Default::default()).unwrap();
+    let (f, _) = read_with(p("out.wrl"), &Default::default()).unwrap();
     assert_eq!(
         f.fat.tables[0].meshes[0].interval_borders,
         vec![0.0, 1024.0]

@@ -328,20 +328,20 @@ fn hostile_inputs_are_errors_not_panics() {
     assert!(e.contains("bad.xml:2:") && e.contains("UTF-8"), "{e}");
     // Deep nesting, both XML formats.
     let deep = format!("<xfdp>{}", "<a>".repeat(1_000_000));
-    let e = read_feature_points(&write("deep.fdp", deep.as_bytes())).unwrap_err();
+    let e = read_feature_points(write("deep.fdp", deep.as_bytes())).unwrap_err();
     assert!(e.to_string().contains("nesting"), "{e}");
     let deep = format!(
         "<featurePoints version=\"1\">{}",
         "<point>".repeat(1_000_000)
     );
-    assert!(read_feature_points(&write("deep.xml", deep.as_bytes())).is_err());
+    assert!(read_feature_points(write("deep.xml", deep.as_bytes())).is_err());
     // A million attributes on an Xface element (unknown ones are skipped, linearly).
     let mut many = String::from("<xfdp><fdp affects=\"m\" index=\"1\" name=\"2.1\"");
     for i in 0..1_000_000 {
         many.push_str(&format!(" a{i}=\"{i}\""));
     }
     many.push_str("/></xfdp>");
-    let f = read_feature_points(&write("many.fdp", many.as_bytes())).unwrap();
+    let f = read_feature_points(write("many.fdp", many.as_bytes())).unwrap();
     assert_eq!(f.points.len(), 1);
     // Truncated documents.
     for (name, text) in [
@@ -356,7 +356,7 @@ fn hostile_inputs_are_errors_not_panics() {
         ("t3.csv", "fp,vertices,combine\n2.1,1;2,sing"),
     ] {
         assert!(
-            read_feature_points(&write(name, text.as_bytes())).is_err(),
+            read_feature_points(write(name, text.as_bytes())).is_err(),
             "{name}"
         );
     }
@@ -370,7 +370,7 @@ fn hostile_inputs_are_errors_not_panics() {
         ("h6.csv", "fp,vertices\n2.1,1;99999999999999999999\n"),
         ("h7.fdp", "<xfdp><fdp affects=\"m\" index=\"1\" name=\"2.1\"><influence fap=\"300\"/></fdp></xfdp>"),
     ] {
-        let e = read_feature_points(&write(name, text.as_bytes())).unwrap_err().to_string();
+        let e = read_feature_points(write(name, text.as_bytes())).unwrap_err().to_string();
         assert!(e.contains(name), "{name}: {e}");
     }
 }

@@ -268,7 +268,7 @@ fn a_quantized_head_builds_the_same_fat_as_the_original() {
         &[],
     );
     let opts = FaceReadOptions::with_feature_points(Some(&manifest(ICT_FP)));
-    let (a, _) = fbakit::face::read_with(&manifest(ICT), &opts).unwrap();
+    let (a, _) = fbakit::face::read_with(manifest(ICT), &opts).unwrap();
     let (b, _) = fbakit::face::read_with(&out, &opts).unwrap();
     assert!(!a.fat.tables.is_empty());
     assert_eq!(a.fat.tables.len(), b.fat.tables.len());

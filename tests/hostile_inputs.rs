@@ -966,7 +966,7 @@ fn a_frame_sequence_stopped_midway_leaves_nothing() {
     // error in a later frame does) leaves neither the folder nor a temporary sibling.
     let face = fbakit::face::read("alma").unwrap();
     let (stream, _) = fbakit::fap::read_stream_file(
-        &Path::new(SAMPLES).join("speech.fap"),
+        Path::new(SAMPLES).join("speech.fap"),
         &fbakit::fap::ReadOptions::lenient(),
     )
     .unwrap();

@@ -89,7 +89,7 @@ fn assert_slider_moves_the_mouth(r: &Value) {
 fn speech_page_plays_and_poses_in_chromium() {
     let face = fbakit::synth::alma().to_face_model();
     let (stream, _) =
-        read_stream_file(&root().join("samples/speech.fap"), &ReadOptions::lenient()).unwrap();
+        read_stream_file(root().join("samples/speech.fap"), &ReadOptions::lenient()).unwrap();
     let player = Player::new(&face, &stream, &PlayOptions::default()).unwrap();
     let frames = player.animation().unwrap();
     let anim = ViewerAnimation {

@@ -190,7 +190,7 @@ mod tests {
             return None;
         }
         let model = crate::candide::read_wfm_file(&dir.join("candide3.wfm")).unwrap();
-        let fp = crate::fdp::read_feature_points(&dir.join("feature-points.csv"))
+        let fp = crate::fdp::read_feature_points(dir.join("feature-points.csv"))
             .unwrap()
             .points;
         Some((model, fp))

@@ -256,9 +256,9 @@ pub fn viseme_shapes(face: &FaceModel) -> Option<Vec<(Viseme, MouthShape)>> {
     )
 }
 
-/// What is wrong with `face`'s visemes against [`viseme_range`] and the order rules (`aa` > `E`
-/// > `ih` in opening, `ou` less open than `oh`), one text per problem; empty when they look
-/// like speech. Visemes the face has no table for are not judged.
+/// What is wrong with a face's viseme figures ([`viseme_shapes`]) against [`viseme_range`] and
+/// the order rules (opening falls from `aa` to `E` to `ih`; `ou` less open than `oh`), one
+/// text per problem; empty when they look like speech. Visemes without a table are not judged.
 pub fn viseme_problems(shapes: &[(Viseme, MouthShape)]) -> Vec<String> {
     let mut bad = Vec::new();
     for (v, s) in shapes {

@@ -53,8 +53,11 @@ struct LipModel<'a> {
     mw0: f32,
     frames: super::FaceFrames,
     /// Per low-level FAP with a table: per lip point, per vertex, its entry and slot.
-    entries: HashMap<FapId, Vec<Vec<Option<(&'a FaceDefMesh, usize)>>>>,
+    entries: HashMap<FapId, Vec<Vec<EntrySlot<'a>>>>,
 }
+
+/// Where one vertex is listed in one table: the entry and the vertex's slot in it.
+type EntrySlot<'a> = Option<(&'a FaceDefMesh, usize)>;
 
 const LIP_POINTS: [FeaturePointId; 6] = [
     FeaturePointId::FP_2_2,

@@ -183,6 +183,6 @@ mod tests {
         assert_eq!(again.meshes[0].mesh.positions, obj.meshes[0].mesh.positions);
         assert_eq!(again.meshes[0].mesh.polygons, obj.meshes[0].mesh.polygons);
         assert_eq!(obj.vertex_count(), face.vertex_count());
-        assert!(write(&dir.path().join("a.txt"), &face).is_err());
+        assert!(write(dir.path().join("a.txt"), &face).is_err());
     }
 }
