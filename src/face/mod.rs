@@ -156,7 +156,7 @@ pub struct FaceModel {
     /// The VRML scene it was read from, kept so writing preserves every other node.
     pub scene: Option<crate::vrml::Scene>,
     /// The OBJ text it was read from, kept so OBJ outputs keep the user's file (groups,
-    /// materials, `vt`, `vn`, comments) and rewrite only its `v` lines ([`obj_patch`]).
+    /// materials, `vt`, `vn`, comments) and rewrite only its `v` lines ([`crate::mesh::obj_patch`]).
     pub obj_source: Option<std::sync::Arc<str>>,
     /// The glTF document it was read from, kept so glTF outputs patch it (mesh names match
     /// [`crate::gltf::source::SourcePart::face_mesh`]).

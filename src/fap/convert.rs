@@ -16,7 +16,7 @@ pub fn is_json_path(path: &Path) -> bool {
 }
 
 /// Reads a `.fap` or `.json` stream leniently (what most files in the wild need), the front
-/// door beside [`crate::face::read`]; [`read_with`] chooses the mode and returns the reader's
+/// door beside [`crate::face::read()`]; [`read_with`] chooses the mode and returns the reader's
 /// warnings.
 ///
 /// ```

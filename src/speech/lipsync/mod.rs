@@ -5,7 +5,7 @@
 //! reports when each starts), both that rendition and the recording are described by MFCCs
 //! ([`features`]), and dynamic time warping ([`alignment`]) finds how the rendition's time
 //! maps onto the recording's; each phone boundary is carried through that map. Silences
-//! found in the recording ([`activity`]) relax the mouth, and [`coarticulation`] makes the
+//! found in the recording ([`mod@activity`]) relax the mouth, and [`coarticulation`] makes the
 //! viseme keys. (Moving m/b/p closures onto the recording's energy dips was tried and
 //! measured: it showed fewer closures on the evaluation set, so it is not done.)
 //!
@@ -82,7 +82,7 @@ pub struct RecordingAnalysis {
 }
 
 /// Describes a recording given as chunks of mono samples at
-/// [`ANALYSIS_RATE`](super::audio::ANALYSIS_RATE); `source` names it in errors.
+/// [`super::audio::ANALYSIS_RATE`]; `source` names it in errors.
 pub fn analyse_chunks<I>(chunks: I, source: &Path) -> Result<RecordingAnalysis>
 where
     I: IntoIterator<Item = Result<Vec<f32>>>,
