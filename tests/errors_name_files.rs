@@ -79,11 +79,17 @@ fn degenerate_feature_points_name_their_file() {
 fn collinear_target_points_name_the_target() {
     let dir = tempfile::tempdir().unwrap();
     let obj = dir.path().join("flat-target.obj");
-    std::fs::write(
-        &obj,
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 4 3\nf 4 5 3\n",
-    )
-    .unwrap();
+    // A thin strip along x, so points on the x axis lie on the mesh.
+    let mut text = String::new();
+    for row in [0.0, 0.1] {
+        for i in 0..=20 {
+            text.push_str(&format!("v {} {row} 0\n", i as f64 * 0.1 - 1.0));
+        }
+    }
+    for i in 1..=20 {
+        text.push_str(&format!("f {} {} {} {}\n", i, i + 1, i + 22, i + 21));
+    }
+    std::fs::write(&obj, text).unwrap();
     let fp = dir.path().join("on-a-line.xml");
     let mut xml =
         String::from("<?xml version=\"1.0\"?>\n<featurePoints version=\"1\" units=\"mm\">\n");
