@@ -116,7 +116,7 @@ pub fn detect_format(path: &Path, text: &str) -> Option<FeaturePointFormat> {
 /// Reads a feature-point file, picking the format with [`detect_format`].
 ///
 /// ```
-/// let file = fbakit::fdp::read_feature_points("samples/feature-points-example.xml".as_ref())?;
+/// let file = fbakit::fdp::read_feature_points("samples/feature-points-example.xml")?;
 /// assert!(file.points.iter().count() > 0);
 /// # Ok::<(), fbakit::error::Error>(())
 /// ```
