@@ -107,12 +107,28 @@ impl MouthGauge {
             }
             p[k] = sum / list.len() as f32;
         }
+        self.figures(&p)
+    }
+
+    /// The figures of the lip points at face-frame positions `p` (in [`MouthGauge::points`]
+    /// order): the module docs' formulas, in one place.
+    pub(crate) fn figures(&self, p: &[Vec3; 6]) -> MouthShape {
         MouthShape {
             opening: (p[0].y - p[1].y) / self.mns0,
             width: p[2].distance(p[3]) / self.mw0,
             protrusion: 0.5 * ((p[4].z - self.neutral[4].z) + (p[5].z - self.neutral[5].z))
                 / self.mns0,
         }
+    }
+
+    /// Per lip point (2.2, 2.3, 8.3, 8.4, 8.1, 8.2), the (mesh, vertex) pairs that carry it.
+    pub(crate) fn points(&self) -> &[Vec<(usize, u32)>; 6] {
+        &self.points
+    }
+
+    /// The lip points' neutral face-frame positions, in [`MouthGauge::points`] order.
+    pub(crate) fn neutral_points(&self) -> &[Vec3; 6] {
+        &self.neutral
     }
 
     /// The figures of the neutral face.

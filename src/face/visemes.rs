@@ -26,11 +26,11 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use super::mouth::{viseme_aim, MouthShape};
+use super::mouth::{viseme_aim, MouthGauge, MouthShape};
 use super::FaceModel;
 use crate::fat::{FaceDefMesh, TableKey};
 use crate::rig::bounded_ls::solve_box_qp;
-use crate::spec::{FapId, FeaturePointId, Viseme};
+use crate::spec::{FapId, Viseme};
 
 /// The correction groups (module docs): FAP numbers moved together.
 const GROUPS: [&[u8]; 4] = [&[3], &[4, 5], &[6, 7, 53, 54], &[16, 17]];
@@ -44,13 +44,10 @@ const STEPS: usize = 8;
 /// Finite-difference step, FAP units.
 const PROBE: f64 = 64.0;
 
-/// The face's low-level displacement of the lip points, evaluated only there.
+/// The face's low-level displacement of the lip points, evaluated only there; the figures
+/// come from the face's [`MouthGauge`].
 struct LipModel<'a> {
-    /// Per lip point (2.2, 2.3, 8.3, 8.4, 8.1, 8.2): its (mesh, vertex) list.
-    points: Vec<Vec<(usize, u32)>>,
-    neutral: Vec<Vec3>,
-    mns0: f32,
-    mw0: f32,
+    gauge: MouthGauge,
     frames: super::FaceFrames,
     /// Per low-level FAP with a table: per lip point, per vertex, its entry and slot.
     entries: HashMap<FapId, Vec<Vec<EntrySlot<'a>>>>,
@@ -59,46 +56,16 @@ struct LipModel<'a> {
 /// Where one vertex is listed in one table: the entry and the vertex's slot in it.
 type EntrySlot<'a> = Option<(&'a FaceDefMesh, usize)>;
 
-const LIP_POINTS: [FeaturePointId; 6] = [
-    FeaturePointId::FP_2_2,
-    FeaturePointId::FP_2_3,
-    FeaturePointId::FP_8_3,
-    FeaturePointId::FP_8_4,
-    FeaturePointId::FP_8_1,
-    FeaturePointId::FP_8_2,
-];
-
 impl<'a> LipModel<'a> {
     fn new(face: &'a FaceModel) -> Option<LipModel<'a>> {
-        let frames = face.frames();
-        let mut points = Vec::new();
-        let mut neutral = Vec::new();
-        for id in LIP_POINTS {
-            let b = face.feature_points.get(id)?.binding.as_ref()?;
-            let mesh = match &b.mesh {
-                Some(name) => face.mesh_index(name)?,
-                None if face.meshes.len() == 1 => 0,
-                None => return None,
-            };
-            let list: Vec<(usize, u32)> = b.vertices.iter().map(|&v| (mesh, v)).collect();
-            let mut sum = Vec3::ZERO;
-            for &(m, v) in &list {
-                sum += face.vertex_world(&frames, m, v)?;
-            }
-            if list.is_empty() {
-                return None;
-            }
-            neutral.push(sum / list.len() as f32);
-            points.push(list);
-        }
-        let mns0 = face.fapu().ok()?.distances.mns0 as f32;
-        let mw0 = neutral[2].distance(neutral[3]);
+        let gauge = MouthGauge::new(face)?;
         let mut entries = HashMap::new();
         for t in &face.fat.tables {
             let TableKey::LowLevel(fap) = t.key else {
                 continue;
             };
-            let per_point = points
+            let per_point = gauge
+                .points()
                 .iter()
                 .map(|list| {
                     list.iter()
@@ -113,12 +80,9 @@ impl<'a> LipModel<'a> {
                 .collect();
             entries.insert(fap, per_point);
         }
-        (mns0 > 0.0 && mw0 > 0.0).then_some(LipModel {
-            points,
-            neutral,
-            mns0,
-            mw0,
-            frames,
+        Some(LipModel {
+            gauge,
+            frames: face.frames(),
             entries,
         })
     }
@@ -126,8 +90,8 @@ impl<'a> LipModel<'a> {
     /// The mouth figures of low-level FAP values `faps` (only mesh displacements are used:
     /// the lip points ride on the skin).
     fn shape(&self, faps: &[(FapId, f64)]) -> MouthShape {
-        let mut p = self.neutral.clone();
-        for (k, list) in self.points.iter().enumerate() {
+        let mut p = *self.gauge.neutral_points();
+        for (k, list) in self.gauge.points().iter().enumerate() {
             let mut sum = Vec3::ZERO;
             for (j, &(mesh, _)) in list.iter().enumerate() {
                 let mut d = Vec3::ZERO;
@@ -140,12 +104,7 @@ impl<'a> LipModel<'a> {
             }
             p[k] += sum / list.len() as f32;
         }
-        MouthShape {
-            opening: (p[0].y - p[1].y) / self.mns0,
-            width: p[2].distance(p[3]) / self.mw0,
-            protrusion: 0.5 * ((p[4].z - self.neutral[4].z) + (p[5].z - self.neutral[5].z))
-                / self.mns0,
-        }
+        self.gauge.figures(&p)
     }
 }
 

@@ -522,8 +522,8 @@ fn field_offset(text: &str, start: usize, col: usize) -> usize {
     split_line(line, start).get(col).map_or(start, |f| f.offset)
 }
 
-/// `1 / median(Δt)` over the positive steps, snapped to a whole rate within 0.5 %.
-fn rate_from_times(t: &[f64]) -> Option<f64> {
+/// The median of the positive steps between successive times (`None` without one).
+fn median_step(t: &[f64]) -> Option<f64> {
     let mut d: Vec<f64> = t
         .windows(2)
         .map(|w| w[1] - w[0])
@@ -533,7 +533,12 @@ fn rate_from_times(t: &[f64]) -> Option<f64> {
         return None;
     }
     d.sort_by(f64::total_cmp);
-    let rate = 1.0 / d[d.len() / 2];
+    Some(d[d.len() / 2])
+}
+
+/// `1 / median(Δt)` over the positive steps, snapped to a whole rate within 0.5 %.
+fn rate_from_times(t: &[f64]) -> Option<f64> {
+    let rate = 1.0 / median_step(t)?;
     if !rate.is_finite() || !(0.001..=1000.0).contains(&rate) {
         return None;
     }
@@ -551,16 +556,7 @@ const COMMON_RATES: [f64; 10] = [15.0, 24.0, 25.0, 30.0, 48.0, 50.0, 60.0, 90.0,
 /// The rate of millisecond stamps (as seconds): a [`COMMON_RATES`] entry whose frame period
 /// is within 1 ms (the stamps' resolution) of the median step, else [`rate_from_times`].
 fn rate_from_milliseconds(t: &[f64]) -> Option<f64> {
-    let mut d: Vec<f64> = t
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|d| *d > 1e-9)
-        .collect();
-    if d.is_empty() {
-        return None;
-    }
-    d.sort_by(f64::total_cmp);
-    let median = d[d.len() / 2];
+    let median = median_step(t)?;
     COMMON_RATES
         .iter()
         .map(|&r| (r, (1.0 / r - median).abs()))
