@@ -11,11 +11,15 @@
 //! let mut player = Player::new(&cloned, &stream, &PlayOptions::default())?;
 //! let mut frame = player.new_frame();
 //! while player.next_frame(&mut frame) { /* frame.pose holds the posed meshes */ }
+//! let out = std::env::temp_dir().join("fbakit-prelude-bruno.glb");
+//! let report = export::write(&out, &cloned, &ExportOptions::default())?; // warnings inside
+//! println!("{report}");
 //! # Ok::<(), fbakit::error::Error>(())
 //! ```
 
 pub use crate::clone::face::{clone_face, CloneOptions, Method};
 pub use crate::error::{Diagnostic, Error, Result};
+pub use crate::export::{self, ExportOptions, ExportReport, ShapeNames};
 pub use crate::face::{self, FaceModel, FacePose, FaceReadOptions};
 pub use crate::fap::{self, read_stream_file, FapFrame, FapStream, ReadOptions};
 pub use crate::fat::eval::Activation;

@@ -17,9 +17,19 @@ fn read_clone_write_play_as_the_readme_shows() -> fbakit::error::Result<()> {
     assert!(summary.starts_with("cloned "), "{summary}");
     assert!(summary.contains(" with fit "), "{summary}");
     let out = dir.path().join("bruno-cloned.wrl");
-    fbakit::export::write_face(&out, &cloned.face)?;
+    let written = export::write(&out, &cloned.face, &ExportOptions::default())?;
+    assert_eq!(written.kind, export::ExportKind::Vrml, "{written}");
+    assert!(written.warnings.is_empty(), "{:?}", written.warnings);
     let back = face::read(&out)?;
     assert_eq!(back.fat.tables.len(), cloned.face.fat.tables.len());
+    // The same front door writes the OBJ shape set the README's example asks for.
+    let set = export::write(
+        dir.path().join("bruno-cloned/"),
+        &cloned.face,
+        &ExportOptions::default(),
+    )?;
+    assert_eq!(set.kind, export::ExportKind::ObjShapes, "{set}");
+    assert_eq!(set.shapes.as_ref().unwrap().shapes.len(), set.morph_targets);
 
     let stream = fap::read("samples/speech.fap")?;
     let mut player = Player::new(&back, &stream, &PlayOptions::default())?;

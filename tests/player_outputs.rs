@@ -197,8 +197,9 @@ fn export_face_writes_morph_targets() {
         names.as_array().unwrap().iter().any(|n| n == "open_jaw#1"),
         "{names}"
     );
-    let o = fbakit(&["face", "export", "alma", "-o", "alma.obj"]);
+    let o = fbakit(&["face", "export", "alma", "-o", "alma.png"]);
     assert_eq!(o.status.code(), Some(2));
+    assert!(!Path::new("alma.png").exists());
 }
 
 #[test]

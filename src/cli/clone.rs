@@ -9,8 +9,7 @@ use fbakit::clone::eval::{
 };
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
 use fbakit::error::{Error, Result, ResultExt};
-use fbakit::export::obj_shapes::{write_obj_shapes, ObjShapesReport, ShapeNames};
-use fbakit::export::write_face;
+use fbakit::export::obj_shapes::ObjShapesReport;
 use fbakit::face::{FaceFormat, FaceModel};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -332,26 +331,14 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     pb.set_message("writing");
     // glTF holds the cloned FAT as morph targets (static; `fbakit play` animates it), or
     // ARKit-named shapes made from it.
-    let mut arkit = None;
-    let mut shapes = None;
-    let write_warnings = if shape_set {
-        let names = if arkit_names {
-            ShapeNames::Arkit
-        } else {
-            ShapeNames::Fat
-        };
-        let mut report = write_obj_shapes(&outcome.face, &args.output, names)?;
-        arkit = report.arkit.take();
-        shapes = Some(report);
-        Vec::new()
-    } else if arkit_names {
-        let (report, warnings) =
-            fbakit::rig::arkit_export::write_arkit_gltf(&outcome.face, &args.output, None)?;
-        arkit = Some(report);
-        warnings
-    } else {
-        write_face(&args.output, &outcome.face)?
+    let export_opts = fbakit::export::ExportOptions {
+        names: args.names.into(),
+        ..Default::default()
     };
+    let mut written = fbakit::export::write(&args.output, &outcome.face, &export_opts)?;
+    let arkit = written.arkit.take();
+    let shapes = written.shapes.take();
+    let write_warnings = std::mem::take(&mut written.warnings);
     pb.inc(1);
     let quality = if args.report {
         pb.set_message("measuring quality");
@@ -413,11 +400,8 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         );
     }
     if arkit.is_some() {
-        super::face_export::print_arkit_report(
-            &args.output.display().to_string(),
-            outcome.face.meshes.len(),
-            arkit.as_ref(),
-        );
+        println!("{written}");
+        super::face_export::print_arkit_details(arkit.as_ref());
     }
     if let Some(q) = quality {
         println!(

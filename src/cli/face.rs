@@ -65,20 +65,24 @@ pub enum FaceCommand {
         after_help = "Example:\n  fbakit face to-morphs face.wrl morphs/"
     )]
     ToMorphs(ToMorphsArgs),
-    /// Export a face with its FAT as glTF 2.0 morph targets (no animation).
+    /// Export a face with its FAT as an asset: glTF morph targets (the face's own glTF
+    /// patched), ARKit shapes, an OBJ shape set or VRML.
     #[command(
-        long_about = "Export a face as glTF 2.0: its transforms as nodes, each mesh with its \
-                      colour, and the FAT as morph targets (one per table, or one per interval \
-                      of a multi-interval table) named in extras.targetNames. OUT's extension \
-                      picks binary .glb or text .gltf (buffer embedded). With --names arkit \
-                      the morph targets are instead Apple ARKit's 52 blend shapes (jawOpen, \
-                      eyeBlinkLeft, ...), each the face posed with its FAP recipe \
-                      (specs/arkit-fap-amplitudes.csv, measured on ICT-FaceKit) minus the \
-                      neutral, on flat meshes in face-frame coordinates; shapes without a \
-                      recipe get no target and are listed.",
+        long_about = "Export a face with its FAT as the asset a pipeline needs; OUT's extension \
+                      picks it. .glb / .gltf: a face read from glTF comes back as its own \
+                      document (every node, material, skin, animation and extra kept, in its \
+                      own units) with the FAT added as morph targets; any other face becomes a \
+                      new document in metres (transforms as nodes, the FAT as morph targets named \
+                      in extras.targetNames). .obj or DIR/: an OBJ shape set (the neutral and one \
+                      OBJ per morph target in the face's vertex order). .wrl / .wrl.gz: VRML97 \
+                      with the FAT. With --names arkit the morph targets are Apple ARKit's 52 \
+                      blend shapes (jawOpen, eyeBlinkLeft, ...), each the face posed with its FAP \
+                      recipe (specs/arkit-fap-amplitudes.csv, measured on ICT-FaceKit) minus the \
+                      neutral; shapes without a recipe get no target and are listed.",
         after_help = "Examples:\n  fbakit face export alma -o alma.glb\n  \
-                      fbakit face export samples/faces/bruno.wrl.gz -o bruno.gltf\n  \
-                      fbakit face export alma -o alma-arkit.glb --names arkit"
+                      fbakit face export avatar.glb -o avatar_fat.glb --names arkit\n  \
+                      fbakit face export samples/faces/bruno.wrl.gz -o bruno_shapes/\n  \
+                      fbakit face export alma -o alma-arkit.glb --names arkit --units mm"
     )]
     Export(super::face_export::FaceExportArgs),
     /// Build a face with a FAP-compliant FAT from a blendshape rig (ARKit names by default).

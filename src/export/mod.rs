@@ -1,5 +1,9 @@
 //! Outputs: what a face or a played animation becomes for people and other tools.
 //!
+//! - [`write()`]: the front door — a face with its FAT as the asset a pipeline needs (the
+//!   user's own glTF patched, a new glTF in metres, ARKit names, OBJ shape sets, VRML), with
+//!   [`ExportOptions`] and an [`ExportReport`] that carries the warnings.
+//! - [`arkit_patch`]: the user's glTF with ARKit-named morph targets.
 //! - [`budget`]: the size estimate every played output passes before its first frame.
 //! - [`gltf`]: a face with its FAT as glTF 2.0 morph targets and transform nodes, optionally
 //!   with a played clip as an animation.
@@ -14,6 +18,7 @@
 //! The player ([`crate::player`]) only computes frames; everything that turns frames into
 //! files lives here.
 
+pub mod arkit_patch;
 pub mod budget;
 mod error;
 pub mod gltf;
@@ -25,8 +30,10 @@ pub mod obj_shapes;
 pub mod picture;
 pub mod video;
 pub mod viewer;
+mod write;
 
 pub use error::ExportError;
+pub use write::{write, ExportKind, ExportOptions, ExportReport, ShapeNames, EXPORTS};
 
 use std::path::Path;
 
@@ -35,8 +42,9 @@ use crate::face::FaceModel;
 use crate::format::OutputFormat;
 
 /// Writes `face` in the face format `path` names ([`OutputFormat::FACES`]): VRML, gzip VRML
-/// or OBJ through [`crate::face::write()`], glTF (`.glb`, `.gltf`) with the FAT as morph
-/// targets through [`gltf::export_face`]. Returns what the format could not hold exactly.
+/// or OBJ (the neutral only) through [`crate::face::write()`], glTF (`.glb`, `.gltf`) as
+/// [`write()`] makes it. Returns what the format could not hold exactly. [`write()`] is the
+/// front door with options and a report.
 pub fn write_face(
     path: impl AsRef<Path>,
     face: &FaceModel,
@@ -44,18 +52,7 @@ pub fn write_face(
     let path = path.as_ref();
     match OutputFormat::resolve(path, OutputFormat::FACES, "a face file")? {
         OutputFormat::Glb | OutputFormat::Gltf => {
-            let mut warnings = Vec::new();
-            if let Some(export) =
-                gltf_patch::patch_if_fits(face, None, &Default::default(), &mut warnings)?
-            {
-                export.document.write(path)?;
-                warnings.extend(export.warnings);
-                return Ok(warnings);
-            }
-            let export = gltf::export_face(face, None)?;
-            export.document.write(path)?;
-            warnings.extend(export.warnings);
-            Ok(warnings)
+            write(path, face, &ExportOptions::default()).map(|r| r.warnings)
         }
         _ => crate::face::write(path, face).map(|()| Vec::new()),
     }

@@ -72,10 +72,11 @@ pub fn shapes_folder(obj: &Path) -> PathBuf {
 /// Writes `face` and its FAT as an OBJ shape set at `out` (a directory, or an `.obj` file and
 /// its `_shapes` folder; module docs), each file atomically.
 pub fn write_obj_shapes(
+    out: impl AsRef<Path>,
     face: &FaceModel,
-    out: &Path,
     names: ShapeNames,
 ) -> Result<ObjShapesReport> {
+    let out = out.as_ref();
     let format = OutputFormat::resolve(
         out,
         &[OutputFormat::Obj, OutputFormat::Directory],

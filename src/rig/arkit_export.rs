@@ -161,8 +161,8 @@ pub fn scale_rig(rig: &mut Rig, k: f32) {
 /// the bundled amplitudes, in metres (`units` is the face's length unit, `None`: guessed),
 /// atomically. Returns the report and the warnings (an unguessable unit).
 pub fn write_arkit_gltf(
+    path: impl AsRef<std::path::Path>,
     face: &FaceModel,
-    path: &std::path::Path,
     units: Option<crate::face::units::LengthUnit>,
 ) -> Result<(ArkitExportReport, Vec<crate::error::Diagnostic>)> {
     if face.fat.tables.is_empty() {
@@ -179,6 +179,6 @@ pub fn write_arkit_gltf(
         .map(crate::error::Diagnostic::warning)
         .collect();
     scale_rig(&mut rig, k);
-    super::gltf_write::write_rig_gltf(&rig, path)?;
+    super::gltf_write::write_rig_gltf(&rig, path.as_ref())?;
     Ok((report, warnings))
 }
