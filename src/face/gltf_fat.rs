@@ -816,8 +816,8 @@ pub fn exact_offset(rate: f32, per_rate: f64) -> f32 {
     }
     let (mut up, mut down) = (first, first);
     for _ in 0..4 {
-        up = up.next_up();
-        down = down.next_down();
+        up = float_step(up, true);
+        down = float_step(down, false);
         for o in [up, down] {
             if rate_of(o, per_rate) == rate {
                 return o;
@@ -825,6 +825,17 @@ pub fn exact_offset(rate: f32, per_rate: f64) -> f32 {
         }
     }
     first
+}
+
+/// The neighbouring float of finite `x` towards +∞ (`up`) or −∞ (`f32::next_up` is newer
+/// than the crate's minimum Rust).
+fn float_step(x: f32, up: bool) -> f32 {
+    if x == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if up { tiny } else { -tiny };
+    }
+    let bits = x.to_bits();
+    f32::from_bits(if (x > 0.0) == up { bits + 1 } else { bits - 1 })
 }
 
 /// The rate a stored `offset` shows when `per_rate` value units make it (see [`exact_offset`]).
@@ -897,4 +908,58 @@ pub fn regroup(
         }
     }
     (next == triangles.len()).then_some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_offsets_read_back_as_their_rates_where_one_exists() {
+        let mut exact = 0;
+        let mut total = 0;
+        for i in 1..2000u32 {
+            let rate = (i as f32 * 0.618_034).sin() * 1e-3;
+            for per in [95.0, 512.0, 0.001 * 340.0, 1.0] {
+                total += 1;
+                let o = exact_offset(rate, per);
+                let back = rate_of(o, per);
+                // Never more than one float step off.
+                assert!(
+                    back == rate
+                        || float_step(back, true) == rate
+                        || float_step(back, false) == rate
+                );
+                exact += usize::from(back == rate);
+            }
+        }
+        // Powers of two are always exact; the others mostly.
+        assert!(exact * 10 > total * 8, "{exact} of {total}");
+        assert_eq!(float_step(1.0, true), 1.0 + f32::EPSILON);
+        assert_eq!(float_step(-1.0, false), -1.0 - f32::EPSILON);
+        assert!(float_step(0.0, true) > 0.0 && float_step(0.0, false) < 0.0);
+    }
+
+    #[test]
+    fn polygons_regroup_from_their_fan_triangles() {
+        let quad = crate::mesh::Mesh::from_triangles(
+            "q",
+            vec![
+                Vec3::ZERO,
+                Vec3::X,
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::Y,
+                Vec3::new(2.0, 0.0, 0.0),
+            ],
+            &[],
+        );
+        let mut mesh = quad.clone();
+        mesh.polygons = crate::mesh::Polygons::from_lists([vec![0u32, 1, 2, 3], vec![1, 4, 2]]);
+        let runs = polygon_runs(&mesh).expect("a quad regroups");
+        assert_eq!(runs, vec![[4, 1], [3, 1]]);
+        let tris = crate::mesh::Polygons::from_triangles(&mesh.triangles());
+        assert_eq!(regroup(&tris, &runs), Some(mesh.polygons.clone()));
+        // Counts that do not add up are refused.
+        assert_eq!(regroup(&tris, &[[4, 2]]), None);
+    }
 }
