@@ -436,9 +436,15 @@ fn generated_glb_reads_back_with_its_fat() {
     let glb = dir.path().join("alma.glb");
     fbakit::export::write_face(&glb, &face).unwrap();
     let back = fbakit::face::read(&glb).unwrap();
+    // The file is in metres; the face comes back in its own units and transforms
+    // (`faceUnit` and `transforms` in the scene record), feature points included, without --fp.
+    let json = json_of(&glb);
     let (k, _) = fbakit::face::units::metres_factor(&face, None);
-    let frames = face.frames();
-    // Feature points come back (in metres) without --fp.
+    assert_eq!(
+        json["scenes"][0]["extras"]["fbakit"]["faceUnit"],
+        serde_json::json!(k)
+    );
+    assert_eq!(back.transforms, face.transforms);
     assert_eq!(back.feature_points.len(), face.feature_points.len());
     let mut compared = 0;
     for table in &face.fat.tables {
@@ -447,7 +453,6 @@ fn generated_glb_reads_back_with_its_fat() {
             continue;
         };
         for m in &table.meshes {
-            let mi = face.mesh_index(&m.mesh).unwrap();
             let g = got
                 .meshes
                 .iter()
@@ -462,8 +467,7 @@ fn generated_glb_reads_back_with_its_fat() {
                     continue;
                 };
                 for j in 0..n {
-                    let want =
-                        frames.meshes[mi].transform_vector3(m.displacements[slot * n + j]) * k;
+                    let want = m.displacements[slot * n + j];
                     let have = g.displacements[gs * n + j];
                     assert!(
                         (want - have).length() <= 1e-4 * want.length() + 1e-9,
@@ -566,4 +570,176 @@ fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
         "{:?}",
         report.diagnostics
     );
+}
+
+/// The avatar's face with its FAT and feature points (metres, the file's world frame) for
+/// the FAP units and the chin.
+fn with_points(face: FaceModel) -> FaceModel {
+    let mut face = with_fat(face);
+    let c = avatar::HEAD_CENTRE * 0.01;
+    let at = |x: f32, y: f32, z: f32| c + Vec3::new(x, y, z) * 0.01;
+    for (id, p) in [
+        ("2.1", at(0.0, -9.0, 4.0)),
+        ("2.2", at(0.0, -4.0, 9.0)),
+        ("3.1", at(3.2, 2.6, 8.6)),
+        ("3.3", at(3.2, 1.4, 8.6)),
+        ("3.5", at(3.2, 2.0, 8.7)),
+        ("3.6", at(-3.2, 2.0, 8.7)),
+        ("8.3", at(2.5, -4.0, 8.8)),
+        ("8.4", at(-2.5, -4.0, 8.8)),
+        ("9.15", at(0.0, -2.0, 9.5)),
+    ] {
+        face.feature_points.insert(fbakit::fdp::FeaturePoint {
+            id: id.parse().unwrap(),
+            position: Some(p),
+            binding: None,
+        });
+    }
+    face
+}
+
+#[test]
+fn the_jaw_joint_takes_the_jaw_faps_over_from_the_morphs() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("avatar.glb");
+    std::fs::write(&input, avatar::build().to_glb()).unwrap();
+    let face = with_points(fbakit::face::read(&input).unwrap());
+    let patched = dir.path().join("patched.glb");
+    fbakit::export::write_face(&patched, &face).unwrap();
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/lowlevel.fap");
+    let play = |out: &Path, extra: &[&str]| {
+        let mut cmd = command();
+        cmd.args([
+            "play".as_ref(),
+            patched.as_os_str(),
+            sample.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]);
+        cmd.args(extra);
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        json_of(out)
+    };
+    let (stream, _) =
+        fbakit::fap::read_stream_file(&sample, &fbakit::fap::ReadOptions::lenient()).unwrap();
+    let open = |frame: usize| {
+        stream.frames[frame]
+            .value(FapId::new(3).unwrap())
+            .unwrap_or(0.0)
+    };
+    let opened = (0..stream.frames.len()).find(|&i| open(i) > 50.0).unwrap();
+    for (name, extra) in [("named", &["--jaw-node", "Jaw"][..]), ("found", &[][..])] {
+        let out = dir.path().join(format!("{name}.glb"));
+        let y = play(&out, extra);
+        let jaw = y["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .position(|n| n["name"] == "Jaw")
+            .unwrap();
+        let anim = &y["animations"][1];
+        let channel = |path: &str| {
+            anim["channels"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|c| c["target"]["node"] == jaw && c["target"]["path"] == path)
+                .cloned()
+        };
+        let rotation = channel("rotation").unwrap_or_else(|| panic!("{name}: no jaw turn"));
+        assert!(channel("translation").is_some(), "{name}: no jaw move");
+        // The turn follows open_jaw: identity where the jaw is closed, about +x when open.
+        let values = sampler_output(&out, &y, anim, &rotation, 4);
+        let q = |i: usize| glam::Quat::from_slice(&values[i * 4..i * 4 + 4]);
+        let rest = glam::Quat::IDENTITY;
+        assert!(
+            q(0).angle_between(rest) < 1e-4,
+            "{name}: frame 0 {:?}",
+            q(0)
+        );
+        let turned = q(opened).angle_between(rest);
+        assert!(
+            turned > 0.01,
+            "{name}: open_jaw {} turns {turned}",
+            open(opened)
+        );
+        // The open_jaw targets are held at zero: no morph for the same motion.
+        let names: Vec<String> =
+            serde_json::from_value(y["meshes"][0]["extras"]["targetNames"].clone()).unwrap();
+        let weights_channel = anim["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["target"]["path"] == "weights")
+            .cloned()
+            .unwrap();
+        let w = sampler_output(&out, &y, anim, &weights_channel, names.len());
+        let jaw_targets: Vec<usize> = names
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.starts_with("open_jaw"))
+            .map(|(i, _)| i)
+            .collect();
+        assert!(!jaw_targets.is_empty());
+        for frame in w.chunks(names.len()) {
+            for &t in &jaw_targets {
+                assert_eq!(frame[t], 0.0, "{name}: {} animated", names[t]);
+            }
+        }
+        let lid = names.iter().position(|n| n == "close_t_l_eyelid").unwrap();
+        assert!(
+            w.chunks(names.len()).any(|f| f[lid] != 0.0),
+            "{name}: lids still morph"
+        );
+    }
+    // No new validator issue.
+    let out = dir.path().join("found.glb");
+    let Some(reports) = support::validator::validate(&[input.clone(), out.clone()]) else {
+        return;
+    };
+    let issues = |r: &Value| {
+        let mut codes: Vec<String> = r["messages"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|m| {
+                let mut words = m.as_str()?.split_whitespace();
+                let severity: u8 = words.next()?.parse().ok()?;
+                (severity <= 1).then(|| words.next().unwrap_or("").to_string())
+            })
+            .collect();
+        codes.sort();
+        codes
+    };
+    assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
+}
+
+/// The floats of a channel's sampler output (`width` per key) from a `.glb`.
+fn sampler_output(
+    path: &Path,
+    json: &Value,
+    anim: &Value,
+    channel: &Value,
+    width: usize,
+) -> Vec<f32> {
+    let bytes = std::fs::read(path).unwrap();
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let bin = &bytes[20 + json_len + 8..];
+    let sampler = &anim["samplers"][channel["sampler"].as_u64().unwrap() as usize];
+    let acc = &json["accessors"][sampler["output"].as_u64().unwrap() as usize];
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+        + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let count = acc["count"].as_u64().unwrap() as usize;
+    let n = if acc["type"] == "SCALAR" {
+        count
+    } else {
+        count * width
+    };
+    assert!(acc["type"] == "SCALAR" || acc["type"] == "VEC4");
+    let _ = width;
+    (0..n)
+        .map(|i| f32::from_le_bytes(bin[start + i * 4..start + i * 4 + 4].try_into().unwrap()))
+        .collect()
 }

@@ -78,6 +78,11 @@ pub struct PlayArgs {
     /// `LEFT,RIGHT` (default: `LeftEye`/`RightEye`, `eye.L`/`eye.R` or the VRM eye bones).
     #[arg(long, value_name = "LEFT,RIGHT", value_parser = parse_node_pair)]
     pub eye_nodes: Option<(String, String)>,
+    /// glTF face: the jaw node open_jaw turns and thrust_jaw / shift_jaw move (FAPs 3, 14,
+    /// 15), instead of their morph targets (default: a node named `Jaw`/`jaw` or the VRM
+    /// humanoid jaw bone). Needs the face's feature points (FAP units and the chin, 2.1).
+    #[arg(long, value_name = "NODE")]
+    pub jaw_node: Option<String>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -400,6 +405,7 @@ fn rotation_nodes(a: &PlayArgs) -> fbakit::export::gltf_rotations::RotationNodes
     fbakit::export::gltf_rotations::RotationNodes {
         head: a.head_node.clone(),
         eyes: a.eye_nodes.clone(),
+        jaw: a.jaw_node.clone(),
     }
 }
 

@@ -84,8 +84,18 @@ impl FaceMorphs {
     /// The targets of `face`'s FAT (see the module docs). Errors when a `FaceDefMesh` refers
     /// to an unknown mesh or vertex, or has the wrong number of displacements.
     pub fn new(face: &FaceModel) -> Result<FaceMorphs> {
+        FaceMorphs::scaled(face, 1.0)
+    }
+
+    /// [`FaceMorphs::new`] with offsets in other units: `scale` output units per face unit.
+    /// Each offset is the one that gives the FAT's rate back exactly when divided by
+    /// `span × scale` ([`crate::face::gltf_fat::exact_offset`]), so a read-back FAT is the
+    /// written one bit for bit.
+    pub fn scaled(face: &FaceModel, scale: f32) -> Result<FaceMorphs> {
+        use crate::face::gltf_fat::exact_offset;
         let mut meshes: Vec<Vec<MorphPiece>> = vec![Vec::new(); face.meshes.len()];
-        for table in &face.fat.tables {
+        // Targets in the canonical order: equal FATs in any table order give one document.
+        for table in &face.fat.canonical_tables() {
             if table.key.slot().is_none() {
                 return Err(FatError::NeutralTable { key: table.key }.into());
             }
@@ -119,7 +129,15 @@ impl FaceMorphs {
                 for j in 0..n {
                     let span = piece_span(table.key, &m.interval_borders, j);
                     let offsets = (0..m.coord_index.len())
-                        .map(|k| (m.displacements[k * n + j].as_dvec3() * span).as_vec3())
+                        .map(|k| {
+                            let r = m.displacements[k * n + j];
+                            let per = span * f64::from(scale);
+                            Vec3::new(
+                                exact_offset(r.x, per),
+                                exact_offset(r.y, per),
+                                exact_offset(r.z, per),
+                            )
+                        })
                         .collect();
                     meshes[mi].push(MorphPiece {
                         name: String::new(),
@@ -279,15 +297,25 @@ pub fn export_face_with_units(
     }
 
     // Meshes, scaled to metres (the scene borrows the buffers until it is built).
+    let written = if k == 1.0 {
+        morphs.clone()
+    } else {
+        FaceMorphs::scaled(face, k)?
+    };
     let scaled: Vec<(Vec<Vec3>, Vec<Vec<Vec3>>)> = face
         .meshes
         .iter()
         .enumerate()
         .map(|(mi, m)| {
-            let positions = m.mesh.positions.iter().map(|&p| p * k).collect();
-            let offsets = morphs.meshes[mi]
+            let positions = m
+                .mesh
+                .positions
                 .iter()
-                .map(|p| p.offsets.iter().map(|&d| d * k).collect())
+                .map(|&p| crate::face::gltf_fat::to_file(p, k))
+                .collect();
+            let offsets = written.meshes[mi]
+                .iter()
+                .map(|p| p.offsets.clone())
                 .collect();
             (positions, offsets)
         })
@@ -340,7 +368,15 @@ pub fn export_face_with_units(
         }
     }
     let mut document = scene.build()?;
-    add_fat_records(&mut document, face, &morphs, &mesh_nodes, k);
+    let transform_nodes: Vec<Option<usize>> = node_a.iter().map(|n| Some(n.index())).collect();
+    add_fat_records(
+        &mut document,
+        face,
+        &morphs,
+        &mesh_nodes,
+        &transform_nodes,
+        k,
+    );
     Ok(GltfExport {
         document,
         warnings: warnings
@@ -357,6 +393,7 @@ fn add_fat_records(
     face: &FaceModel,
     morphs: &FaceMorphs,
     mesh_nodes: &[Option<NodeId>],
+    transform_nodes: &[Option<usize>],
     k: f32,
 ) {
     use crate::face::gltf_fat::{scene_record, targets_record, TargetRecord, KEY};
@@ -384,7 +421,7 @@ fn add_fat_records(
             o.insert(KEY.into(), targets_record(&records));
         }
     }
-    let record = scene_record(face, k);
+    let record = scene_record(face, k, transform_nodes);
     if let (Some(scene), false) = (document.root.scenes.first_mut(), record.is_empty()) {
         scene.extras = Some(serde_json::Value::Object(record));
     }

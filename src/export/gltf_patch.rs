@@ -11,7 +11,9 @@
 //! FAT motion of transforms (rigid parts turned by the cloner) has no node of its own in
 //! the user's document: it is baked into per-vertex targets, piecewise linear over
 //! `±2 V` in 8 intervals for rotations (`V` the key's reference value), one interval for
-//! translations and scales (linear in the FAP value).
+//! translations and scales (linear in the FAP value). A document fbakit generated records
+//! its transforms' nodes (`specs/gltf-fat.md`): their motion is animated on those nodes and
+//! recorded, not baked, and the document's `faceUnit` is kept.
 //!
 //! With frames, one animation `play` drives the weights of the first node showing each
 //! patched mesh (the user's own targets held at their default weights).
@@ -22,15 +24,16 @@ use glam::{Affine3A, Quat, Vec3};
 use serde_json::Map;
 
 use super::gltf::FaceMorphs;
-use super::gltf_rotations::{rotated_nodes, same_hemisphere, RotationNodes};
+use super::gltf_rotations::{jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes};
 use crate::error::{Diagnostic, Result};
 use crate::face::gltf_fat::{self, TargetRecord};
+use crate::face::gltf_fat::{exact_offset, rate_of};
 use crate::face::FaceModel;
 use crate::fat::eval::Activation;
 use crate::fat::morph::default_value;
 use crate::fat::{interval_weights, Fat, TableKey, TransformField};
 use crate::gltf::patch::{GltfPatch, MeshPatch, PatchAnimation, PatchedGltf, SparseOffsets};
-use crate::gltf::source::GltfSource;
+use crate::gltf::source::{GltfSource, RestPose};
 use crate::player::AnimationFrame;
 
 /// Rotation bake: intervals over `±ROTATION_REACH × V`.
@@ -92,6 +95,9 @@ struct FaceMeshPiece {
     piece: TargetPiece,
     vertices: Vec<u32>,
     world: Vec<Vec3>,
+    /// `world` is a FAT row times the span (a vertex table of a mesh placed by the identity),
+    /// so it can be written to read back bit for bit.
+    exact: bool,
 }
 
 /// The targets of one glTF mesh under construction.
@@ -174,7 +180,16 @@ pub fn patch_face(
 ) -> Result<GltfPatchExport> {
     face.check_structure()?;
     let mut warnings = Vec::new();
-    let world_pieces = face_pieces(face)?;
+    // A face fbakit generated and read back: its transforms are nodes of the document (their
+    // motion is animated there, not baked) and its lengths may be in other units.
+    let unit = gltf_fat::face_unit(&source.json);
+    let by_name = gltf_fat::transform_nodes(&source.json);
+    let transform_nodes: Vec<Option<usize>> = face
+        .transforms
+        .iter()
+        .map(|t| by_name.get(&t.name).copied())
+        .collect();
+    let world_pieces = face_pieces(face, &transform_nodes)?;
     let mut meshes: BTreeMap<usize, MeshTargets> = BTreeMap::new();
     // A glTF mesh shown by several nodes is patched once: from its first instance.
     let mut taken: BTreeMap<(usize, usize), String> = BTreeMap::new();
@@ -218,8 +233,22 @@ pub fn patch_face(
                 .or_default()
                 .entry(t)
                 .or_default();
+            // Rest poses that are the file's unit scale only (fbakit's own documents): the
+            // offsets fbakit writes read back as the FAT's rates exactly.
+            let unit_rest = match &part.rest {
+                RestPose::Matrix(m) => {
+                    (glam::Mat3::from_mat4(*m) * unit).abs_diff_eq(glam::Mat3::IDENTITY, 1e-6)
+                }
+                RestPose::PerVertex(_) => false,
+            };
+            let per_rate = wp.piece.span * f64::from(unit);
             for (&v, &d) in wp.vertices.iter().zip(&wp.world) {
-                let local = part.rest.to_local(v as usize, d);
+                let local = if wp.exact && unit_rest {
+                    let exact = |o: f32| exact_offset(rate_of(o, wp.piece.span), per_rate);
+                    Vec3::new(exact(d.x), exact(d.y), exact(d.z))
+                } else {
+                    part.rest.to_local(v as usize, d)
+                };
                 *slot.entry(v).or_insert(Vec3::ZERO) += local;
             }
         }
@@ -304,9 +333,36 @@ pub fn patch_face(
             },
         );
     }
-    patch.scene_extras = gltf_fat::scene_record(face, 1.0);
+    patch.scene_extras = gltf_fat::scene_record(face, unit, &transform_nodes);
     if let Some(frames) = frames.filter(|f| !f.is_empty()) {
-        patch.animation = animation(source, &meshes, &layouts, frames);
+        // The jaw joint, when there is one, takes open_jaw, thrust_jaw and shift_jaw over
+        // from the targets (never a joint and a morph for one motion).
+        let driven: Vec<usize> = transform_nodes.iter().flatten().copied().collect();
+        let jaw = match jaw_node(source, face, nodes.jaw.as_deref(), unit, &driven) {
+            Ok(jaw) => jaw,
+            Err(why) => {
+                warnings.push(Diagnostic::warning(format!(
+                    "{}: {why}; open_jaw, thrust_jaw and shift_jaw stay morph targets",
+                    source.path.display()
+                )));
+                None
+            }
+        };
+        let morph_frames: Vec<AnimationFrame>;
+        let weight_frames = if jaw.is_some() {
+            morph_frames = frames
+                .iter()
+                .map(|f| {
+                    let mut f = f.clone();
+                    f.activations.retain(|a| !JawNode::takes(a.key));
+                    f
+                })
+                .collect();
+            &morph_frames[..]
+        } else {
+            frames
+        };
+        patch.animation = animation(source, &meshes, &layouts, weight_frames);
         let turned = rotated_nodes(source, &face.fat, nodes);
         if !turned.is_empty() {
             let anim = patch
@@ -320,6 +376,24 @@ pub fn patch_face(
                 same_hemisphere(&mut values);
                 anim.rotations.push((n.node, values));
             }
+        }
+        transform_channels(face, &transform_nodes, unit, frames, &mut patch.animation);
+        if let Some(jaw) = &jaw {
+            let anim = patch
+                .animation
+                .get_or_insert_with(|| empty_animation(frames));
+            let keyed = keyed_frames(frames);
+            if !anim.rotations.iter().any(|(n, _)| *n == jaw.node) {
+                let mut values: Vec<Quat> =
+                    keyed.iter().map(|f| jaw.rotation(&f.activations)).collect();
+                same_hemisphere(&mut values);
+                anim.rotations.push((jaw.node, values));
+            }
+            let values = keyed
+                .iter()
+                .map(|f| jaw.translation(&f.activations))
+                .collect();
+            anim.translations.push((jaw.node, values));
         }
     }
     let document = patch.apply(source)?;
@@ -412,7 +486,10 @@ fn piece_names(pieces: &[TargetPiece], taken: &[String]) -> Vec<String> {
 
 /// Per face mesh, the world-frame motion of every piece: the FAT's vertex tables, then its
 /// transform motion baked.
-fn face_pieces(face: &FaceModel) -> Result<Vec<Vec<FaceMeshPiece>>> {
+fn face_pieces(
+    face: &FaceModel,
+    transform_nodes: &[Option<usize>],
+) -> Result<Vec<Vec<FaceMeshPiece>>> {
     let morphs = FaceMorphs::new(face)?;
     let frames = face.frames();
     let mut out: Vec<Vec<FaceMeshPiece>> = Vec::with_capacity(face.meshes.len());
@@ -434,12 +511,22 @@ fn face_pieces(face: &FaceModel) -> Result<Vec<Vec<FaceMeshPiece>>> {
                         .iter()
                         .map(|&o| linear.transform_vector3(o))
                         .collect(),
+                    exact: linear == Affine3A::IDENTITY,
                 })
                 .collect(),
         );
     }
-    for table in face.fat.tables.iter().filter(|t| !t.transforms.is_empty()) {
-        bake_transforms(face, table, &mut out)?;
+    for table in &face.fat.tables {
+        // Motion of transforms the document shows as nodes is animated on them instead.
+        let mut baked = table.clone();
+        baked.transforms.retain(|x| {
+            face.transform_index(&x.transform)
+                .and_then(|i| transform_nodes.get(i).copied().flatten())
+                .is_none()
+        });
+        if !baked.transforms.is_empty() {
+            bake_transforms(face, &baked, &mut out)?;
+        }
     }
     Ok(out)
 }
@@ -503,11 +590,71 @@ fn bake_transforms(
                     },
                     vertices,
                     world,
+                    exact: false,
                 });
             }
         }
     }
     Ok(())
+}
+
+/// Channels on the nodes that show the face's FAT-driven transforms (a face fbakit generated
+/// and read back): the animated field values, lengths × `unit` (the rule of `export::gltf`).
+fn transform_channels(
+    face: &FaceModel,
+    transform_nodes: &[Option<usize>],
+    unit: f32,
+    frames: &[AnimationFrame],
+    animation: &mut Option<PatchAnimation>,
+) {
+    let mut driven = vec![[false; 3]; face.transforms.len()];
+    for x in face.fat.tables.iter().flat_map(|t| &t.transforms) {
+        if let Some(i) = face.transform_index(&x.transform) {
+            let f = match x.field {
+                TransformField::Rotation => 0,
+                TransformField::Translation => 1,
+                TransformField::Scale => 2,
+            };
+            driven[i][f] = true;
+        }
+    }
+    let keyed = keyed_frames(frames);
+    for (i, t) in face.transforms.iter().enumerate() {
+        let Some(node) = transform_nodes.get(i).copied().flatten() else {
+            continue;
+        };
+        let [rot, tr, sc] = driven[i];
+        if !(rot || tr || sc) {
+            continue;
+        }
+        let delta = |f: &AnimationFrame| {
+            f.transform_deltas
+                .get(i)
+                .copied()
+                .unwrap_or(crate::fat::eval::TransformDelta::IDENTITY)
+        };
+        let anim = animation.get_or_insert_with(|| empty_animation(frames));
+        // A node already turned as a head or eye keeps that one rotation.
+        if rot && !anim.rotations.iter().any(|(n, _)| *n == node) {
+            let mut values: Vec<Quat> = keyed
+                .iter()
+                .map(|f| (delta(f).rotation * t.rotation).normalize())
+                .collect();
+            same_hemisphere(&mut values);
+            anim.rotations.push((node, values));
+        }
+        if tr {
+            let values = keyed
+                .iter()
+                .map(|f| (t.translation + delta(f).translation + t.center) * unit)
+                .collect();
+            anim.translations.push((node, values));
+        }
+        if sc {
+            let values = keyed.iter().map(|f| t.scale + delta(f).scale).collect();
+            anim.scales.push((node, values));
+        }
+    }
 }
 
 /// The played frames with a closing key one frame after the last that holds it (the rule of

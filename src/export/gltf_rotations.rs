@@ -7,8 +7,14 @@
 //! usual names (`Head`, `LeftEye`/`RightEye`, `eye.L`, Mixamo, CC, VRM 0 bone names) or by
 //! the VRM humanoid bones (`VRMC_vrm` 1.0, `VRM` 0.x). A FAP the face's FAT has a table for
 //! is left to that table (its morph targets): never a rotation and a morph for one motion.
+//!
+//! The jaw is the other way round ([`jaw_node`]): a skinned jaw joint carries the chin, the
+//! lower teeth and the lower lip with it, so when the document has one (`play --jaw-node`,
+//! or a node named `Jaw`/`jaw`, the VRM humanoid `jaw` bone), `open_jaw` turns it about the
+//! face's +x through the joint, `thrust_jaw` and `shift_jaw` move it, and the FAT's targets
+//! for these three FAPs are held at zero in the animation (they stay in the document).
 
-use glam::{Mat4, Quat};
+use glam::{Mat3, Mat4, Quat, Vec3};
 use serde_json::Value;
 
 use crate::fat::eval::Activation;
@@ -23,6 +29,8 @@ pub struct RotationNodes {
     pub head: Option<String>,
     /// The left and right eye nodes (FAPs 23–26); left is the face's own left.
     pub eyes: Option<(String, String)>,
+    /// The jaw node (FAPs 3, 14, 15: `open_jaw`, `thrust_jaw`, `shift_jaw`).
+    pub jaw: Option<String>,
 }
 
 /// One node to turn: its index, the FAPs that turn it, and how a face-frame rotation maps
@@ -231,6 +239,206 @@ pub fn rotated_nodes(source: &GltfSource, fat: &Fat, names: &RotationNodes) -> V
     out
 }
 
+const JAW_NAMES: &[&str] = &[
+    "jaw",
+    "jawbone",
+    "jawroot",
+    "mixamorigjaw",
+    "ccbasejawroot",
+    "jbipcjaw",
+    "lowerjaw",
+];
+
+/// The FAPs the jaw node takes over from the FAT: `open_jaw`, `thrust_jaw`, `shift_jaw`.
+pub const JAW_FAPS: [u8; 3] = [3, 14, 15];
+
+/// The jaw joint `play` moves for `open_jaw` (a turn), `thrust_jaw` and `shift_jaw` (moves).
+#[derive(Clone, Debug)]
+pub struct JawNode {
+    /// Node index.
+    pub node: usize,
+    rest_rotation: Quat,
+    rest_translation: Vec3,
+    /// The parent's world rotation (world turns are conjugated by it).
+    parent_rotation: Quat,
+    /// The inverse of the parent's world linear part (world moves into its frame).
+    parent_inverse: Mat3,
+    /// Radians per unit of `open_jaw`, signed so that the chin goes down.
+    open_per_unit: f64,
+    /// World move per unit of `thrust_jaw` and of `shift_jaw` (file units).
+    thrust_per_unit: Vec3,
+    shift_per_unit: Vec3,
+}
+
+fn fap_value(activations: &[Activation], fap: u8) -> f64 {
+    let Some(id) = FapId::new(fap) else {
+        return 0.0;
+    };
+    activations
+        .iter()
+        .filter(|a| a.key == TableKey::LowLevel(id) && a.value.is_finite())
+        .map(|a| a.value)
+        .sum()
+}
+
+impl JawNode {
+    /// The node's rotation for `activations`.
+    pub fn rotation(&self, activations: &[Activation]) -> Quat {
+        let angle = fap_value(activations, 3) * self.open_per_unit;
+        let world = Quat::from_axis_angle(Vec3::X, angle as f32);
+        ((self.parent_rotation.inverse() * world * self.parent_rotation) * self.rest_rotation)
+            .normalize()
+    }
+
+    /// The node's translation for `activations`.
+    pub fn translation(&self, activations: &[Activation]) -> Vec3 {
+        let world = self.thrust_per_unit * fap_value(activations, 14) as f32
+            + self.shift_per_unit * fap_value(activations, 15) as f32;
+        self.rest_translation + self.parent_inverse * world
+    }
+
+    /// Whether `key` is one of the FAPs the jaw node takes over.
+    pub fn takes(key: TableKey) -> bool {
+        matches!(key, TableKey::LowLevel(f) if JAW_FAPS.contains(&f.number()))
+    }
+}
+
+/// World matrix of every node at rest (parents from `children`).
+fn world_matrices(json: &Value) -> (Vec<Mat4>, Vec<Option<usize>>) {
+    let nodes = json["nodes"].as_array().cloned().unwrap_or_default();
+    let mut parent = vec![None; nodes.len()];
+    for (i, n) in nodes.iter().enumerate() {
+        for c in n["children"].as_array().into_iter().flatten() {
+            if let Some(c) = c.as_u64().filter(|&c| (c as usize) < nodes.len()) {
+                parent[c as usize] = Some(i);
+            }
+        }
+    }
+    let local: Vec<Mat4> = nodes.iter().map(local_matrix).collect();
+    let world = (0..nodes.len())
+        .map(|i| {
+            let mut m = local[i];
+            let mut at = parent[i];
+            let mut depth = 0;
+            while let Some(p) = at {
+                depth += 1;
+                if depth > 256 {
+                    break;
+                }
+                m = local[p] * m;
+                at = parent[p];
+            }
+            m
+        })
+        .collect();
+    (world, parent)
+}
+
+fn vec3_of(v: &Value, default: Vec3) -> Vec3 {
+    match v.as_array() {
+        Some(a) if a.len() == 3 => {
+            let f = |i: usize| a[i].as_f64().unwrap_or(0.0) as f32;
+            Vec3::new(f(0), f(1), f(2))
+        }
+        _ => default,
+    }
+}
+
+fn local_matrix(n: &Value) -> Mat4 {
+    if let Some(m) = n["matrix"].as_array() {
+        let v: Vec<f32> = m.iter().map(|x| x.as_f64().unwrap_or(0.0) as f32).collect();
+        if v.len() == 16 {
+            return Mat4::from_cols_slice(&v);
+        }
+    }
+    Mat4::from_scale_rotation_translation(
+        vec3_of(&n["scale"], Vec3::ONE),
+        local_rotation(n),
+        vec3_of(&n["translation"], Vec3::ZERO),
+    )
+}
+
+/// The jaw node `play` moves in `source` (see the module docs): the node named `name`, else
+/// the first with a usual jaw name, else the VRM humanoid `jaw` bone. The turn per unit of
+/// `open_jaw` is the chin's (feature point 2.1) drop of one MNS over its distance from the
+/// joint in the face's side view; `thrust_jaw` and `shift_jaw` move it by MNS and MW along
+/// the standard's directions. `unit` is the file's length per face unit. `Err` says why a
+/// node that was found cannot be used (a `matrix` node, no feature points, no FAP units, the
+/// chin on the joint, or a node the FAT's own transform tables drive: `skip`).
+pub fn jaw_node(
+    source: &GltfSource,
+    face: &crate::face::FaceModel,
+    name: Option<&str>,
+    unit: f32,
+    skip: &[usize],
+) -> Result<Option<JawNode>, String> {
+    let json = &source.json;
+    let node = find(json, name, JAW_NAMES)
+        .or_else(|| name.is_none().then(|| vrm_bone(json, "jaw")).flatten());
+    let Some(node) = node else {
+        return match name {
+            Some(n) => Err(format!("no node named `{n}`")),
+            None => Ok(None),
+        };
+    };
+    let label = json["nodes"][node]["name"]
+        .as_str()
+        .unwrap_or("")
+        .to_string();
+    if skip.contains(&node) {
+        // The FAT's own transform (a face fbakit wrote) already moves it.
+        return Ok(None);
+    }
+    if json["nodes"][node].get("matrix").is_some() {
+        return Err(format!(
+            "jaw node `{label}` is given by a matrix, which glTF cannot animate"
+        ));
+    }
+    let fapu = face
+        .fapu()
+        .map_err(|e| format!("jaw node `{label}` needs the face's FAP units: {e}"))?;
+    let chin = face
+        .feature_points
+        .position(crate::spec::FeaturePointId::FP_2_1)
+        .ok_or_else(|| format!("jaw node `{label}` needs the chin's feature point 2.1"))?
+        * unit;
+    let (world, parent) = world_matrices(json);
+    let pivot = world[node].w_axis.truncate();
+    let r = chin - pivot;
+    let radius = (r.y * r.y + r.z * r.z).sqrt();
+    if !radius.is_finite() || radius <= 1e-6 * (chin.length() + 1.0) {
+        return Err(format!(
+            "jaw node `{label}` sits on the chin (2.1): it cannot turn the jaw open"
+        ));
+    }
+    let mns = fapu.unit(crate::spec::FapuKind::Mns) * f64::from(unit);
+    let mw = fapu.unit(crate::spec::FapuKind::Mw) * f64::from(unit);
+    // A turn θ about +x moves the chin by (0, −r.z θ, r.y θ): down when r.z θ > 0.
+    let open_per_unit = mns / f64::from(radius) * f64::from(r.z.signum());
+    let dir = |f: u8| {
+        FapId::new(f)
+            .and_then(|f| f.info().direction())
+            .unwrap_or(Vec3::ZERO)
+    };
+    let parent_world = parent[node].map_or(Mat4::IDENTITY, |p| world[p]);
+    let parent_linear = Mat3::from_mat4(parent_world);
+    let det = parent_linear.determinant();
+    if det.abs() < 1e-12 || !det.is_finite() {
+        return Err(format!("jaw node `{label}` has a degenerate parent"));
+    }
+    let (_, parent_rotation, _) = parent_world.to_scale_rotation_translation();
+    Ok(Some(JawNode {
+        node,
+        rest_rotation: local_rotation(&json["nodes"][node]),
+        rest_translation: vec3_of(&json["nodes"][node]["translation"], Vec3::ZERO),
+        parent_rotation,
+        parent_inverse: parent_linear.inverse(),
+        open_per_unit,
+        thrust_per_unit: dir(14) * mns as f32,
+        shift_per_unit: dir(15) * mw as f32,
+    }))
+}
+
 /// Keys in one hemisphere, so LINEAR (slerp) takes the short way.
 pub fn same_hemisphere(values: &mut [Quat]) {
     let mut prev = Quat::IDENTITY;
@@ -286,7 +494,7 @@ mod tests {
         // Named nodes win over usual names.
         let named = RotationNodes {
             head: Some("Armature".into()),
-            eyes: None,
+            ..RotationNodes::default()
         };
         assert_eq!(rotated_nodes(&source, &Fat::default(), &named)[0].node, 0);
     }

@@ -36,9 +36,8 @@ pub(crate) fn rig_face(
         let mut face = rig.to_face();
         face.name = super::format::face_name(path);
         // A glTF fbakit wrote carries its FAT and feature points (specs/gltf-fat.md).
-        if let Some((points, fat)) = super::gltf_fat::read_records(rig)? {
-            face.feature_points = points;
-            face.fat = fat;
+        if let Some(records) = super::gltf_fat::read_records(rig)? {
+            records.apply(&mut face);
             return Ok((face, report));
         }
         if !rig.shapes.is_empty() {

@@ -5,20 +5,23 @@
 //!   `target` name (as in `targetNames`), table `key` (`open_jaw`, `viseme_7`, `joy`),
 //!   interval `borders`, `interval` index and `span` (the FAP value the target shows).
 //! - `scene.extras.fbakit`: `version`, `featurePoints` (label, position in the file's world
-//!   frame, and the face mesh and vertices it is bound to) and `fapu` (the five distances).
+//!   frame, and the face mesh and vertices it is bound to) and `fapu` (the five distances);
+//!   for faces with transforms or polygons other than triangles also `faceUnit`,
+//!   `transforms`, `meshes` (order, transform, polygon run lengths) and `transformTables`.
 //!
 //! Reading back: a target's offsets divided by its span are the rates of its interval; the
 //! targets of one `(key, borders)` on one primitive make one `FaceDefMesh`.
 
 use std::collections::BTreeMap;
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use serde_json::{json, Map, Value};
 
-use super::FaceModel;
+use super::{FaceModel, FaceTransform};
 use crate::error::Result;
-use crate::fat::{FaceDefMesh, FaceDefTable, Fat, TableKey};
+use crate::fat::{FaceDefMesh, FaceDefTable, FaceDefTransform, Fat, TableKey, TransformField};
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
+use crate::gltf::source::RestPose;
 use crate::rig::{Rig, RigError};
 
 /// The extras key fbakit's records live under, on meshes and scenes.
@@ -59,9 +62,12 @@ pub fn targets_record(records: &[TargetRecord]) -> Value {
     json!({ "targets": list })
 }
 
-/// The scene record of `face`: feature points and FAPU (when they can be measured), lengths
-/// multiplied by `scale` (the output's units per face unit).
-pub fn scene_record(face: &FaceModel, scale: f32) -> Map<String, Value> {
+/// The scene record of `face`: feature points and FAPU (when they can be measured), the
+/// face's transforms and which mesh hangs under which, and the transform motion of its tables
+/// whose transform is shown by a node of the document (`nodes[t]`, per face transform; the
+/// others are baked into targets by the writer). Lengths are multiplied by `scale` (the
+/// output's units per face unit), which is recorded as `faceUnit` when it is not 1.
+pub fn scene_record(face: &FaceModel, scale: f32, nodes: &[Option<usize>]) -> Map<String, Value> {
     let mut out = Map::new();
     if face.feature_points.is_empty() && face.fat.tables.is_empty() {
         return out;
@@ -72,7 +78,7 @@ pub fn scene_record(face: &FaceModel, scale: f32) -> Map<String, Value> {
         .map(|p| {
             let mut v = json!({ "id": p.id.to_string() });
             if let Some(pos) = p.position {
-                let pos = pos * scale;
+                let pos = to_file(pos, scale);
                 v["position"] = json!([pos.x, pos.y, pos.z]);
             }
             if let Some(b) = &p.binding {
@@ -93,8 +99,144 @@ pub fn scene_record(face: &FaceModel, scale: f32) -> Map<String, Value> {
             "mns0": d.mns0 * s, "mw0": d.mw0 * s,
         });
     }
+    if scale != 1.0 {
+        record["faceUnit"] = json!(scale);
+    }
+    let runs: Vec<Option<Vec<[usize; 2]>>> =
+        face.meshes.iter().map(|m| polygon_runs(&m.mesh)).collect();
+    if !face.transforms.is_empty() || runs.iter().any(Option::is_some) {
+        record["meshes"] = face
+            .meshes
+            .iter()
+            .zip(&runs)
+            .map(|(m, runs)| {
+                let mut r = json!({ "mesh": m.name, "transform": m.transform });
+                if let Some(runs) = runs {
+                    r["polygons"] = json!(runs);
+                }
+                r
+            })
+            .collect();
+    }
+    if !face.transforms.is_empty() {
+        record["transforms"] = transforms_record(face, scale, nodes);
+
+        let tables: Vec<Value> = face
+            .fat
+            .canonical_tables()
+            .iter()
+            .filter_map(|t| {
+                let list: Vec<Value> = t
+                    .transforms
+                    .iter()
+                    .filter(|x| {
+                        face.transform_index(&x.transform)
+                            .and_then(|i| nodes.get(i).copied().flatten())
+                            .is_some()
+                    })
+                    .map(|x| transform_motion_record(x, scale))
+                    .collect();
+                (!list.is_empty()).then(|| json!({ "key": t.key.name(), "transforms": list }))
+            })
+            .collect();
+        if !tables.is_empty() {
+            record["transformTables"] = Value::Array(tables);
+        }
+    }
     out.insert(KEY.into(), record);
     out
+}
+
+/// A length in face units in the file's (`scale` per face unit), exactly invertible.
+pub fn to_file(v: Vec3, scale: f32) -> Vec3 {
+    let s = f64::from(scale);
+    Vec3::new(
+        exact_offset(v.x, s),
+        exact_offset(v.y, s),
+        exact_offset(v.z, s),
+    )
+}
+
+fn vec_json(v: Vec3) -> Value {
+    json!([v.x, v.y, v.z])
+}
+
+fn quat_json(q: Quat) -> Value {
+    json!([q.x, q.y, q.z, q.w])
+}
+
+/// `transforms`: every face transform with its fields (lengths × `scale`), parent index and node.
+fn transforms_record(face: &FaceModel, scale: f32, nodes: &[Option<usize>]) -> Value {
+    face.transforms
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            json!({
+                "name": t.name,
+                "parent": t.parent,
+                "translation": vec_json(to_file(t.translation, scale)),
+                "rotation": quat_json(t.rotation),
+                "scale": vec_json(t.scale),
+                "scaleOrientation": quat_json(t.scale_orientation),
+                "center": vec_json(to_file(t.center, scale)),
+                "node": nodes.get(i).copied().flatten(),
+            })
+        })
+        .collect()
+}
+
+/// One `FaceDefTransform` (translation per unit × `scale`).
+fn transform_motion_record(x: &FaceDefTransform, scale: f32) -> Value {
+    let field = match x.field {
+        TransformField::Rotation => "rotation",
+        TransformField::Scale => "scale",
+        TransformField::Translation => "translation",
+    };
+    json!({
+        "transform": x.transform,
+        "field": field,
+        "axis": vec_json(x.rotation_axis),
+        "angle": x.rotation_angle,
+        "scale": vec_json(x.scale),
+        "translation": vec_json(to_file(x.translation, scale)),
+    })
+}
+
+/// The length of one face unit in the units of the document `json` (its scene record's
+/// `faceUnit`, 1 when absent or not a positive number).
+pub fn face_unit(json: &Value) -> f32 {
+    scene_value(json)
+        .0
+        .get("faceUnit")
+        .and_then(Value::as_f64)
+        .filter(|u| u.is_finite() && *u > 0.0)
+        .map_or(1.0, |u| u as f32)
+}
+
+/// The node each recorded face transform is shown by, by transform name.
+pub fn transform_nodes(json: &Value) -> BTreeMap<String, usize> {
+    let mut out = BTreeMap::new();
+    for t in scene_value(json).0["transforms"]
+        .as_array()
+        .into_iter()
+        .flatten()
+    {
+        if let (Some(name), Some(node)) = (t["name"].as_str(), t["node"].as_u64()) {
+            if json["nodes"].get(node as usize).is_some() {
+                out.insert(name.to_string(), node as usize);
+            }
+        }
+    }
+    out
+}
+
+/// The shown scene's record and its JSON path (`asset.extras` for a file without scenes).
+fn scene_value(json: &Value) -> (&Value, String) {
+    let s = json["scene"].as_u64().unwrap_or(0) as usize;
+    match json["scenes"].get(s) {
+        Some(scene) => (&scene["extras"][KEY], format!("scenes[{s}].extras.{KEY}")),
+        None => (&json["asset"]["extras"][KEY], format!("asset.extras.{KEY}")),
+    }
 }
 
 /// An error at JSON path `at` of the rig's file.
@@ -112,18 +254,158 @@ fn bad(rig: &Rig, at: &str, what: impl Into<String>) -> crate::error::Error {
     .into()
 }
 
-/// The feature points and FAT recorded in the document `rig` was read from, if it has
-/// fbakit's records (see the module docs). Malformed records are errors naming their path.
-pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
+/// What a document fbakit wrote records about its face, lengths in the file's units.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FaceRecords {
+    /// Feature points (positions in the file's world frame).
+    pub points: FeaturePointSet,
+    /// The FAT: vertex tables from the targets (displacements in the file's world frame) and
+    /// the recorded transform motion.
+    pub fat: Fat,
+    /// Length of one face unit in the file's units (`faceUnit`, 1 when absent).
+    pub face_unit: f32,
+    /// The face's transforms (lengths in the file's units), parents first.
+    pub transforms: Vec<FaceTransform>,
+    /// The face's meshes in its order, with the transform each hangs under.
+    pub meshes: Vec<MeshRecord>,
+}
+
+/// One recorded face mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshRecord {
+    /// The face mesh's name.
+    pub mesh: String,
+    /// The transform it hangs under (index into the recorded transforms).
+    pub transform: Option<usize>,
+    /// Its polygons as run lengths `[corners, count]` when they are not all triangles.
+    pub polygons: Option<Vec<[usize; 2]>>,
+}
+
+impl FaceRecords {
+    /// Puts the recorded face into `face` (its meshes read from the document in the file's
+    /// world frame): feature points, FAT, transforms, the face's mesh order, and every length
+    /// back in face units and each mesh's vertices and table rows back in its transform's
+    /// frame, so the face reads back as it was written. The document kept on the face maps
+    /// its rest poses the same way, so patching it again writes in the file's units.
+    pub fn apply(self, face: &mut FaceModel) {
+        let inv_unit = 1.0 / self.face_unit;
+        let unit = f64::from(self.face_unit);
+        let back = |v: Vec3| Vec3::new(rate_of(v.x, unit), rate_of(v.y, unit), rate_of(v.z, unit));
+        let mut fat = self.fat;
+        // Vertex rows are read in face units already (`rate_of`).
+        for t in fat.tables.iter_mut() {
+            for x in t.transforms.iter_mut() {
+                x.translation = back(x.translation);
+            }
+        }
+        let mut points = FeaturePointSet::new();
+        for p in self.points.iter() {
+            let mut p = p.clone();
+            if let Some(pos) = p.position.as_mut() {
+                *pos = back(*pos);
+            }
+            points.insert(p);
+        }
+        for m in face.meshes.iter_mut() {
+            for p in m.mesh.positions.iter_mut() {
+                *p = back(*p);
+            }
+        }
+        face.transforms = self.transforms;
+        for t in face.transforms.iter_mut() {
+            t.translation = back(t.translation);
+            t.center = back(t.center);
+        }
+        // The face's mesh order; meshes the record does not name keep theirs, after.
+        let mut order: Vec<usize> = Vec::with_capacity(face.meshes.len());
+        for r in &self.meshes {
+            if let Some(i) = face.mesh_index(&r.mesh) {
+                if !order.contains(&i) {
+                    order.push(i);
+                    let m = &mut face.meshes[i];
+                    m.transform = r.transform.filter(|&t| t < face.transforms.len());
+                    // Triangles a writer made of polygons; left as they are when they do not
+                    // regroup (the document was edited).
+                    let regrouped = r
+                        .polygons
+                        .as_ref()
+                        .and_then(|runs| regroup(&m.mesh.polygons, runs));
+                    if let Some(polygons) = regrouped {
+                        if m.mesh.uv_polygons.as_ref() == Some(&m.mesh.polygons) {
+                            m.mesh.uv_polygons = Some(polygons.clone());
+                        }
+                        if m.mesh.normal_polygons.as_ref() == Some(&m.mesh.polygons) {
+                            m.mesh.normal_polygons = Some(polygons.clone());
+                        }
+                        m.mesh.polygons = polygons;
+                    }
+                }
+            }
+        }
+        for i in 0..face.meshes.len() {
+            if !order.contains(&i) {
+                order.push(i);
+            }
+        }
+        let mut old: Vec<Option<super::FaceMesh>> = std::mem::take(&mut face.meshes)
+            .into_iter()
+            .map(Some)
+            .collect();
+        face.meshes = order.iter().filter_map(|&i| old[i].take()).collect();
+        // Back into each transform's frame.
+        let frames = face.frames();
+        let mut to_local: BTreeMap<String, glam::Affine3A> = BTreeMap::new();
+        for (mi, m) in face.meshes.iter_mut().enumerate() {
+            if m.transform.is_none() {
+                continue;
+            }
+            let inv = frames.meshes[mi].inverse();
+            for p in m.mesh.positions.iter_mut() {
+                *p = inv.transform_point3(*p);
+            }
+            for n in m.mesh.normals.iter_mut() {
+                *n = inv.transform_vector3(*n).normalize_or_zero();
+            }
+            to_local.insert(m.name.clone(), inv);
+        }
+        for t in fat.tables.iter_mut() {
+            for m in t.meshes.iter_mut() {
+                if let Some(inv) = to_local.get(&m.mesh) {
+                    for d in m.displacements.iter_mut() {
+                        *d = inv.transform_vector3(*d);
+                    }
+                }
+            }
+        }
+        face.feature_points = points;
+        face.fat = fat;
+        // Rest poses now place vertices in the face frame.
+        if self.face_unit != 1.0 {
+            if let Some(source) = face.gltf_source.as_mut() {
+                let source = std::sync::Arc::make_mut(source);
+                let s = glam::Mat4::from_scale(Vec3::splat(inv_unit));
+                for part in source.parts.iter_mut() {
+                    part.rest = match &part.rest {
+                        RestPose::Matrix(m) => RestPose::Matrix(s * *m),
+                        RestPose::PerVertex(list) => {
+                            RestPose::PerVertex(list.iter().map(|m| s * *m).collect())
+                        }
+                    };
+                }
+            }
+        }
+    }
+}
+
+/// The feature points, FAT and face structure recorded in the document `rig` was read from,
+/// if it has fbakit's records (see the module docs). Malformed records are errors naming
+/// their path.
+pub fn read_records(rig: &Rig) -> Result<Option<FaceRecords>> {
     let Some(source) = &rig.source else {
         return Ok(None);
     };
     let json = &source.json;
-    let s = json["scene"].as_u64().unwrap_or(0) as usize;
-    let (scene, scene_at) = match json["scenes"].get(s) {
-        Some(scene) => (&scene["extras"][KEY], format!("scenes[{s}].extras.{KEY}")),
-        None => (&json["asset"]["extras"][KEY], format!("asset.extras.{KEY}")),
-    };
+    let (scene, scene_at) = scene_value(json);
     if scene.is_null() {
         return Ok(None);
     }
@@ -178,6 +460,19 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
             binding,
         });
     }
+    let face_unit = match scene.get("faceUnit") {
+        None => 1.0,
+        Some(u) => u
+            .as_f64()
+            .filter(|u| u.is_finite() && *u > 0.0)
+            .ok_or_else(|| {
+                bad(
+                    rig,
+                    &format!("{scene_at}.faceUnit"),
+                    "must be a positive number",
+                )
+            })? as f32,
+    };
     // Tables: per (key, borders bits) and face mesh, the targets of each interval.
     type Group = (TableKey, Vec<u64>);
     // Per glTF mesh: (interval, span, target name).
@@ -259,7 +554,12 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
                     let Some(d) = shape.delta(mi) else { continue };
                     for (&v, &o) in d.vertices.iter().zip(&d.offsets) {
                         let slot = rates.entry(v).or_insert_with(|| vec![Vec3::ZERO; n]);
-                        slot[*j] += (o.as_dvec3() / *span).as_vec3();
+                        let per_rate = *span * f64::from(face_unit);
+                        slot[*j] += Vec3::new(
+                            rate_of(o.x, per_rate),
+                            rate_of(o.y, per_rate),
+                            rate_of(o.z, per_rate),
+                        );
                     }
                 }
                 if rates.is_empty() {
@@ -279,8 +579,217 @@ pub fn read_records(rig: &Rig) -> Result<Option<(FeaturePointSet, Fat)>> {
             }
         }
     }
+    let (transforms, meshes) = read_structure(rig, scene, &scene_at)?;
+    for (i, t) in scene["transformTables"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
+        let at = format!("{scene_at}.transformTables[{i}]");
+        let key = t["key"]
+            .as_str()
+            .and_then(TableKey::from_name)
+            .ok_or_else(|| {
+                bad(
+                    rig,
+                    &format!("{at}.key"),
+                    "not a FAP, viseme or expression name",
+                )
+            })?;
+        let table = by_key.entry(key).or_insert_with(|| FaceDefTable::new(key));
+        for (j, x) in t["transforms"].as_array().into_iter().flatten().enumerate() {
+            table.transforms.push(read_transform_motion(
+                rig,
+                x,
+                &format!("{at}.transforms[{j}]"),
+                &transforms,
+            )?);
+        }
+    }
     fat.tables = by_key.into_values().collect();
-    Ok(Some((points, fat)))
+    Ok(Some(FaceRecords {
+        points,
+        fat,
+        face_unit,
+        transforms,
+        meshes,
+    }))
+}
+
+type Structure = (Vec<FaceTransform>, Vec<MeshRecord>);
+
+/// The recorded transforms and mesh order (`transforms`, `meshes`).
+fn read_structure(rig: &Rig, scene: &Value, scene_at: &str) -> Result<Structure> {
+    let mut transforms: Vec<FaceTransform> = Vec::new();
+    for (i, t) in scene["transforms"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
+        let at = format!("{scene_at}.transforms[{i}]");
+        let name = t["name"]
+            .as_str()
+            .filter(|n| !n.is_empty() && !transforms.iter().any(|x| x.name == *n))
+            .ok_or_else(|| bad(rig, &format!("{at}.name"), "must be a new transform name"))?;
+        let parent = match &t["parent"] {
+            Value::Null => None,
+            p => Some(
+                p.as_u64()
+                    .map(|p| p as usize)
+                    .filter(|&p| p < i)
+                    .ok_or_else(|| {
+                        bad(
+                            rig,
+                            &format!("{at}.parent"),
+                            "must index an earlier transform or be null",
+                        )
+                    })?,
+            ),
+        };
+        let v3 = |field: &str| {
+            vec3(&t[field]).ok_or_else(|| {
+                bad(
+                    rig,
+                    &format!("{at}.{field}"),
+                    "must be three finite numbers",
+                )
+            })
+        };
+        let q = |field: &str| {
+            quat(&t[field]).ok_or_else(|| {
+                bad(
+                    rig,
+                    &format!("{at}.{field}"),
+                    "must be a unit quaternion [x, y, z, w]",
+                )
+            })
+        };
+        transforms.push(FaceTransform {
+            name: name.to_string(),
+            parent,
+            translation: v3("translation")?,
+            rotation: q("rotation")?,
+            scale: v3("scale")?,
+            scale_orientation: q("scaleOrientation")?,
+            center: v3("center")?,
+        });
+    }
+    let mut meshes = Vec::new();
+    for (i, m) in scene["meshes"].as_array().into_iter().flatten().enumerate() {
+        let at = format!("{scene_at}.meshes[{i}]");
+        let name = m["mesh"]
+            .as_str()
+            .ok_or_else(|| bad(rig, &format!("{at}.mesh"), "must name a face mesh"))?;
+        let transform = match &m["transform"] {
+            Value::Null => None,
+            t => Some(
+                t.as_u64()
+                    .map(|t| t as usize)
+                    .filter(|&t| t < transforms.len())
+                    .ok_or_else(|| {
+                        bad(
+                            rig,
+                            &format!("{at}.transform"),
+                            "must index `transforms` or be null",
+                        )
+                    })?,
+            ),
+        };
+        let polygons = match m.get("polygons") {
+            None => None,
+            Some(v) => Some(
+                v.as_array()
+                    .and_then(|a| {
+                        a.iter()
+                            .map(|r| {
+                                let r = r.as_array().filter(|r| r.len() == 2)?;
+                                Some([r[0].as_u64()? as usize, r[1].as_u64()? as usize])
+                            })
+                            .collect::<Option<Vec<_>>>()
+                    })
+                    .ok_or_else(|| {
+                        bad(
+                            rig,
+                            &format!("{at}.polygons"),
+                            "must be [corners, count] pairs",
+                        )
+                    })?,
+            ),
+        };
+        meshes.push(MeshRecord {
+            mesh: name.to_string(),
+            transform,
+            polygons,
+        });
+    }
+    Ok((transforms, meshes))
+}
+
+/// One recorded `FaceDefTransform`.
+fn read_transform_motion(
+    rig: &Rig,
+    x: &Value,
+    at: &str,
+    transforms: &[FaceTransform],
+) -> Result<FaceDefTransform> {
+    let transform = x["transform"]
+        .as_str()
+        .filter(|n| transforms.iter().any(|t| t.name == *n))
+        .ok_or_else(|| {
+            bad(
+                rig,
+                &format!("{at}.transform"),
+                "must name a recorded transform",
+            )
+        })?;
+    let field = match x["field"].as_str() {
+        Some("rotation") => TransformField::Rotation,
+        Some("scale") => TransformField::Scale,
+        Some("translation") => TransformField::Translation,
+        _ => {
+            return Err(bad(
+                rig,
+                &format!("{at}.field"),
+                "must be \"rotation\", \"scale\" or \"translation\"",
+            ))
+        }
+    };
+    let v3 = |field: &str| {
+        vec3(&x[field]).ok_or_else(|| {
+            bad(
+                rig,
+                &format!("{at}.{field}"),
+                "must be three finite numbers",
+            )
+        })
+    };
+    let angle = x["angle"]
+        .as_f64()
+        .filter(|a| a.is_finite())
+        .ok_or_else(|| bad(rig, &format!("{at}.angle"), "must be a number"))?;
+    Ok(FaceDefTransform {
+        transform: transform.to_string(),
+        field,
+        rotation_axis: v3("axis")?,
+        rotation_angle: angle as f32,
+        scale: v3("scale")?,
+        translation: v3("translation")?,
+    })
+}
+
+fn quat(v: &Value) -> Option<Quat> {
+    let a = v.as_array()?;
+    if a.len() != 4 {
+        return None;
+    }
+    let mut q = [0.0f32; 4];
+    for (o, x) in q.iter_mut().zip(a) {
+        *o = x.as_f64()? as f32;
+    }
+    let q = Quat::from_array(q);
+    (q.is_finite() && (q.length() - 1.0).abs() < 1e-3).then_some(q)
 }
 
 fn vec3(v: &Value) -> Option<Vec3> {
@@ -294,4 +803,163 @@ fn vec3(v: &Value) -> Option<Vec3> {
         a[2].as_f64()? as f32,
     );
     p.is_finite().then_some(p)
+}
+
+/// The offset a writer stores for `rate` so that a reader dividing by `per_rate` in double
+/// precision ([`rate_of`]) gets `rate` back bit for bit: the nearest float to
+/// `rate × per_rate`, or one of its neighbours a few steps away when that one reads back
+/// differently (single-precision rounding of the product can land one step off).
+pub fn exact_offset(rate: f32, per_rate: f64) -> f32 {
+    let first = (f64::from(rate) * per_rate) as f32;
+    if !first.is_finite() || rate_of(first, per_rate) == rate {
+        return first;
+    }
+    let (mut up, mut down) = (first, first);
+    for _ in 0..4 {
+        up = float_step(up, true);
+        down = float_step(down, false);
+        for o in [up, down] {
+            if rate_of(o, per_rate) == rate {
+                return o;
+            }
+        }
+    }
+    first
+}
+
+/// The neighbouring float of finite `x` towards +∞ (`up`) or −∞ (`f32::next_up` is newer
+/// than the crate's minimum Rust).
+fn float_step(x: f32, up: bool) -> f32 {
+    if x == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if up { tiny } else { -tiny };
+    }
+    let bits = x.to_bits();
+    f32::from_bits(if (x > 0.0) == up { bits + 1 } else { bits - 1 })
+}
+
+/// The rate a stored `offset` shows when `per_rate` value units make it (see [`exact_offset`]).
+pub fn rate_of(offset: f32, per_rate: f64) -> f32 {
+    (f64::from(offset) / per_rate) as f32
+}
+
+/// Run lengths `[corners, count]` of a mesh's polygons when it has other polygons than
+/// triangles and [`regroup`] gives them back from the triangles a glTF holds; `None` else.
+pub fn polygon_runs(mesh: &crate::mesh::Mesh) -> Option<Vec<[usize; 2]>> {
+    if mesh.polygons.iter().all(|p| p.len() == 3) {
+        return None;
+    }
+    let mut runs: Vec<[usize; 2]> = Vec::new();
+    for p in mesh.polygons.iter() {
+        match runs.last_mut() {
+            Some(r) if r[0] == p.len() => r[1] += 1,
+            _ => runs.push([p.len(), 1]),
+        }
+    }
+    let triangles = crate::mesh::Polygons::from_triangles(&mesh.triangles());
+    (regroup(&triangles, &runs).as_ref() == Some(&mesh.polygons)).then_some(runs)
+}
+
+/// Polygons of `runs` (`[corners, count]`) from their triangles in order: each polygon's
+/// `corners − 2` triangles, walked round their outer edges from the first triangle's first
+/// corner (where a fan starts). `None` when the counts do not add up or a polygon's
+/// triangles do not make one loop.
+pub fn regroup(
+    triangles: &crate::mesh::Polygons,
+    runs: &[[usize; 2]],
+) -> Option<crate::mesh::Polygons> {
+    let mut out = crate::mesh::Polygons::new();
+    let mut next = 0usize;
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    let mut corners: Vec<u32> = Vec::new();
+    for &[n, count] in runs {
+        if n < 3 {
+            return None;
+        }
+        for _ in 0..count {
+            let tris: Vec<&[u32]> = (next..next + n - 2)
+                .map(|i| triangles.get(i).filter(|t| t.len() == 3))
+                .collect::<Option<_>>()?;
+            next += n - 2;
+            edges.clear();
+            for t in &tris {
+                for k in 0..3 {
+                    edges.push((t[k], t[(k + 1) % 3]));
+                }
+            }
+            let outer: Vec<(u32, u32)> = edges
+                .iter()
+                .copied()
+                .filter(|&(a, b)| !edges.contains(&(b, a)))
+                .collect();
+            if outer.len() != n {
+                return None;
+            }
+            corners.clear();
+            let mut at = tris[0][0];
+            for _ in 0..n {
+                corners.push(at);
+                at = outer.iter().find(|e| e.0 == at)?.1;
+            }
+            if at != corners[0] {
+                return None;
+            }
+            out.push(&corners);
+        }
+    }
+    (next == triangles.len()).then_some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_offsets_read_back_as_their_rates_where_one_exists() {
+        let mut exact = 0;
+        let mut total = 0;
+        for i in 1..2000u32 {
+            let rate = (i as f32 * 0.618_034).sin() * 1e-3;
+            for per in [95.0, 512.0, 0.001 * 340.0, 1.0] {
+                total += 1;
+                let o = exact_offset(rate, per);
+                let back = rate_of(o, per);
+                // Never more than one float step off.
+                assert!(
+                    back == rate
+                        || float_step(back, true) == rate
+                        || float_step(back, false) == rate
+                );
+                exact += usize::from(back == rate);
+            }
+        }
+        // Powers of two are always exact; the others mostly.
+        assert!(exact * 10 > total * 8, "{exact} of {total}");
+        assert_eq!(float_step(1.0, true), 1.0 + f32::EPSILON);
+        assert_eq!(float_step(-1.0, false), -1.0 - f32::EPSILON);
+        assert!(float_step(0.0, true) > 0.0 && float_step(0.0, false) < 0.0);
+    }
+
+    #[test]
+    fn polygons_regroup_from_their_fan_triangles() {
+        let quad = crate::mesh::Mesh::from_triangles(
+            "q",
+            vec![
+                Vec3::ZERO,
+                Vec3::X,
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::Y,
+                Vec3::new(2.0, 0.0, 0.0),
+            ],
+            &[],
+        );
+        let mut mesh = quad.clone();
+        mesh.polygons = crate::mesh::Polygons::from_lists([vec![0u32, 1, 2, 3], vec![1, 4, 2]]);
+        let runs = polygon_runs(&mesh).expect("a quad regroups");
+        assert_eq!(runs, vec![[4, 1], [3, 1]]);
+        let tris = crate::mesh::Polygons::from_triangles(&mesh.triangles());
+        assert_eq!(regroup(&tris, &runs), Some(mesh.polygons.clone()));
+        // Counts that do not add up are refused.
+        assert_eq!(regroup(&tris, &[[4, 2]]), None);
+    }
 }

@@ -408,6 +408,8 @@ pub fn morph_values(face: &FaceModel, value: Option<f64>) -> Vec<(TableKey, Vec<
         };
         out.push((t.key, values));
     }
+    // Keys in order whatever the tables' order, so equal FATs write the same set.
+    out.sort_by_key(|(k, _)| *k);
     out
 }
 

@@ -333,6 +333,23 @@ impl Fat {
         self.tables.iter().find(|t| t.key == key)
     }
 
+    /// The tables in fbakit's canonical order, for documents fbakit generates (so equal
+    /// FATs read in any order write the same bytes): by key (FAPs by number, then visemes,
+    /// then expressions; tables of one key keep their order), each table's entries by mesh
+    /// name and by transform name and field.
+    pub fn canonical_tables(&self) -> Vec<FaceDefTable> {
+        let mut tables = self.tables.clone();
+        tables.sort_by_key(|t| t.key);
+        for t in &mut tables {
+            t.meshes.sort_by(|a, b| a.mesh.cmp(&b.mesh));
+            t.transforms.sort_by(|a, b| {
+                (a.transform.as_str(), a.field.field_id())
+                    .cmp(&(b.transform.as_str(), b.field.field_id()))
+            });
+        }
+        tables
+    }
+
     /// Keys that have at least one table, sorted.
     pub fn keys(&self) -> Vec<TableKey> {
         let mut k: Vec<TableKey> = self.tables.iter().map(|t| t.key).collect();

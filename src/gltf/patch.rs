@@ -76,6 +76,10 @@ pub struct PatchAnimation {
     pub weights: Vec<(usize, Vec<f32>)>,
     /// Rotations per node: the node index and one rotation per key.
     pub rotations: Vec<(usize, Vec<Quat>)>,
+    /// Translations per node: the node index and one translation per key.
+    pub translations: Vec<(usize, Vec<Vec3>)>,
+    /// Scales per node: the node index and one scale per key.
+    pub scales: Vec<(usize, Vec<Vec3>)>,
 }
 
 /// What fbakit adds to a document.
@@ -507,7 +511,12 @@ fn read_floats(b: &Builder, acc: usize) -> Option<Vec<f32>> {
 }
 
 fn add_animation(b: &mut Builder, anim: &PatchAnimation) {
-    if anim.times.is_empty() || (anim.weights.is_empty() && anim.rotations.is_empty()) {
+    if anim.times.is_empty()
+        || (anim.weights.is_empty()
+            && anim.rotations.is_empty()
+            && anim.translations.is_empty()
+            && anim.scales.is_empty())
+    {
         return;
     }
     let tv = b.floats(&anim.times);
@@ -536,6 +545,18 @@ fn add_animation(b: &mut Builder, anim: &PatchAnimation) {
         channels
             .push(json!({"sampler": samplers.len(), "target": {"node": node, "path": "rotation"}}));
         samplers.push(json!({"input": times, "output": out, "interpolation": "LINEAR"}));
+    }
+    for (path, list) in [("translation", &anim.translations), ("scale", &anim.scales)] {
+        for (node, values) in list {
+            let flat: Vec<f32> = values.iter().flat_map(|v| v.to_array()).collect();
+            let v = b.floats(&flat);
+            let out = b.accessor(json!({
+                "bufferView": v, "componentType": FLOAT, "count": values.len(), "type": "VEC3"
+            }));
+            channels
+                .push(json!({"sampler": samplers.len(), "target": {"node": node, "path": path}}));
+            samplers.push(json!({"input": times, "output": out, "interpolation": "LINEAR"}));
+        }
     }
     b.array("animations").push(json!({
         "name": anim.name, "samplers": samplers, "channels": channels

@@ -36,8 +36,17 @@ pub(super) fn table_nodes(
         .zip(transform_nodes)
         .map(|(t, &id)| (t.name.as_str(), id))
         .collect();
-    let mut tables = Vec::with_capacity(face.fat.tables.len());
-    for table in &face.fat.tables {
+    // A face read from VRML keeps its file's table order; a generated file has the
+    // canonical one, so equal FATs in any order write the same bytes.
+    let canonical;
+    let in_order = if face.scene.is_some() {
+        &face.fat.tables
+    } else {
+        canonical = face.fat.canonical_tables();
+        &canonical
+    };
+    let mut tables = Vec::with_capacity(in_order.len());
+    for table in in_order {
         let (fap_id, select) = table.key.node_fields();
         let mut node = Node::new("FaceDefTables");
         node.fields
