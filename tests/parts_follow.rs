@@ -195,3 +195,125 @@ fn lash_primitive_follows_the_eyelid_not_the_jaw() {
     assert!(before > 0.0);
     assert!((again - before).abs() < 0.01 * before, "{again} vs {before}");
 }
+
+#[test]
+fn positions_snap_to_the_skin_and_the_pupils_to_the_eyes() {
+    let source = fbakit::face::read("alma").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    // 3.1 and 3.3 given exactly at lash vertices (the nearest vertex of all), 3.5 at the left
+    // pupil.
+    let lash = avatar::body_prims()[3].positions.clone();
+    let world = |p: Vec3| p * 0.01;
+    let (a, b) = (world(lash[1]), world(lash[2]));
+    let extra = format!("3.1,{},{},{}\n", a.x, a.y, a.z);
+    let csv = avatar_fp_csv(&source, dir.path(), "");
+    // Replace the 3.1 row and the 3.3 row by lash positions.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut body: String = text
+        .lines()
+        .filter(|l| !l.starts_with("3.1,") && !l.starts_with("3.3,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    body.push_str(&extra);
+    body.push_str(&format!("3.3,{},{},{}\n", b.x, b.y, b.z));
+    std::fs::write(&csv, body).unwrap();
+    let face = read_avatar(dir.path(), &csv);
+    let skin = face.mesh_index("Body.0").unwrap();
+    let eyes = face.mesh_index("Body.2").unwrap();
+    for p in face.feature_points.iter() {
+        let (m, _) = face.fp_vertex(p.id).unwrap();
+        let want = if ["3.5", "3.6"].contains(&p.id.to_string().as_str()) {
+            eyes
+        } else {
+            skin
+        };
+        assert_eq!(m, want, "{} on {}", p.id, face.meshes[m].name);
+    }
+    // The snap distance of the lash-placed points is the skin's, reported.
+    let o = support::cli::fbakit(&[
+        "face",
+        "info",
+        dir.path().join("avatar.glb").to_str().unwrap(),
+        "--fp",
+        csv.to_str().unwrap(),
+    ]);
+    let err = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("feature point 3.1 snapped") && err.contains("of `Body.0`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn obj_shape_sets_carry_their_materials_and_textures() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // bruno as one OBJ with a material library, a texture beside it in a subfolder, feature
+    // points by position.
+    let bruno = fbakit::face::read("bruno").unwrap();
+    let plain = d.join("plain.obj");
+    fbakit::face::write(&plain, &bruno).unwrap();
+    let src = d.join("src");
+    std::fs::create_dir_all(src.join("tex")).unwrap();
+    let text = std::fs::read_to_string(&plain).unwrap();
+    let obj = src.join("head.obj");
+    std::fs::write(&obj, format!("mtllib head.mtl\nusemtl skin\n{text}")).unwrap();
+    let mtl = "newmtl skin\nKd 0.8 0.7 0.6\nmap_Kd -s 1 1 1 tex/skin.png\nmap_Bump ../escape.png\n";
+    std::fs::write(src.join("head.mtl"), mtl).unwrap();
+    std::fs::write(src.join("tex/skin.png"), b"not really a png").unwrap();
+    let mut csv = String::from("fp,x,y,z\n");
+    for p in bruno.feature_points.iter() {
+        let q = p.position.unwrap();
+        csv.push_str(&format!("{},{},{},{}\n", p.id, q.x, q.y, q.z));
+    }
+    let fp_csv = d.join("fp.csv");
+    std::fs::write(&fp_csv, csv).unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let set = d.join("out/");
+    let o = support::cli::fbakit(&[
+        "clone",
+        "alma",
+        &s(&obj),
+        "--fp-target",
+        &s(&fp_csv),
+        "-o",
+        &s(&set),
+        "--json",
+    ]);
+    let err = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let neutral = std::fs::read_to_string(set.join("neutral.obj")).unwrap();
+    assert!(neutral.starts_with("mtllib head.mtl\nusemtl skin\n"));
+    assert_eq!(
+        std::fs::read_to_string(set.join("head.mtl")).unwrap(),
+        mtl
+    );
+    assert_eq!(
+        std::fs::read(set.join("tex/skin.png")).unwrap(),
+        b"not really a png"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["shapes"]["materials"].as_array().unwrap().len(), 2, "{}", v["shapes"]);
+    // `map_Bump ../escape.png` reaches out of the folder: warned about, not copied.
+    assert!(err.contains("`../escape.png` lies outside the file's folder"), "{err}");
+    assert!(!d.join("escape.png").exists());
+    // `.obj` out: the libraries beside the neutral and in its shapes folder.
+    let out = d.join("o2/head-out.obj");
+    std::fs::create_dir_all(d.join("o2")).unwrap();
+    let o = support::cli::fbakit(&[
+        "clone",
+        "alma",
+        &s(&obj),
+        "--fp-target",
+        &s(&fp_csv),
+        "-o",
+        &s(&out),
+        "--names",
+        "fat",
+    ]);
+    assert!(o.status.success(), "{}", support::cli::text(&o.stderr));
+    assert!(d.join("o2/head.mtl").is_file());
+    assert!(d.join("o2/head-out_shapes/head.mtl").is_file());
+    assert!(d.join("o2/tex/skin.png").is_file());
+}

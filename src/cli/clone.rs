@@ -9,7 +9,9 @@ use fbakit::clone::eval::{
 };
 use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
 use fbakit::error::{Error, Result, ResultExt};
-use fbakit::export::obj_shapes::{write_obj_shapes, ObjShapesReport, ShapeNames};
+use fbakit::export::obj_shapes::{
+    copy_obj_materials, write_obj_shapes, ObjShapesReport, ShapeNames,
+};
 use fbakit::export::write_face;
 use fbakit::face::{FaceFormat, FaceModel};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
@@ -341,9 +343,11 @@ pub fn run(args: CloneArgs) -> Result<u8> {
             ShapeNames::Fat
         };
         let mut report = write_obj_shapes(&outcome.face, &args.output, names)?;
+        copy_obj_materials(&outcome.face, &args.target, &mut report)?;
         arkit = report.arkit.take();
+        let warnings = std::mem::take(&mut report.warnings);
         shapes = Some(report);
-        Vec::new()
+        warnings
     } else if arkit_names {
         let (report, warnings) =
             fbakit::rig::arkit_export::write_arkit_gltf(&outcome.face, &args.output, None)?;

@@ -240,26 +240,29 @@ fn attach_file(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    attach_feature_points(face, file.points, &[&alias]).map_err(|e| {
-        let id = match &e {
-            crate::error::Error::Face(super::FaceError::UnknownFeaturePointMeshes {
-                first, ..
-            }) => Some(*first),
-            crate::error::Error::Face(super::FaceError::FeaturePointVertexOutOfRange {
-                id, ..
-            }) => Some(*id),
-            _ => None,
-        };
-        match id.and_then(|id| csv_line_of(fp, id)) {
-            Some(line) => super::FaceError::InFileAt {
-                file: fp.to_path_buf(),
-                line,
-                source: Box::new(e),
-            }
-            .into(),
-            None => super::FaceError::in_file(fp, e).into(),
+    attach_feature_points(face, file.points, &[&alias]).map_err(|e| in_fp_file(fp, e).into())
+}
+
+/// A problem of the feature points of file `fp` (that do not fit the face), prefixed with the
+/// file and, for a CSV row naming an unknown mesh or a vertex out of range, its line.
+pub(crate) fn in_fp_file(fp: &Path, e: crate::error::Error) -> super::FaceError {
+    let id = match &e {
+        crate::error::Error::Face(super::FaceError::UnknownFeaturePointMeshes { first, .. }) => {
+            Some(*first)
         }
-    })
+        crate::error::Error::Face(super::FaceError::FeaturePointVertexOutOfRange {
+            id, ..
+        }) => Some(*id),
+        _ => None,
+    };
+    match id.and_then(|id| csv_line_of(fp, id)) {
+        Some(line) => super::FaceError::InFileAt {
+            file: fp.to_path_buf(),
+            line,
+            source: Box::new(e),
+        },
+        None => super::FaceError::in_file(fp, e),
+    }
 }
 
 /// The 1-based line of the CSV feature-point file `fp` whose first field is point `id`
