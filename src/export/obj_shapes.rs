@@ -153,7 +153,10 @@ pub fn copy_obj_materials(
         let mtl_dir = rel.parent().map(Path::to_path_buf).unwrap_or_default();
         let maps = statement_args(
             &String::from_utf8_lossy(&mtl),
-            &["map_Ka", "map_Kd", "map_Ks", "map_Ke", "map_Ns", "map_d", "map_bump", "bump", "disp", "decal", "norm", "map_Pr", "map_Pm"],
+            &[
+                "map_Ka", "map_Kd", "map_Ks", "map_Ke", "map_Ns", "map_d", "map_bump", "bump",
+                "disp", "decal", "norm", "map_Pr", "map_Pm",
+            ],
         );
         for map in maps {
             // Options (`-s 1 1 1`) come first: the file is the last word.
@@ -183,14 +186,16 @@ pub fn copy_obj_materials(
         }
     }
     for rel in &files {
-        let bytes = std::fs::read(from.join(rel)).map_err(|e| crate::error::Error::io(from.join(rel), e))?;
+        let bytes = std::fs::read(from.join(rel))
+            .map_err(|e| crate::error::Error::io(from.join(rel), e))?;
         for d in &dests {
             let to = d.join(rel);
             if to == from.join(rel) {
                 continue;
             }
             if let Some(parent) = to.parent() {
-                std::fs::create_dir_all(parent).map_err(|e| crate::error::Error::output(parent, e))?;
+                std::fs::create_dir_all(parent)
+                    .map_err(|e| crate::error::Error::output(parent, e))?;
             }
             crate::io::write_atomic(&to, &bytes)?;
             report.materials.push(to);
@@ -206,7 +211,8 @@ fn statement_args(text: &str, keywords: &[&str]) -> Vec<String> {
             let l = l.trim();
             let (kw, rest) = l.split_once(char::is_whitespace)?;
             keywords
-                .contains(&kw)
+                .iter()
+                .any(|k| k.eq_ignore_ascii_case(kw))
                 .then(|| rest.trim().to_string())
                 .filter(|r| !r.is_empty())
         })
@@ -220,10 +226,12 @@ fn relative_inside(name: &str, file: &Path, warnings: &mut Vec<Diagnostic>) -> O
     if p.is_absolute() {
         return None;
     }
-    if p
-        .components()
-        .any(|c| !matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir))
-    {
+    if p.components().any(|c| {
+        !matches!(
+            c,
+            std::path::Component::Normal(_) | std::path::Component::CurDir
+        )
+    }) {
         warnings.push(Diagnostic::warning(format!(
             "{}: `{name}` lies outside the file's folder; not copied",
             file.display()

@@ -7,11 +7,11 @@
 //! [`MAX_SNAP_FRACTION`] of the face size (the diagonal of its neutral bounding box) from
 //! every vertex is refused; [`snap_warnings`] names the snaps beyond [`WARN_SNAP_FRACTION`].
 
+use super::snap::SnapIndex;
 use super::vrml::FeaturePointMatch;
 use super::FaceModel;
 use crate::error::Diagnostic;
 use crate::error::Result;
-use super::snap::SnapIndex;
 use crate::fdp::FeaturePointSet;
 
 /// Largest snap distance, as a fraction of the face size, for a point given by position.

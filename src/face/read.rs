@@ -247,9 +247,9 @@ fn attach_file(
 /// file and, for a CSV row naming an unknown mesh or a vertex out of range, its line.
 pub(crate) fn in_fp_file(fp: &Path, e: crate::error::Error) -> super::FaceError {
     let id = match &e {
-        crate::error::Error::Face(super::FaceError::UnknownFeaturePointMeshes { first, .. }) => {
-            Some(*first)
-        }
+        crate::error::Error::Face(super::FaceError::UnknownFeaturePointMeshes {
+            first, ..
+        }) => Some(*first),
         crate::error::Error::Face(super::FaceError::FeaturePointVertexOutOfRange {
             id, ..
         }) => Some(*id),
