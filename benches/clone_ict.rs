@@ -1,6 +1,7 @@
 //! Cloning between real heads: ICT head A (rig FAT, 14 FAPs) onto the reshaped head B of the
 //! ground truth (tests/support/ict_truth.rs), every method, alma onto the bundled
-//! one-mesh `ict` (parts split out); dense CANDIDE-3 onto `ict` is `clone_candide_ict`. The
+//! one-mesh `ict` (parts split out), alma onto the `ict-head.glb` sample written back as a
+//! patched glb; dense CANDIDE-3 onto `ict` is `clone_candide_ict`. The
 //! ICT cases are skipped when `../shared/data/ict-facekit` is absent. Quality figures are printed once per case.
 
 #[path = "../tests/support/ict_truth.rs"]
@@ -66,4 +67,22 @@ fn alma_to_bundled_ict(method: Method) {
         )
     });
     divan::black_box(clone_face(alma, ict, &opts(method)).expect("clone"));
+}
+
+/// What `fbakit clone alma ict-head.glb --fp-target ict-head-fp.csv -o out.glb` does: read the
+/// glb target with its feature points, clone by `fit`, write the patched glb (the user's
+/// document with the new morph targets).
+#[divan::bench(sample_count = 5)]
+fn alma_to_ict_head_glb_patched() {
+    static F: OnceLock<FaceModel> = OnceLock::new();
+    let alma = F.get_or_init(|| fbakit::face::read("alma").expect("alma"));
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/faces/ict-head");
+    let (target, _) = fbakit::face::read_with(
+        dir.join("ict-head.glb"),
+        &fbakit::face::FaceReadOptions::with_feature_points(Some(&dir.join("ict-head-fp.csv"))),
+    )
+    .expect("ict-head.glb");
+    let out = clone_face(alma, &target, &opts(Method::Fit)).expect("clone");
+    let tmp = tempfile::tempdir().expect("temp dir");
+    fbakit::export::write_face(tmp.path().join("out.glb"), &out.face).expect("write");
 }

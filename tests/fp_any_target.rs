@@ -122,8 +122,10 @@ fn mesh_column_names_glb_primitives() {
             assert_eq!(names, ["mesh0.0", "mesh0.1"]);
             ("#0/0", "#0/1")
         };
+        // The glTF mesh's own name (`body`, its node being `avatar`) names primitives too.
+        let by_mesh = if named { "body/1" } else { "#0/1" };
         let csv = format!(
-            "fp,vertices,mesh\n2.1,0,{skin}\n3.5,6,{eye}\n9.3,5,{}\n",
+            "fp,vertices,mesh\n2.1,0,{skin}\n3.5,6,{eye}\n9.3,5,{}\n3.6,7,{by_mesh}\n",
             face.meshes[1].name
         );
         let table = fbakit::fdp::csv::parse_csv(&csv, Path::new("fp.csv")).unwrap();
@@ -132,6 +134,7 @@ fn mesh_column_names_glb_primitives() {
         assert_eq!(face.fp_vertex(id("2.1")), Some((0, 0)));
         assert_eq!(face.fp_vertex(id("3.5")), Some((1, 6)));
         assert_eq!(face.fp_vertex(id("9.3")), Some((1, 5)));
+        assert_eq!(face.fp_vertex(id("3.6")), Some((1, 7)));
         assert_eq!(
             face.feature_points.position(id("3.5")),
             Some(cube_positions()[6] * 0.1 + Vec3::new(0.2, 0.2, 0.6))
@@ -158,7 +161,7 @@ fn bad_feature_points_exit_2_with_one_line_naming_the_file() {
             ),
             glb,
             vec![
-                "unknown.csv",
+                "unknown.csv:3:",
                 "3.5 names mesh `hat/1`",
                 "avatar.0, avatar.1",
             ],
@@ -169,7 +172,18 @@ fn bad_feature_points_exit_2_with_one_line_naming_the_file() {
                 "fp,vertices,mesh\n2.1,0,avatar/0\n3.5,20,avatar/1\n",
             ),
             glb,
-            vec!["range.csv", "20"],
+            vec![
+                "range.csv:3:",
+                "feature point 3.5 is bound to vertex 20 of mesh `avatar.1`, which has 8 vertices",
+            ],
+        ),
+        (
+            put(
+                "node-range.csv",
+                "fp,vertices,mesh\n2.1,0,avatar/0\n\n3.5,8,body/1\n",
+            ),
+            glb,
+            vec!["node-range.csv:4:", "vertex 8 of mesh `avatar.1`"],
         ),
         (
             put("far.csv", "fp,x,y,z\n2.1,0.5,0.5,0.5\n3.5,40,0,0\n"),

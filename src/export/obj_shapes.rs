@@ -3,8 +3,9 @@
 //! A face read from OBJ (that still has that file's layout) gets the user's file back in every
 //! one of them — groups, `usemtl`/`mtllib`, `vt`, `vn`, comments kept — with only the `v` lines
 //! rewritten ([`crate::face::write::source_obj_text`]); other faces get their meshes merged in
-//! face coordinates, as OBJ output always does. The `.mtl` files a `mtllib` names are not
-//! copied.
+//! face coordinates, as OBJ output always does. [`copy_obj_materials`] copies the `.mtl` files
+//! the user's `mtllib` lines name, and the textures those name by relative path, beside every
+//! written OBJ, so `mtllib` still points at its materials.
 //!
 //! **Where.** `DIR/`: `neutral.obj`, `feature-points.csv` and the shapes, a morph set that
 //! `face from-morphs DIR/neutral.obj DIR --fp DIR/feature-points.csv` reads back. `OUT.obj`:
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::Serialize;
 
-use crate::error::Result;
+use crate::error::{Diagnostic, Result};
 use crate::face::morphs::{
     merged_feature_points, write_morph_set, FEATURE_POINTS_FILE, NEUTRAL_FILE,
 };
@@ -59,6 +60,13 @@ pub struct ObjShapesReport {
     /// With [`ShapeNames::Arkit`]: the shapes made and those left out.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub arkit: Option<ArkitExportReport>,
+    /// Material libraries and textures copied from beside the user's OBJ
+    /// ([`copy_obj_materials`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<PathBuf>,
+    /// Material files that could not be carried over (missing, outside the OBJ's folder).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// The folder `OUT.obj`'s shapes go into: `OUT_shapes` beside it.
@@ -112,6 +120,126 @@ pub fn write_obj_shapes(
         report.neutral = out.to_path_buf();
     }
     Ok(report)
+}
+
+/// Copies the material libraries the face's own OBJ text names (`mtllib`, relative to the
+/// folder of `source_obj`, the file the face was read from) beside the OBJs `report` lists
+/// (the neutral's folder and the shapes' folder), and the texture maps each library names by
+/// a relative path, keeping their relative places so every `mtllib` and `map_*` still
+/// resolves. Absolute paths are left as they are (they resolve anywhere); names reaching out
+/// of the folder (`..`) and missing files are warnings in the report. Each file is written
+/// atomically. A face not read from OBJ has nothing to copy.
+pub fn copy_obj_materials(
+    face: &FaceModel,
+    source_obj: &Path,
+    report: &mut ObjShapesReport,
+) -> Result<()> {
+    let Some(text) = face.obj_source.as_deref() else {
+        return Ok(());
+    };
+    let from = source_obj.parent().unwrap_or(Path::new("."));
+    let mut files: Vec<PathBuf> = Vec::new();
+    for lib in statement_args(text, &["mtllib"]) {
+        let Some(rel) = relative_inside(&lib, source_obj, &mut report.warnings) else {
+            continue;
+        };
+        let Ok(mtl) = std::fs::read(from.join(&rel)) else {
+            report.warnings.push(Diagnostic::warning(format!(
+                "{}: material library `{lib}` not found beside it; not copied",
+                source_obj.display()
+            )));
+            continue;
+        };
+        files.push(rel.clone());
+        let mtl_dir = rel.parent().map(Path::to_path_buf).unwrap_or_default();
+        let maps = statement_args(
+            &String::from_utf8_lossy(&mtl),
+            &[
+                "map_Ka", "map_Kd", "map_Ks", "map_Ke", "map_Ns", "map_d", "map_bump", "bump",
+                "disp", "decal", "norm", "map_Pr", "map_Pm",
+            ],
+        );
+        for map in maps {
+            // Options (`-s 1 1 1`) come first: the file is the last word.
+            let Some(name) = map.split_whitespace().last() else {
+                continue;
+            };
+            let Some(tex) = relative_inside(name, &from.join(&rel), &mut report.warnings) else {
+                continue;
+            };
+            let tex = mtl_dir.join(tex);
+            if from.join(&tex).is_file() {
+                if !files.contains(&tex) {
+                    files.push(tex);
+                }
+            } else {
+                report.warnings.push(Diagnostic::warning(format!(
+                    "{}: texture `{name}` not found; not copied",
+                    from.join(&rel).display()
+                )));
+            }
+        }
+    }
+    let mut dests: Vec<PathBuf> = vec![report.folder.clone()];
+    if let Some(d) = report.neutral.parent() {
+        if !dests.iter().any(|x| x == d) {
+            dests.push(d.to_path_buf());
+        }
+    }
+    for rel in &files {
+        let bytes = std::fs::read(from.join(rel))
+            .map_err(|e| crate::error::Error::io(from.join(rel), e))?;
+        for d in &dests {
+            let to = d.join(rel);
+            if to == from.join(rel) {
+                continue;
+            }
+            if let Some(parent) = to.parent() {
+                std::fs::create_dir_all(parent)
+                    .map_err(|e| crate::error::Error::output(parent, e))?;
+            }
+            crate::io::write_atomic(&to, &bytes)?;
+            report.materials.push(to);
+        }
+    }
+    Ok(())
+}
+
+/// The arguments of every statement of `text` whose keyword is one of `keywords` (trimmed).
+fn statement_args(text: &str, keywords: &[&str]) -> Vec<String> {
+    text.lines()
+        .filter_map(|l| {
+            let l = l.trim();
+            let (kw, rest) = l.split_once(char::is_whitespace)?;
+            keywords
+                .iter()
+                .any(|k| k.eq_ignore_ascii_case(kw))
+                .then(|| rest.trim().to_string())
+                .filter(|r| !r.is_empty())
+        })
+        .collect()
+}
+
+/// `name` (a file a `mtllib` or `map_*` in `file` names) as a path relative to that file's
+/// folder; `None`, with a warning for names outside it, for absolute and escaping names.
+fn relative_inside(name: &str, file: &Path, warnings: &mut Vec<Diagnostic>) -> Option<PathBuf> {
+    let p = Path::new(name);
+    if p.is_absolute() {
+        return None;
+    }
+    if p.components().any(|c| {
+        !matches!(
+            c,
+            std::path::Component::Normal(_) | std::path::Component::CurDir
+        )
+    }) {
+        warnings.push(Diagnostic::warning(format!(
+            "{}: `{name}` lies outside the file's folder; not copied",
+            file.display()
+        )));
+        return None;
+    }
+    Some(p.to_path_buf())
 }
 
 /// The ARKit-named set in `dir`: neutral, feature points and one OBJ per shape.

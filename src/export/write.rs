@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 pub use super::obj_shapes::ShapeNames;
-use super::obj_shapes::{write_obj_shapes, ObjShapesReport};
+use super::obj_shapes::{copy_obj_materials, write_obj_shapes, ObjShapesReport};
 use crate::error::{Diagnostic, Error, Result};
 use crate::face::units::LengthUnit;
 use crate::face::FaceModel;
@@ -151,6 +151,10 @@ pub fn write(
         OutputFormat::Glb | OutputFormat::Gltf => write_gltf(path, face, options),
         OutputFormat::Obj | OutputFormat::Directory => {
             let mut shapes = write_obj_shapes(path, face, options.names)?;
+            if let Some(obj) = &face.obj_path {
+                copy_obj_materials(face, obj, &mut shapes)?;
+            }
+            let warnings = std::mem::take(&mut shapes.warnings);
             Ok(ExportReport {
                 output: path.to_path_buf(),
                 kind: ExportKind::ObjShapes,
@@ -163,7 +167,7 @@ pub fn write(
                 units: own_units(face),
                 arkit: shapes.arkit.take(),
                 shapes: Some(shapes),
-                warnings: Vec::new(),
+                warnings,
             })
         }
         _ => {

@@ -1,16 +1,17 @@
 //! Putting feature points from a separate file on a face's meshes: bound points on their
-//! vertices, position-only points on the nearest vertex.
+//! vertices, position-only points on the nearest vertex of the skin, or of the eye or teeth
+//! part for the points the standard puts there ([`super::snap`]).
 //!
 //! A binding's mesh may be named as the face names it, or for a glTF face by
 //! [`FaceModel::resolve_mesh_spec`]'s rule (`Name/1`, `#3/1`). A position farther than
 //! [`MAX_SNAP_FRACTION`] of the face size (the diagonal of its neutral bounding box) from
 //! every vertex is refused; [`snap_warnings`] names the snaps beyond [`WARN_SNAP_FRACTION`].
 
+use super::snap::SnapIndex;
 use super::vrml::FeaturePointMatch;
 use super::FaceModel;
 use crate::error::Diagnostic;
 use crate::error::Result;
-use crate::face::vertex_index::FaceVertexIndex;
 use crate::fdp::FeaturePointSet;
 
 /// Largest snap distance, as a fraction of the face size, for a point given by position.
@@ -96,25 +97,53 @@ pub fn attach_feature_points(
                 b.mesh = Some(only.clone())
             }
             (_, Some(_)) if resolved.is_some() => b.mesh = resolved,
-            (_, m) => bad.push(format!(
-                "{id} names mesh {}",
-                m.map_or("<none>".to_string(), |m| format!("`{m}`"))
+            (_, m) => bad.push((
+                id,
+                format!(
+                    "{id} names mesh {}",
+                    m.map_or("<none>".to_string(), |m| format!("`{m}`"))
+                ),
             )),
         }
     }
-    if !bad.is_empty() {
+    if let Some(&(first, _)) = bad.first() {
         let names: Vec<&str> = face.meshes.iter().map(|m| m.name.as_str()).collect();
+        let points: Vec<&str> = bad.iter().map(|b| b.1.as_str()).collect();
         return Err(super::FaceError::UnknownFeaturePointMeshes {
-            points: bad.join(", "),
+            first,
+            points: points.join(", "),
             meshes: names.join(", "),
         }
         .into());
     }
+    // Vertex ids beyond their mesh, the first named with its mesh's range.
+    for p in points.iter() {
+        let Some(b) = &p.binding else {
+            continue;
+        };
+        let mi = match b.mesh.as_deref() {
+            Some(m) => face.mesh_index(m),
+            None => single.as_ref().and(Some(0)),
+        };
+        let Some(mesh) = mi.and_then(|i| face.meshes.get(i)) else {
+            continue;
+        };
+        let count = mesh.mesh.positions.len();
+        if let Some(&vertex) = b.vertices.iter().find(|&&v| v as usize >= count) {
+            return Err(super::FaceError::FeaturePointVertexOutOfRange {
+                id: p.id,
+                mesh: mesh.name.clone(),
+                vertex,
+                count,
+            }
+            .into());
+        }
+    }
     face.feature_points = points;
     face.resolve_feature_points()?;
 
-    // Position-only points: bind to the nearest vertex of any mesh.
-    let index = FaceVertexIndex::new(face);
+    // Position-only points: bind to the nearest vertex of the skin, or of the part for
+    // pupils, teeth and tongue (`super::snap`).
     let mut matches = Vec::new();
     let unbound: Vec<_> = face
         .feature_points
@@ -122,12 +151,22 @@ pub fn attach_feature_points(
         .filter(|p| p.binding.is_none())
         .filter_map(|p| Some((p.id, p.position?)))
         .collect();
+    if let Some((id, _)) = unbound.iter().find(|(_, p)| !p.is_finite()) {
+        return Err(super::FaceError::NonFiniteFeaturePoint { id: *id }.into());
+    }
+    if unbound.is_empty() {
+        return Ok(matches);
+    }
+    let bound: Vec<usize> = face
+        .feature_points
+        .iter()
+        .filter_map(|p| p.binding.as_ref()?.mesh.as_deref())
+        .filter_map(|m| face.mesh_index(m))
+        .collect();
+    let index = SnapIndex::new(face, &unbound, &bound);
     let limit = MAX_SNAP_FRACTION * face_size(face);
     for (id, pos) in unbound {
-        if !pos.is_finite() {
-            return Err(super::FaceError::NonFiniteFeaturePoint { id }.into());
-        }
-        let Some((binding, found)) = index.bind(face, id, pos) else {
+        let Some((binding, found)) = index.for_point(id, pos).bind(face, id, pos) else {
             continue;
         };
         if found.distance > limit {

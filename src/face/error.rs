@@ -22,6 +22,17 @@ pub enum FaceError {
         /// The problem.
         source: Box<Error>,
     },
+    /// An error about one line of another input (a feature-point CSV row that does not fit
+    /// the face), prefixed with the file and line.
+    #[error("{}:{line}: {source}", file.display())]
+    InFileAt {
+        /// The file the problem is in.
+        file: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// The problem.
+        source: Box<Error>,
+    },
     /// A folder given as a face is not an OBJ rig folder.
     #[error("{}: is a directory and not a rig folder ({reason}); expected a face file (.wrl, \
              .wrl.gz, .obj, .wfm, .glb, .gltf), a folder of rig shape OBJs or a bundled face \
@@ -90,10 +101,24 @@ pub enum FaceError {
     /// Feature points name meshes the face does not have.
     #[error("feature points bound to meshes the face does not have ({points}); the face's meshes: {meshes}")]
     UnknownFeaturePointMeshes {
+        /// The first such point (its line is looked up for the message).
+        first: crate::spec::FeaturePointId,
         /// Each point and the mesh it names, comma-separated.
         points: String,
         /// The face's mesh names, comma-separated.
         meshes: String,
+    },
+    /// A feature point is bound to a vertex its mesh does not have.
+    #[error("feature point {id} is bound to vertex {vertex} of mesh `{mesh}`, which has {count} vertices (ids 0 to {last})", last = count.saturating_sub(1))]
+    FeaturePointVertexOutOfRange {
+        /// The point.
+        id: crate::spec::FeaturePointId,
+        /// The mesh, as the face names it.
+        mesh: String,
+        /// The vertex id given.
+        vertex: u32,
+        /// The mesh's vertex count.
+        count: usize,
     },
     /// A feature point given by position is far from every vertex of the face.
     #[error("feature point {id} is {distance} from the nearest vertex, more than a tenth of the face size ({limit}); are the positions in the face file's frame and units (`fbakit face info`)?")]

@@ -57,7 +57,7 @@ pub(crate) fn rig_face(
     let (mut face, mut fat) =
         face_from_rig(rig, Some(points), &FapMap::arkit()).map_err(|e| match e {
             crate::error::Error::Rig(_) => e,
-            e => super::FaceError::in_file(fp, e).into(),
+            e => super::read::in_fp_file(fp, e).into(),
         })?;
     face.name = super::format::face_name(path);
     report.fp_matches = std::mem::take(&mut fat.fp_matches);

@@ -23,6 +23,7 @@ pub mod mouth;
 pub mod parts;
 pub mod pose;
 pub mod read;
+pub mod snap;
 pub mod subdivide;
 pub mod summary;
 pub mod units;
@@ -158,6 +159,9 @@ pub struct FaceModel {
     /// The OBJ text it was read from, kept so OBJ outputs keep the user's file (groups,
     /// materials, `vt`, `vn`, comments) and rewrite only its `v` lines ([`crate::mesh::obj_patch`]).
     pub obj_source: Option<std::sync::Arc<str>>,
+    /// The OBJ file it was read from: its material libraries and textures are found beside
+    /// it when OBJ outputs copy them.
+    pub obj_path: Option<std::path::PathBuf>,
     /// The glTF document it was read from, kept so glTF outputs patch it (mesh names match
     /// [`crate::gltf::source::SourcePart::face_mesh`]).
     pub gltf_source: Option<std::sync::Arc<crate::gltf::source::GltfSource>>,
@@ -192,6 +196,7 @@ impl FaceModel {
             fat: Fat::default(),
             scene: None,
             obj_source: None,
+            obj_path: None,
             gltf_source: None,
         }
     }
@@ -226,14 +231,40 @@ impl FaceModel {
         if let Some(i) = self.mesh_index(spec) {
             return Some(i);
         }
-        let (base, p) = spec.rsplit_once('/')?;
-        let p: usize = p.trim().parse().ok()?;
+        let (base, p) = match spec.rsplit_once('/') {
+            Some((base, p)) => (base, p.trim().parse::<usize>().ok()?),
+            None => (spec, 0),
+        };
+        if let Some(i) = self.resolve_gltf_spec(base, p) {
+            return Some(i);
+        }
         let base = match base.strip_prefix('#') {
             Some(m) => format!("mesh{}", m.trim().parse::<usize>().ok()?),
             None => base.to_string(),
         };
         self.mesh_index(&format!("{base}.{p}"))
             .or_else(|| (p == 0).then(|| self.mesh_index(&base)).flatten())
+    }
+
+    /// Primitive `p` of the glTF node or mesh named `base` (or of mesh `#m`) in the document
+    /// the face was read from: the face mesh it became, first instance first.
+    fn resolve_gltf_spec(&self, base: &str, p: usize) -> Option<usize> {
+        let doc = self.gltf_source.as_deref()?;
+        let name_of = |list: &str, i: usize| doc.json[list][i]["name"].as_str();
+        let index = base
+            .strip_prefix('#')
+            .and_then(|m| m.trim().parse::<usize>().ok());
+        let part = doc.parts.iter().find(|s| {
+            s.primitive == p
+                && match index {
+                    Some(m) => s.mesh == m,
+                    None => {
+                        name_of("meshes", s.mesh) == Some(base)
+                            || s.node.and_then(|n| name_of("nodes", n)) == Some(base)
+                    }
+                }
+        })?;
+        self.mesh_index(&part.face_mesh)
     }
 
     /// Index of the transform named `name`.

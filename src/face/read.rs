@@ -201,6 +201,7 @@ fn obj_face(path: &Path, bytes: &[u8], name: &str) -> Result<(FaceModel, FaceRea
     let (obj, diagnostics) = crate::mesh::obj::parse_obj(&text, path)?;
     let mut face = FaceModel::single_mesh(name, obj.mesh);
     face.obj_source = Some(text.into());
+    face.obj_path = Some(path.to_path_buf());
     let report = FaceReadReport {
         diagnostics,
         mesh_paths: vec![format!("OBJ {}", path.display())],
@@ -240,8 +241,46 @@ fn attach_file(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    attach_feature_points(face, file.points, &[&alias])
-        .map_err(|e| super::FaceError::in_file(fp, e).into())
+    attach_feature_points(face, file.points, &[&alias]).map_err(|e| in_fp_file(fp, e).into())
+}
+
+/// A problem of the feature points of file `fp` (that do not fit the face), prefixed with the
+/// file and, for a CSV row naming an unknown mesh or a vertex out of range, its line.
+pub(crate) fn in_fp_file(fp: &Path, e: crate::error::Error) -> super::FaceError {
+    let id = match &e {
+        crate::error::Error::Face(super::FaceError::UnknownFeaturePointMeshes {
+            first, ..
+        }) => Some(*first),
+        crate::error::Error::Face(super::FaceError::FeaturePointVertexOutOfRange {
+            id, ..
+        }) => Some(*id),
+        _ => None,
+    };
+    match id.and_then(|id| csv_line_of(fp, id)) {
+        Some(line) => super::FaceError::InFileAt {
+            file: fp.to_path_buf(),
+            line,
+            source: Box::new(e),
+        },
+        None => super::FaceError::in_file(fp, e),
+    }
+}
+
+/// The 1-based line of the CSV feature-point file `fp` whose first field is point `id`
+/// (`None` for other formats or an unreadable file: the message then names the file alone).
+fn csv_line_of(fp: &Path, id: crate::spec::FeaturePointId) -> Option<usize> {
+    let is_csv = fp
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    if !is_csv {
+        return None;
+    }
+    let bytes = crate::io::read_bounded_text(fp, crate::io::DEFAULT_MAX_INPUT_BYTES).ok()?;
+    let text = String::from_utf8_lossy(&bytes);
+    let want = id.to_string();
+    text.lines()
+        .position(|l| l.split(',').next().map(|f| f.trim().trim_matches('"')) == Some(&want))
+        .map(|i| i + 1)
 }
 
 #[cfg(test)]

@@ -19,10 +19,19 @@ pub struct FaceVertexIndex {
 impl FaceVertexIndex {
     /// Indexes every vertex of `face` at neutral, placed by its mesh's transform chain.
     pub fn new(face: &FaceModel) -> FaceVertexIndex {
+        let all: Vec<usize> = (0..face.meshes.len()).collect();
+        FaceVertexIndex::of_meshes(face, &all)
+    }
+
+    /// Indexes the vertices of the meshes `meshes` of `face` (indices; unknown ones skipped).
+    pub fn of_meshes(face: &FaceModel, meshes: &[usize]) -> FaceVertexIndex {
         let frames = face.frames();
         let mut owners = Vec::with_capacity(face.vertex_count());
         let mut world = Vec::with_capacity(face.vertex_count());
-        for (mi, m) in face.meshes.iter().enumerate() {
+        for &mi in meshes {
+            let Some(m) = face.meshes.get(mi) else {
+                continue;
+            };
             for (vi, p) in m.mesh.positions.iter().enumerate() {
                 owners.push((mi, vi as u32));
                 world.push(frames.meshes[mi].transform_point3(*p));

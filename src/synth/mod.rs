@@ -412,6 +412,7 @@ impl SynthFace {
             fat: face.fat.clone(),
             scene: None,
             obj_source: None,
+            obj_path: None,
             gltf_source: None,
         }
     }

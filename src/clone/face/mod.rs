@@ -129,6 +129,7 @@
 
 mod align;
 mod assemble;
+mod attached;
 mod fold;
 mod motions;
 mod options;
@@ -231,8 +232,10 @@ pub fn clone_face(
     tparts.parts.retain(|_, l| !l.is_empty());
     report.split_parts = split;
     report.timings.push("parts", clock.elapsed().as_secs_f64());
-    check_parts(source, &sparts, "source", &mut report.warnings)?;
-    check_parts(target, &tparts, "target", &mut report.warnings)?;
+    check_parts(&sparts, "source")?;
+    warn_others(source, &sparts.other, "source", &mut report.warnings);
+    // The target's others are named once step 8 knows which of them ride on the skin.
+    check_parts(&tparts, "target")?;
     target_check::check_target(target, &tparts, &mut report.warnings);
     // 2. Alignment.
     let clock = Instant::now();
@@ -316,6 +319,29 @@ pub fn clone_face(
     for (key, meshes) in deformed.meshes {
         part_meshes.entry(key).or_default().extend(meshes);
     }
+    // Small meshes on the skin (lashes as their own mesh or primitive) ride on it.
+    let frames = face.frames();
+    let riders = attached::attach_to_skin(&face, &frames, &tparts, &tsurf, &alignment);
+    for m in &cloned_motions {
+        let meshes = attached::attached_motion(&face, &frames, &riders, &tsurf, &alignment, m);
+        if !meshes.is_empty() {
+            part_meshes
+                .entry((m.key, m.value.to_bits()))
+                .or_default()
+                .extend(meshes);
+        }
+    }
+    report.attached_meshes = riders
+        .iter()
+        .map(|r| face.meshes[r.mesh].name.clone())
+        .collect();
+    let rigid_others: Vec<usize> = tparts
+        .other
+        .iter()
+        .copied()
+        .filter(|&m| !riders.iter().any(|r| r.mesh == m))
+        .collect();
+    warn_others(&face, &rigid_others, "target", &mut report.warnings);
     let cloned = ClonedMotions {
         skin: cloned,
         parts: part_meshes,
@@ -415,32 +441,30 @@ fn clone_skin_motions(
     Ok(result.motions)
 }
 
-/// A face (`side` = "source" or "target") needs a skin mesh; meshes of neither skin nor a
-/// part get a warning.
-fn check_parts(
-    face: &FaceModel,
-    parts: &FaceParts,
-    side: &str,
-    warnings: &mut Vec<Diagnostic>,
-) -> Result<()> {
+/// A face (`side` = "source" or "target") needs a skin mesh.
+fn check_parts(parts: &FaceParts, side: &str) -> Result<()> {
     if parts.skin.is_empty() {
         return Err(CloneError::NoSkin {
             face: format!("{side} face"),
         }
         .into());
     }
-    if !parts.other.is_empty() {
-        let names: Vec<&str> = parts
-            .other
-            .iter()
-            .map(|&m| face.meshes[m].name.as_str())
-            .collect();
-        warnings.push(Diagnostic::warning(format!(
-            "{side} meshes {} are neither skin nor a part; they stay rigid with the head",
-            names.join(", ")
-        )));
-    }
     Ok(())
+}
+
+/// One warning naming the meshes (`others`) of neither skin nor a part that stay rigid.
+fn warn_others(face: &FaceModel, others: &[usize], side: &str, warnings: &mut Vec<Diagnostic>) {
+    if others.is_empty() {
+        return;
+    }
+    let names: Vec<&str> = others
+        .iter()
+        .map(|&m| face.meshes[m].name.as_str())
+        .collect();
+    warnings.push(Diagnostic::warning(format!(
+        "{side} meshes {} are neither skin nor a part; they stay rigid with the head",
+        names.join(", ")
+    )));
 }
 
 #[cfg(test)]

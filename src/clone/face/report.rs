@@ -63,6 +63,8 @@ pub struct CloneReport {
     pub split_parts: Vec<SplitPart>,
     /// Cloned FAPs that failed the guard (step 6), repaired or dropped.
     pub failed_faps: Vec<FapFailure>,
+    /// Meshes of neither skin nor a part that ride on the skin (lashes; step 8).
+    pub attached_meshes: Vec<String>,
 }
 
 /// The report as the CLI prints it: a summary line, the alignment, the warnings.
