@@ -216,3 +216,71 @@ pub fn subdivide(face: &FaceModel) -> FaceModel {
     }
     out
 }
+
+/// ICT-FaceKit identity `name` (`identities/<name>.obj`) as per-vertex offsets from the
+/// generic neutral: one standard deviation of that principal component.
+pub fn identity_offsets(dir: &Path, name: &str) -> Vec<Vec3> {
+    let read = |p: &Path| -> Vec<Vec3> {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|l| {
+                let c: Vec<f32> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
+                Vec3::new(c[0], c[1], c[2])
+            })
+            .collect()
+    };
+    let neutral = read(&dir.join("generic_neutral_mesh.obj"));
+    let id = read(&dir.join("identities").join(format!("{name}.obj")));
+    assert_eq!(neutral.len(), id.len());
+    id.iter().zip(&neutral).map(|(a, b)| *a - *b).collect()
+}
+
+/// A second real head from ICT's linear identity model: A's neutral plus `Σ w · identity`
+/// (`weights` in standard deviations), then `× scale + offset`; its true FAT is A's rates
+/// times the FAPU ratio, as for [`head_b`] (an expression's delta applies to every identity
+/// unchanged, so the same rates in FAP units of B are B's motion).
+pub fn identity_head(
+    a: &FaceModel,
+    dir: &Path,
+    weights: &[(&str, f32)],
+    scale: f32,
+    offset: Vec3,
+) -> FaceModel {
+    let offsets: Vec<Vec<Vec3>> = weights
+        .iter()
+        .map(|(n, _)| identity_offsets(dir, n))
+        .collect();
+    let mut b = a.clone();
+    assert_eq!(b.meshes.len(), 1);
+    let n = b.meshes[0].mesh.positions.len();
+    assert_eq!(n, offsets[0].len());
+    for v in 0..n {
+        let mut p = b.meshes[0].mesh.positions[v];
+        for (k, (_, w)) in weights.iter().enumerate() {
+            p += *w * offsets[k][v];
+        }
+        b.meshes[0].mesh.positions[v] = p * scale + offset;
+    }
+    b.meshes[0].mesh.normals.clear();
+    b.meshes[0].mesh.normal_polygons = None;
+    b.resolve_feature_points().unwrap();
+    b.scene = None;
+    let mut truth = b;
+    let (fa, fb) = (a.fapu().unwrap(), truth.fapu().unwrap());
+    for (t, ta) in truth.fat.tables.iter_mut().zip(&a.fat.tables) {
+        let kind = match t.key {
+            fbakit::fat::TableKey::LowLevel(fap) => fap.info().fapu.unwrap_or(FapuKind::Mns),
+            _ => FapuKind::Mns,
+        };
+        let r = (fb.unit(kind) / fa.unit(kind)) as f32;
+        for (m, ma) in t.meshes.iter_mut().zip(&ta.meshes) {
+            for (d, da) in m.displacements.iter_mut().zip(&ma.displacements) {
+                *d = *da * r;
+            }
+        }
+    }
+    truth.name = "ict_identity".into();
+    truth
+}

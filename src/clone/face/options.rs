@@ -3,8 +3,8 @@
 use serde::Serialize;
 
 use crate::clone::fit::FitOptions;
-use crate::clone::fmc::{FmcOptions, NormalisationMode, OverlapRule};
-use crate::clone::rbf::RbfOptions;
+use crate::clone::fmc::{FmcCorrespondence, FmcOptions, NormalisationMode, OverlapRule};
+use crate::clone::rbf::{RbfCorrespondence, RbfOptions};
 
 /// Which surface method clones the skin. The default, `Fit`, is the one every command uses
 /// unless told otherwise: on the real-head ground truth (ICT-FaceKit heads with known FATs)
@@ -66,12 +66,22 @@ impl Default for CloneOptions {
         CloneOptions {
             method: Method::default(),
             fmc: face_fmc_options(),
-            rbf: RbfOptions::default(),
+            rbf: face_rbf_options(),
             fit: FitOptions::default(),
             rbf_fapu_rescale: true,
             align: true,
             align_snap_degrees: 3.0,
         }
+    }
+}
+
+/// The RBF settings whole faces clone with: the paper's volume morph and motion transport,
+/// with target vertices bound by `fit`'s dense correspondence instead of normal rays
+/// ([`crate::clone::rbf`] module docs, "Default mode").
+pub fn face_rbf_options() -> RbfOptions {
+    RbfOptions {
+        correspondence: RbfCorrespondence::Dense,
+        ..RbfOptions::default()
     }
 }
 
@@ -82,6 +92,7 @@ pub fn face_fmc_options() -> FmcOptions {
         normalisation: NormalisationMode::Global,
         overlap: OverlapRule::NearestDepth,
         filter_support: 0.0,
+        correspondence: FmcCorrespondence::Dense,
         ..FmcOptions::default()
     }
 }

@@ -146,6 +146,20 @@ pub struct RbfOptions {
     pub contours: bool,
     /// Keep upper- and lower-lip vertices from mapping onto the other lip.
     pub lip_separation: bool,
+    /// How target vertices are bound to the source (step 4; default the paper's rays).
+    pub correspondence: RbfCorrespondence,
+}
+
+/// How step 4 binds each target vertex to a place on the source.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RbfCorrespondence {
+    /// The paper's: a ray along the target vertex's normal onto the morphed source.
+    #[default]
+    Rays,
+    /// `fit`'s dense correspondence ([`crate::clone::fit`], default settings): the target
+    /// vertex's closest point on the source registered onto the target (module docs,
+    /// "Default mode").
+    Dense,
 }
 
 impl Default for RbfOptions {
@@ -158,6 +172,7 @@ impl Default for RbfOptions {
             min_offset_factor: 1e-6,
             contours: true,
             lip_separation: true,
+            correspondence: RbfCorrespondence::Rays,
         }
     }
 }
@@ -174,6 +189,52 @@ fn excluded_fp(id: FeaturePointId) -> bool {
     matches!(id.group(), 10 | 6)
         || (id.group() == 9 && (8..=11).contains(&id.index()))
         || (id.group() == 11 && id.index() == 5)
+}
+
+/// Least distance between two centres taken from the dense correspondence, in target ES0.
+const DENSE_SPACING: f32 = 0.25;
+
+/// Pairs `(source point, target vertex)` of the dense correspondence `corr` (target vertex →
+/// place on the source; faded ones left out), thinned so that no two source points, nor one
+/// and a point of `taken`, lie closer than `spacing` (greedy, in target vertex order).
+fn thin_out(
+    corr: &[Option<crate::clone::fit::Correspondence>],
+    source: &[Vec3],
+    target: &[Vec3],
+    taken: &[Vec3],
+    spacing: f32,
+) -> Vec<(Vec3, Vec3)> {
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Vec::new();
+    }
+    let cell = |p: Vec3| (p / spacing).floor().as_ivec3();
+    let mut grid: HashMap<glam::IVec3, Vec<Vec3>> = HashMap::new();
+    for &p in taken {
+        grid.entry(cell(p)).or_default().push(p);
+    }
+    let mut out = Vec::new();
+    for (q, c) in corr.iter().enumerate() {
+        let Some(c) = c.filter(|c| c.fade >= 1.0) else {
+            continue;
+        };
+        let p: Vec3 = (0..3)
+            .map(|k| source[c.vertices[k] as usize] * c.weights[k])
+            .sum();
+        let k = cell(p);
+        let near = (-1..=1).any(|dx| {
+            (-1..=1).any(|dy| {
+                (-1..=1).any(|dz| {
+                    grid.get(&(k + glam::IVec3::new(dx, dy, dz)))
+                        .is_some_and(|v| v.iter().any(|o| o.distance(p) < spacing))
+                })
+            })
+        });
+        if !near && p.is_finite() {
+            grid.entry(k).or_default().push(p);
+            out.push((p, target[q]));
+        }
+    }
+    out
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -338,6 +399,7 @@ pub fn clone_rbf(
         }
     }
     let mut warnings = Vec::new();
+    let mut fit_warnings = Vec::new();
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
     let ens_t = target.fapu.distances.ens0 as f32;
@@ -443,6 +505,44 @@ pub fn clone_rbf(
     }
     timings.push("fit", clock.elapsed().as_secs_f64());
 
+    // Default mode: fit's dense correspondence binds the target (step 4) and, thinned out,
+    // adds centres to `f` so its Jacobian follows the real shape change (module docs).
+    let dense = match opts.correspondence {
+        RbfCorrespondence::Rays => None,
+        RbfCorrespondence::Dense => {
+            let (corr, _) = crate::clone::fit::correspondences(
+                source,
+                target,
+                &crate::clone::fit::FitOptions::default(),
+                &mut timings,
+                &mut stats,
+                &mut fit_warnings,
+            )?;
+            let clock = Instant::now();
+            let spacing = DENSE_SPACING * target.fapu.distances.es0 as f32;
+            let taken: Vec<Vec3> = set.pairs.iter().map(|e| e.0).collect();
+            let picked = thin_out(&corr, &source.positions, &target.positions, &taken, spacing);
+            let before = set.pairs.len();
+            let base = source.positions.len() as u32;
+            for (i, (p, u)) in picked.into_iter().enumerate() {
+                set.refine(base.saturating_add(i as u32), p, u);
+            }
+            stats.insert(
+                "dense_correspondences".into(),
+                (set.pairs.len() - before) as f64,
+            );
+            match set.fit() {
+                Ok(g) => f = g,
+                Err(e) => warnings.push(Diagnostic::warning(format!(
+                    "RBF refit with dense correspondences failed ({e}); using feature points \
+                     and contours only"
+                ))),
+            }
+            timings.push("dense_fit", clock.elapsed().as_secs_f64());
+            Some(corr)
+        }
+    };
+
     // 3. Iterative refinement on the movable vertices.
     let clock = Instant::now();
     let mut movable: Vec<u32> = motions
@@ -545,14 +645,15 @@ pub fn clone_rbf(
             fp_source.insert(tv, sv);
         }
     }
-    let binding: Vec<Option<(u32, [f32; 3], bool)>> = (0..target.positions.len())
+    let rays = || -> Vec<Option<([u32; 3], [f32; 3], bool)>> {
+        (0..target.positions.len())
         .into_par_iter()
         .map(|q| {
             if !in_surface[q] {
                 return None;
             }
             if let Some(&(tri, w)) = fp_binding.get(&(q as u32)) {
-                return Some((tri, w, false));
+                return Some((source.triangles[tri as usize], w, false));
             }
             let p = target.positions[q];
             let region = t_regions[q];
@@ -572,12 +673,28 @@ pub fn clone_rbf(
                 };
             let t = source.triangles[hit.triangle as usize].map(|i| deformed[i as usize]);
             Some((
-                hit.triangle,
+                source.triangles[hit.triangle as usize],
                 barycentric(hit.point, t[0], t[1], t[2]),
                 fallback,
             ))
         })
-        .collect();
+        .collect()
+    };
+    let binding = match dense {
+        None => rays(),
+        Some(corr) => corr
+            .into_iter()
+            .enumerate()
+            .map(|(q, c)| {
+                if let Some(&(tri, w)) = fp_binding.get(&(q as u32)) {
+                    return Some((source.triangles[tri as usize], w, false));
+                }
+                let c = c?;
+                Some((c.vertices, c.weights.map(|w| w * c.fade), false))
+            })
+            .collect(),
+    };
+    warnings.extend(fit_warnings.drain(..).map(Diagnostic::warning));
     let fallbacks = binding.iter().flatten().filter(|b| b.2).count();
     let unbound = (0..binding.len())
         .filter(|&q| in_surface[q] && binding[q].is_none())
@@ -585,8 +702,10 @@ pub fn clone_rbf(
     let mut bound_to: Vec<Vec<u32>> = vec![Vec::new(); source.positions.len()];
     for (q, b) in binding.iter().enumerate() {
         if let Some((tri, _, _)) = b {
-            for &v in &source.triangles[*tri as usize] {
-                bound_to[v as usize].push(q as u32);
+            for &v in tri {
+                if bound_to[v as usize].last() != Some(&(q as u32)) {
+                    bound_to[v as usize].push(q as u32);
+                }
             }
         }
     }
@@ -639,8 +758,7 @@ pub fn clone_rbf(
                         let o = d.normalize_or_zero() * len;
                         return (o.length() > min_offset).then_some((q, o));
                     }
-                    let (tri, w, _) = binding[q as usize]?;
-                    let t = source.triangles[tri as usize];
+                    let (t, w, _) = binding[q as usize]?;
                     let o = (0..3)
                         .map(|k| moved.get(&t[k]).copied().unwrap_or(Vec3::ZERO) * w[k])
                         .sum::<Vec3>();
