@@ -14,7 +14,7 @@ use std::sync::OnceLock;
 use fbakit::clone::eval::ground_truth_error;
 use fbakit::clone::face::{clone_face, CloneOptions, Method};
 use fbakit::clone::fmc::{FmcCorrespondence, FmcOptions, NormalisationMode};
-use fbakit::clone::rbf::{RbfCorrespondence, RbfOptions};
+use fbakit::clone::rbf::RbfOptions;
 use fbakit::export::picture::strip_fat;
 use fbakit::face::subdivide::subdivide_face;
 use fbakit::face::FaceModel;
@@ -29,7 +29,8 @@ enum Mode {
     FmcProjected,
     FmcPaper,
     Rbf,
-    /// rbf's default mode before dense correspondence (the paper's rays).
+    /// rbf's default mode before dense correspondence (the paper's rays and transport
+    /// through the morph, with the FAPU rescale).
     RbfRays,
     RbfPaper,
     Fit,
@@ -55,13 +56,12 @@ impl Mode {
             Mode::Rbf => o.method = Method::Rbf,
             Mode::RbfRays => {
                 o.method = Method::Rbf;
-                o.rbf.correspondence = RbfCorrespondence::Rays;
+                o.rbf = RbfOptions::default();
             }
             Mode::RbfPaper => {
                 o.method = Method::Rbf;
                 o.rbf = RbfOptions {
                     max_iterations: 3,
-                    correspondence: RbfCorrespondence::Rays,
                     ..RbfOptions::default()
                 };
                 o.rbf_fapu_rescale = false;
@@ -130,10 +130,15 @@ fn cases() -> Option<&'static Vec<Case>> {
         ];
         let cases = heads
             .into_iter()
+            .filter(|(name, _)| {
+                std::env::var("IDENTITY_CASES").map_or(true, |c| c.contains(&name[..4]))
+            })
             .map(|(name, truth)| {
                 let target = strip_fat(&truth);
+                let only = std::env::var("IDENTITY_MODES").unwrap_or_default();
                 let rows = MODES
                     .iter()
+                    .filter(|m| only.is_empty() || only.split(',').any(|o| o == format!("{m:?}")))
                     .map(|&mode| {
                         let t = std::time::Instant::now();
                         let out = clone_face(&a, &target, &mode.options()).unwrap();
@@ -178,9 +183,21 @@ fn every_mode_on_identity_heads() {
             );
         }
     }
+    // Issue 21's targets for the default modes: median ≤ 8 % on every real-head case
+    // (measured 5.7–6.9 % fmc, 5.0–6.0 % rbf). The papers' modes stay as printed: far
+    // behind (30–34 %), but finite and no FAP lost entirely.
     for c in cases {
         for r in &c.rows {
             assert!(r.median.is_finite() && r.worst.1.is_finite());
+            match r.mode {
+                Mode::Fmc | Mode::Rbf => {
+                    assert!(r.median <= 8.0, "{} {:?}: median {}", c.name, r.mode, r.median)
+                }
+                Mode::FmcPaper | Mode::RbfPaper => {
+                    assert!(r.median < 40.0, "{} {:?}: median {}", c.name, r.mode, r.median)
+                }
+                _ => {}
+            }
         }
     }
 }

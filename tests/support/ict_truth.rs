@@ -53,6 +53,16 @@ pub fn ict_dir() -> Option<PathBuf> {
 
 /// Head A: the ICT neutral with its rig FAT restricted to [`FAPS`].
 pub fn head_a(dir: &Path) -> FaceModel {
+    let mut face = rig_head(dir);
+    face.fat.tables.retain(
+        |t| matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if FAPS.contains(&f.number())),
+    );
+    face.name = "ict_a".into();
+    face
+}
+
+/// The ICT neutral with every table of its rig FAT.
+pub fn rig_head(dir: &Path) -> FaceModel {
     let rig = fbakit::rig::read_rig(dir).unwrap();
     let ids = read_landmark_ids(&dir.join("vertex_indices.json")).unwrap();
     let found =
@@ -60,10 +70,7 @@ pub fn head_a(dir: &Path) -> FaceModel {
             .unwrap();
     let (mut face, _) =
         face_from_rig(&rig, Some(found.feature_point_set()), &FapMap::arkit()).unwrap();
-    face.fat.tables.retain(
-        |t| matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if FAPS.contains(&f.number())),
-    );
-    face.name = "ict_a".into();
+    face.name = "ict".into();
     face
 }
 

@@ -4,7 +4,7 @@ use serde::Serialize;
 
 use crate::clone::fit::FitOptions;
 use crate::clone::fmc::{FmcCorrespondence, FmcOptions, NormalisationMode, OverlapRule};
-use crate::clone::rbf::{RbfCorrespondence, RbfOptions};
+use crate::clone::rbf::{RbfCorrespondence, RbfOptions, RbfTransport};
 
 /// Which surface method clones the skin. The default, `Fit`, is the one every command uses
 /// unless told otherwise: on the real-head ground truth (ICT-FaceKit heads with known FATs)
@@ -75,12 +75,14 @@ impl Default for CloneOptions {
     }
 }
 
-/// The RBF settings whole faces clone with: the paper's volume morph and motion transport,
-/// with target vertices bound by `fit`'s dense correspondence instead of normal rays
+/// The RBF settings whole faces clone with: target vertices bound by `fit`'s dense
+/// correspondence instead of normal rays, motions carried as displacements (scaled to the
+/// target's FAP units by the pipeline's rescale) instead of through the volume morph
 /// ([`crate::clone::rbf`] module docs, "Default mode").
 pub fn face_rbf_options() -> RbfOptions {
     RbfOptions {
         correspondence: RbfCorrespondence::Dense,
+        transport: RbfTransport::Displacement,
         ..RbfOptions::default()
     }
 }
