@@ -145,7 +145,11 @@ fn cases() -> Option<&'static Vec<Case>> {
                         let secs = t.elapsed().as_secs_f64();
                         let r = ground_truth_error(&out.face, &truth).unwrap();
                         let med = median(r.keys.iter().map(|k| k.all).collect());
-                        let w = r.keys.iter().max_by(|x, y| x.all.total_cmp(&y.all)).unwrap();
+                        let w = r
+                            .keys
+                            .iter()
+                            .max_by(|x, y| x.all.total_cmp(&y.all))
+                            .unwrap();
                         eprintln!(
                             "{name:<20} {:<9} {secs:6.2} s  median {med:5.1} %  worst {} {:.1} %",
                             format!("{mode:?}"),
@@ -191,10 +195,22 @@ fn every_mode_on_identity_heads() {
             assert!(r.median.is_finite() && r.worst.1.is_finite());
             match r.mode {
                 Mode::Fmc | Mode::Rbf => {
-                    assert!(r.median <= 8.0, "{} {:?}: median {}", c.name, r.mode, r.median)
+                    assert!(
+                        r.median <= 8.0,
+                        "{} {:?}: median {}",
+                        c.name,
+                        r.mode,
+                        r.median
+                    )
                 }
                 Mode::FmcPaper | Mode::RbfPaper => {
-                    assert!(r.median < 40.0, "{} {:?}: median {}", c.name, r.mode, r.median)
+                    assert!(
+                        r.median < 40.0,
+                        "{} {:?}: median {}",
+                        c.name,
+                        r.mode,
+                        r.median
+                    )
                 }
                 _ => {}
             }

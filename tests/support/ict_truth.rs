@@ -263,12 +263,12 @@ pub fn identity_head(
     assert_eq!(b.meshes.len(), 1);
     let n = b.meshes[0].mesh.positions.len();
     assert_eq!(n, offsets[0].len());
-    for v in 0..n {
-        let mut p = b.meshes[0].mesh.positions[v];
-        for (k, (_, w)) in weights.iter().enumerate() {
-            p += *w * offsets[k][v];
-        }
-        b.meshes[0].mesh.positions[v] = p * scale + offset;
+    for (v, q) in b.meshes[0].mesh.positions.iter_mut().enumerate() {
+        let moved = weights
+            .iter()
+            .zip(&offsets)
+            .fold(*q, |p, ((_, w), o)| p + *w * o[v]);
+        *q = moved * scale + offset;
     }
     b.meshes[0].mesh.normals.clear();
     b.meshes[0].mesh.normal_polygons = None;

@@ -60,8 +60,8 @@ use glam::Vec3;
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::Result;
 use crate::mesh::spatial::find_coincident_vertices;
-use regions::{classify, triangle_masks};
 pub(crate) use correspond::Correspondence;
+use regions::{classify, triangle_masks};
 use register::{register, Moving};
 use surface::{adjacency, QuerySurface};
 

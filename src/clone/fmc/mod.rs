@@ -365,16 +365,27 @@ pub fn clone_fmc(
                 &mut stats,
                 &mut fit_warnings,
             )?;
+            // As in step 3, a target feature-point vertex whose point the source has samples
+            // exactly that point: its motion is the FAP itself.
+            let fp_source: BTreeMap<u32, u32> = target
+                .fp_vertices
+                .iter()
+                .filter_map(|(id, &tv)| Some((tv, *source.fp_vertices.get(id)?)))
+                .collect();
             corr.iter()
-                .map(|c| Mapped {
-                    weights: c.map_or_else(Vec::new, |c| {
-                        c.vertices
-                            .iter()
-                            .zip(c.weights)
-                            .filter(|(_, w)| *w != 0.0)
-                            .map(|(&v, w)| (v, f64::from(w * c.fade)))
-                            .collect()
-                    }),
+                .enumerate()
+                .map(|(q, c)| Mapped {
+                    weights: match fp_source.get(&(q as u32)) {
+                        Some(&sv) => vec![(sv, 1.0)],
+                        None => c.map_or_else(Vec::new, |c| {
+                            c.vertices
+                                .iter()
+                                .zip(c.weights)
+                                .filter(|(_, w)| *w != 0.0)
+                                .map(|(&v, w)| (v, f64::from(w * c.fade)))
+                                .collect()
+                        }),
+                    },
                     outside: 0,
                     overlaps: 0,
                 })

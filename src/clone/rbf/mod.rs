@@ -230,6 +230,10 @@ fn excluded_fp(id: FeaturePointId) -> bool {
         || (id.group() == 11 && id.index() == 5)
 }
 
+/// Where a target vertex lies on the source: the source vertices, their barycentric weights,
+/// and whether the closest point stood in for a missed ray.
+type Binding = ([u32; 3], [f32; 3], bool);
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
     FeaturePoint,
@@ -527,8 +531,9 @@ pub fn clone_rbf(
     let tol = opts.min_error_factor as f32 * ens_t;
     let mirror = mirror_partners(&source.positions, &movable, eps.max(1e-5 * ens_t));
     let mut iterations = 0usize;
-    let mut max_error: f32;
-    loop {
+    let mut max_error: f32 = 0.0;
+    // With dense binding and no rounds, `f` binds nothing: no rays to cast.
+    while dense.is_none() || opts.max_iterations > 0 {
         let deformed: Vec<Vec3> = source.positions.par_iter().map(|&p| f.apply(p)).collect();
         let normals = vertex_normals(&deformed, &source.triangles);
         let mut hits: Vec<(u32, Vec3, f32)> = movable
@@ -616,40 +621,40 @@ pub fn clone_rbf(
             fp_source.insert(tv, sv);
         }
     }
-    let rays = || -> Vec<Option<([u32; 3], [f32; 3], bool)>> {
+    let rays = || -> Vec<Option<Binding>> {
         (0..target.positions.len())
-        .into_par_iter()
-        .map(|q| {
-            if !in_surface[q] {
-                return None;
-            }
-            if let Some(&(tri, w)) = fp_binding.get(&(q as u32)) {
-                return Some((source.triangles[tri as usize], w, false));
-            }
-            let p = target.positions[q];
-            let region = t_regions[q];
-            let n = t_normals[q];
-            let facing = |tri: u32| s_tri_normals[tri as usize].dot(n) >= MIN_NORMAL_COSINE;
-            let (hit, fallback) =
-                match source_bvh.ray_both_ways_where(region, p, n, ray_len, facing) {
-                    Some(h) => (h, false),
-                    // Beyond the rays' reach the source has no surface here (a face mask on a
-                    // whole head): no motion rather than the motion of its nearest border.
-                    None => (
-                        source_bvh
-                            .closest(region, p)
-                            .filter(|h| h.point.distance(p) <= ray_len)?,
-                        true,
-                    ),
-                };
-            let t = source.triangles[hit.triangle as usize].map(|i| deformed[i as usize]);
-            Some((
-                source.triangles[hit.triangle as usize],
-                barycentric(hit.point, t[0], t[1], t[2]),
-                fallback,
-            ))
-        })
-        .collect()
+            .into_par_iter()
+            .map(|q| {
+                if !in_surface[q] {
+                    return None;
+                }
+                if let Some(&(tri, w)) = fp_binding.get(&(q as u32)) {
+                    return Some((source.triangles[tri as usize], w, false));
+                }
+                let p = target.positions[q];
+                let region = t_regions[q];
+                let n = t_normals[q];
+                let facing = |tri: u32| s_tri_normals[tri as usize].dot(n) >= MIN_NORMAL_COSINE;
+                let (hit, fallback) =
+                    match source_bvh.ray_both_ways_where(region, p, n, ray_len, facing) {
+                        Some(h) => (h, false),
+                        // Beyond the rays' reach the source has no surface here (a face mask on a
+                        // whole head): no motion rather than the motion of its nearest border.
+                        None => (
+                            source_bvh
+                                .closest(region, p)
+                                .filter(|h| h.point.distance(p) <= ray_len)?,
+                            true,
+                        ),
+                    };
+                let t = source.triangles[hit.triangle as usize].map(|i| deformed[i as usize]);
+                Some((
+                    source.triangles[hit.triangle as usize],
+                    barycentric(hit.point, t[0], t[1], t[2]),
+                    fallback,
+                ))
+            })
+            .collect()
     };
     let binding = match dense {
         None => rays(),
@@ -690,7 +695,10 @@ pub fn clone_rbf(
     let disp: HashMap<u32, DVec3> = movable
         .par_iter()
         .filter(|&&v| !bound_to[v as usize].is_empty())
-        .map(|&v| (v, f.displacement(source.positions[v as usize].as_dvec3())))
+        .map(|&v| match opts.transport {
+            RbfTransport::Morph => (v, f.displacement(source.positions[v as usize].as_dvec3())),
+            RbfTransport::Displacement => (v, DVec3::ZERO),
+        })
         .collect();
     let fp_source_vertices: std::collections::HashSet<u32> = fp_source.values().copied().collect();
     let out: Vec<SurfaceMotion> = motions
