@@ -124,7 +124,9 @@
 //! Measured on ICT identity heads against their true FATs (`tests/clone_ict_identities.rs`,
 //! per-case median over 14 FAPs): the paper's rays and transport 8.7–9.8 % (with 3
 //! refinement rounds and no rescale, the paper as printed, 29–34 %); the default mode
-//! 5.0–6.0 %.
+//! 4.4–5.0 %, the same as `fit`'s: with both changes the morph `f` no longer moves anything
+//! (it is still fitted, and used by the paper's mode), so the default mode is `fit`'s
+//! correspondence and transfer with rbf's contours, feature-point binding and FAPU rescale.
 
 mod contours;
 mod interp;
