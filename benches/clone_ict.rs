@@ -3,6 +3,7 @@
 //! one-mesh `ict` (parts split out), alma onto the `ict-head.glb` sample written back as a
 //! patched glb; dense CANDIDE-3 onto `ict` is `clone_candide_ict`. The
 //! ICT cases are skipped when `../shared/data/ict-facekit` is absent. Quality figures are printed once per case.
+//! `ict_to_its_dense_remesh`: the rig head onto itself subdivided once (105k vertices), `fit`.
 
 #[path = "../tests/support/ict_truth.rs"]
 mod ict_truth;
@@ -85,4 +86,58 @@ fn alma_to_ict_head_glb_patched() {
     let out = clone_face(alma, &target, &opts(Method::Fit)).expect("clone");
     let tmp = tempfile::tempdir().expect("temp dir");
     fbakit::export::write_face(tmp.path().join("out.glb"), &out.face).expect("write");
+}
+
+/// The ICT rig head (26 719 vertices, every table of its rig FAT) and its remesh 4× denser
+/// (one round of midpoint subdivision: 105k vertices, triangles). Step timings of one `fit`
+/// run and the process's peak memory are printed first.
+fn dense_pair() -> Option<&'static (FaceModel, FaceModel)> {
+    static P: OnceLock<Option<(FaceModel, FaceModel)>> = OnceLock::new();
+    P.get_or_init(|| {
+        let dir = ict_truth::ict_dir()?;
+        let head = ict_truth::rig_head(&dir);
+        let dense = fbakit::face::subdivide::subdivide_face(
+            &strip_fat(&head),
+            fbakit::mesh::subdivide::Scheme::Midpoint,
+            1,
+        )
+        .expect("subdivide");
+        let out = clone_face(&head, &dense, &opts(Method::Fit)).expect("clone");
+        let steps: Vec<String> = out
+            .report
+            .timings
+            .steps
+            .iter()
+            .map(|(s, t)| format!("{s} {:.0} ms", t * 1e3))
+            .collect();
+        eprintln!(
+            "fit ({} tables, {} → {} vertices): {:.0} ms: {}",
+            head.fat.tables.len(),
+            head.vertex_count(),
+            dense.vertex_count(),
+            out.report.timings.total() * 1e3,
+            steps.join(", ")
+        );
+        if let Some(peak) = peak_rss_mb() {
+            eprintln!("peak memory so far: {peak:.0} MB");
+        }
+        Some((head, dense))
+    })
+    .as_ref()
+}
+
+/// The process's peak resident set (Linux `VmHWM`), in MB.
+fn peak_rss_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+#[divan::bench(sample_count = 3)]
+fn ict_to_its_dense_remesh() {
+    let Some((head, dense)) = dense_pair() else {
+        return;
+    };
+    divan::black_box(clone_face(head, dense, &opts(Method::Fit)).expect("clone"));
 }

@@ -157,6 +157,7 @@ fn rbf_paper_mode_is_less_compliant() {
     let (a, b) = faces();
     let paper = CloneOptions {
         rbf_fapu_rescale: false,
+        rbf: fbakit::clone::rbf::RbfOptions::default(),
         ..opts(Method::Rbf)
     };
     let out = clone_face(a, b, &paper).unwrap();

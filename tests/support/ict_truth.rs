@@ -53,6 +53,16 @@ pub fn ict_dir() -> Option<PathBuf> {
 
 /// Head A: the ICT neutral with its rig FAT restricted to [`FAPS`].
 pub fn head_a(dir: &Path) -> FaceModel {
+    let mut face = rig_head(dir);
+    face.fat.tables.retain(
+        |t| matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if FAPS.contains(&f.number())),
+    );
+    face.name = "ict_a".into();
+    face
+}
+
+/// The ICT neutral with every table of its rig FAT.
+pub fn rig_head(dir: &Path) -> FaceModel {
     let rig = fbakit::rig::read_rig(dir).unwrap();
     let ids = read_landmark_ids(&dir.join("vertex_indices.json")).unwrap();
     let found =
@@ -60,10 +70,7 @@ pub fn head_a(dir: &Path) -> FaceModel {
             .unwrap();
     let (mut face, _) =
         face_from_rig(&rig, Some(found.feature_point_set()), &FapMap::arkit()).unwrap();
-    face.fat.tables.retain(
-        |t| matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if FAPS.contains(&f.number())),
-    );
-    face.name = "ict_a".into();
+    face.name = "ict".into();
     face
 }
 
@@ -215,4 +222,72 @@ pub fn subdivide(face: &FaceModel) -> FaceModel {
         }
     }
     out
+}
+
+/// ICT-FaceKit identity `name` (`identities/<name>.obj`) as per-vertex offsets from the
+/// generic neutral: one standard deviation of that principal component.
+pub fn identity_offsets(dir: &Path, name: &str) -> Vec<Vec3> {
+    let read = |p: &Path| -> Vec<Vec3> {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|l| {
+                let c: Vec<f32> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
+                Vec3::new(c[0], c[1], c[2])
+            })
+            .collect()
+    };
+    let neutral = read(&dir.join("generic_neutral_mesh.obj"));
+    let id = read(&dir.join("identities").join(format!("{name}.obj")));
+    assert_eq!(neutral.len(), id.len());
+    id.iter().zip(&neutral).map(|(a, b)| *a - *b).collect()
+}
+
+/// A second real head from ICT's linear identity model: A's neutral plus `Σ w · identity`
+/// (`weights` in standard deviations), then `× scale + offset`; its true FAT is A's rates
+/// times the FAPU ratio, as for [`head_b`] (an expression's delta applies to every identity
+/// unchanged, so the same rates in FAP units of B are B's motion).
+pub fn identity_head(
+    a: &FaceModel,
+    dir: &Path,
+    weights: &[(&str, f32)],
+    scale: f32,
+    offset: Vec3,
+) -> FaceModel {
+    let offsets: Vec<Vec<Vec3>> = weights
+        .iter()
+        .map(|(n, _)| identity_offsets(dir, n))
+        .collect();
+    let mut b = a.clone();
+    assert_eq!(b.meshes.len(), 1);
+    let n = b.meshes[0].mesh.positions.len();
+    assert_eq!(n, offsets[0].len());
+    for (v, q) in b.meshes[0].mesh.positions.iter_mut().enumerate() {
+        let moved = weights
+            .iter()
+            .zip(&offsets)
+            .fold(*q, |p, ((_, w), o)| p + *w * o[v]);
+        *q = moved * scale + offset;
+    }
+    b.meshes[0].mesh.normals.clear();
+    b.meshes[0].mesh.normal_polygons = None;
+    b.resolve_feature_points().unwrap();
+    b.scene = None;
+    let mut truth = b;
+    let (fa, fb) = (a.fapu().unwrap(), truth.fapu().unwrap());
+    for (t, ta) in truth.fat.tables.iter_mut().zip(&a.fat.tables) {
+        let kind = match t.key {
+            fbakit::fat::TableKey::LowLevel(fap) => fap.info().fapu.unwrap_or(FapuKind::Mns),
+            _ => FapuKind::Mns,
+        };
+        let r = (fb.unit(kind) / fa.unit(kind)) as f32;
+        for (m, ma) in t.meshes.iter_mut().zip(&ta.meshes) {
+            for (d, da) in m.displacements.iter_mut().zip(&ma.displacements) {
+                *d = *da * r;
+            }
+        }
+    }
+    truth.name = "ict_identity".into();
+    truth
 }

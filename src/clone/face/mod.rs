@@ -147,7 +147,7 @@ use std::collections::HashMap;
 use std::time::Instant;
 
 pub use align::Similarity;
-pub use options::{face_fmc_options, CloneOptions, Method};
+pub use options::{face_fmc_options, face_rbf_options, CloneOptions, Method};
 pub use parts::{identify_parts, FaceParts, Part};
 pub use report::{CloneOutcome, CloneReport, RigidReport};
 pub use rescale::FapFailure;

@@ -3,14 +3,15 @@
 use serde::Serialize;
 
 use crate::clone::fit::FitOptions;
-use crate::clone::fmc::{FmcOptions, NormalisationMode, OverlapRule};
-use crate::clone::rbf::RbfOptions;
+use crate::clone::fmc::{FmcCorrespondence, FmcOptions, NormalisationMode, OverlapRule};
+use crate::clone::rbf::{RbfCorrespondence, RbfOptions, RbfTransport};
 
 /// Which surface method clones the skin. The default, `Fit`, is the one every command uses
 /// unless told otherwise: on the real-head ground truth (ICT-FaceKit heads with known FATs)
-/// it has the lowest error of the three (median 2.6 % against fmc's 7.4 % and rbf's 5.5 %,
-/// better than fmc on every FAP), and on alma → bruno too (25.5 % against 30.6 / 31.5 %).
-/// `Fmc` is the fastest.
+/// it has the lowest error of the three (median 2.6 % against the papers' projections and
+/// rays, 7.4 % and 5.5 %), and on alma → bruno too (25.5 % against 30.6 / 31.5 %). The
+/// default modes of `Fmc` and `Rbf` now take `fit`'s dense correspondence too (their module
+/// docs): on ICT identity heads fit 4.4–5.0 %, fmc 5.7–6.9 %, rbf 4.4–5.0 %.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
@@ -66,12 +67,24 @@ impl Default for CloneOptions {
         CloneOptions {
             method: Method::default(),
             fmc: face_fmc_options(),
-            rbf: RbfOptions::default(),
+            rbf: face_rbf_options(),
             fit: FitOptions::default(),
             rbf_fapu_rescale: true,
             align: true,
             align_snap_degrees: 3.0,
         }
+    }
+}
+
+/// The RBF settings whole faces clone with: target vertices bound by `fit`'s dense
+/// correspondence instead of normal rays, motions carried as displacements (scaled to the
+/// target's FAP units by the pipeline's rescale) instead of through the volume morph
+/// ([`crate::clone::rbf`] module docs, "Default mode").
+pub fn face_rbf_options() -> RbfOptions {
+    RbfOptions {
+        correspondence: RbfCorrespondence::Dense,
+        transport: RbfTransport::Displacement,
+        ..RbfOptions::default()
     }
 }
 
@@ -82,6 +95,7 @@ pub fn face_fmc_options() -> FmcOptions {
         normalisation: NormalisationMode::Global,
         overlap: OverlapRule::NearestDepth,
         filter_support: 0.0,
+        correspondence: FmcCorrespondence::Dense,
         ..FmcOptions::default()
     }
 }

@@ -60,6 +60,7 @@ use glam::Vec3;
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::Result;
 use crate::mesh::spatial::find_coincident_vertices;
+pub(crate) use correspond::Correspondence;
 use regions::{classify, triangle_masks};
 use register::{register, Moving};
 use surface::{adjacency, QuerySurface};
@@ -185,30 +186,14 @@ pub fn clone_fit(
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
     let mut warnings: Vec<String> = Vec::new();
-    let (corr, rotations) = if opts.shared_topology && same_topology(source, target) {
-        let clock = Instant::now();
-        let corr = (0..target.positions.len() as u32)
-            .map(|v| {
-                Some(correspond::Correspondence {
-                    vertices: [v; 3],
-                    weights: [1.0, 0.0, 0.0],
-                    fade: 1.0,
-                })
-            })
-            .collect();
-        stats.insert("fit_shared_topology".into(), 1.0);
-        timings.push("correspond", clock.elapsed().as_secs_f64());
-        (corr, None)
-    } else {
-        register_and_correspond(
-            source,
-            target,
-            opts,
-            &mut timings,
-            &mut stats,
-            &mut warnings,
-        )?
-    };
+    let (corr, rotations) = correspondences(
+        source,
+        target,
+        opts,
+        &mut timings,
+        &mut stats,
+        &mut warnings,
+    )?;
     // 4. Transfer.
     let clock = Instant::now();
     let out = transfer::transfer(
@@ -229,6 +214,37 @@ pub fn clone_fit(
             .map(crate::error::Diagnostic::warning)
             .collect(),
     })
+}
+
+/// Where each target vertex lies on the source (steps 1–3, or vertex to vertex for one
+/// topology), with the source vertices' local rotations when `opts.transfer` asks for them.
+/// `fmc` and `rbf` take these in their default modes (their module docs).
+#[allow(clippy::type_complexity)]
+pub(crate) fn correspondences(
+    source: &CloneSurface,
+    target: &CloneSurface,
+    opts: &FitOptions,
+    timings: &mut StepTimings,
+    stats: &mut BTreeMap<String, f64>,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<Option<Correspondence>>, Option<Vec<glam::Mat3>>)> {
+    if opts.shared_topology && same_topology(source, target) {
+        let clock = Instant::now();
+        let corr = (0..target.positions.len() as u32)
+            .map(|v| {
+                Some(Correspondence {
+                    vertices: [v; 3],
+                    weights: [1.0, 0.0, 0.0],
+                    fade: 1.0,
+                })
+            })
+            .collect();
+        stats.insert("fit_shared_topology".into(), 1.0);
+        timings.push("correspond", clock.elapsed().as_secs_f64());
+        Ok((corr, None))
+    } else {
+        register_and_correspond(source, target, opts, timings, stats, warnings)
+    }
 }
 
 /// Steps 1–3 (module docs): sides, registration of the source onto the target, and each

@@ -101,6 +101,26 @@
 //!
 //! Rigid parts (eyes, teeth, tongue, head transforms) are not part of a [`CloneSurface`] and
 //! are not handled here.
+//!
+//! # Default mode: what whole faces use, and how it differs from the paper
+//!
+//! [`FmcOptions::default`] is the paper (with the choices above). Whole faces clone with
+//! [`face_fmc_options`](crate::clone::face::face_fmc_options): `Global` normalisation,
+//! nearest-depth overlaps, no anti-aliasing filter, and **dense correspondence**
+//! ([`FmcCorrespondence::Dense`]) in place of steps 3–6 and 7: each target vertex samples the
+//! source where `fit`'s registration puts it ([`crate::clone::fit`]: side-restricted
+//! closest points after a landmark-guided non-rigid registration, or vertex to vertex for
+//! one topology). The paper aligns the two faces through 39 feature points in a 2D
+//! cylindrical projection; between those points the alignment is piecewise affine, so
+//! the cheeks, lids and lips of two real heads land on the wrong part of each other (and
+//! the lip and lid separation of step 7 is then needed to repair the worst of it; the
+//! registration's slit sides do that job). The motion scaling — each source motion
+//! normalised by its own region's FAPU and denormalised by the target's (steps 1 and 8) — is
+//! the paper's.
+//!
+//! Measured on ICT identity heads against their true FATs (`tests/clone_ict_identities.rs`,
+//! per-case median over 14 FAPs): projected alignment 10.9–14.5 % (the paper's `Paper`
+//! normalisation with its filter 30–32 %), dense correspondence 5.7–6.9 %.
 
 mod align;
 mod interp;
@@ -150,6 +170,19 @@ pub enum OverlapRule {
     NearestDepth,
 }
 
+/// Where each target vertex samples the source's motion (steps 3–6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FmcCorrespondence {
+    /// The paper's: the target's projected feature points aligned onto the source's, each
+    /// target vertex interpolated in the source's projected triangles (steps 3–6).
+    #[default]
+    Paper,
+    /// `fit`'s dense correspondence ([`crate::clone::fit`], default settings): each target
+    /// vertex's closest point on the source registered onto the target (module docs,
+    /// "Default mode").
+    Dense,
+}
+
 /// Options of [`clone_fmc`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct FmcOptions {
@@ -166,6 +199,8 @@ pub struct FmcOptions {
     pub lip_separation: bool,
     /// Resolution of overlapping source triangles.
     pub overlap: OverlapRule,
+    /// Where target vertices sample the source (default: the paper's projection).
+    pub correspondence: FmcCorrespondence,
 }
 
 impl Default for FmcOptions {
@@ -177,6 +212,7 @@ impl Default for FmcOptions {
             normalisation: NormalisationMode::Anchored,
             lip_separation: true,
             overlap: OverlapRule::FrontMost,
+            correspondence: FmcCorrespondence::Paper,
         }
     }
 }
@@ -298,6 +334,7 @@ pub fn clone_fmc(
     }
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
+    let mut fit_warnings = Vec::new();
 
     // 1. Normalisation.
     let t = Instant::now();
@@ -315,6 +352,125 @@ pub fn clone_fmc(
     stats.insert("target_axis_z".into(), tgt.axis.z0);
     timings.push("project", t.elapsed().as_secs_f64());
 
+    let mapped = match opts.correspondence {
+        FmcCorrespondence::Paper => {
+            map_paper(source, target, &src, &tgt, opts, &mut timings, &mut stats)?
+        }
+        FmcCorrespondence::Dense => {
+            let (corr, _) = crate::clone::fit::correspondences(
+                source,
+                target,
+                &crate::clone::fit::FitOptions::default(),
+                &mut timings,
+                &mut stats,
+                &mut fit_warnings,
+            )?;
+            // As in step 3, a target feature-point vertex whose point the source has samples
+            // exactly that point: its motion is the FAP itself.
+            let fp_source: BTreeMap<u32, u32> = target
+                .fp_vertices
+                .iter()
+                .filter_map(|(id, &tv)| Some((tv, *source.fp_vertices.get(id)?)))
+                .collect();
+            corr.iter()
+                .enumerate()
+                .map(|(q, c)| Mapped {
+                    weights: match fp_source.get(&(q as u32)) {
+                        Some(&sv) => vec![(sv, 1.0)],
+                        None => c.map_or_else(Vec::new, |c| {
+                            c.vertices
+                                .iter()
+                                .zip(c.weights)
+                                .filter(|(_, w)| *w != 0.0)
+                                .map(|(&v, w)| (v, f64::from(w * c.fade)))
+                                .collect()
+                        }),
+                    },
+                    outside: 0,
+                    overlaps: 0,
+                })
+                .collect()
+        }
+    };
+    warnings.extend(fit_warnings.into_iter().map(Diagnostic::warning));
+
+    // 5 and 8. Motion mapping; each source motion is normalised by its own vertex's region
+    // and denormalised by the target's factors of that same region (see step 8).
+    let t = Instant::now();
+    let ratio: Vec<DVec3> = src
+        .norm
+        .region
+        .iter()
+        .zip(&src.norm.motion_factors)
+        .map(|(id, n)| normalise::factors(&target.fapu, normalise::motion_kinds(id.group())) / *n)
+        .collect();
+    let normalised: Vec<Vec<DVec3>> = motions
+        .par_iter()
+        .map(|m| {
+            let mut dense = vec![DVec3::ZERO; source.positions.len()];
+            for &(v, d) in &m.offsets {
+                dense[v as usize] = d.as_dvec3() * ratio[v as usize];
+            }
+            mapped
+                .iter()
+                .map(|mp| mp.weights.iter().map(|&(v, w)| dense[v as usize] * w).sum())
+                .collect()
+        })
+        .collect();
+    timings.push("motions", t.elapsed().as_secs_f64());
+
+    // 8. Output (the target's factors were applied per source region above).
+    let t = Instant::now();
+    let mut out = Vec::with_capacity(motions.len());
+    for (m, field) in motions.iter().zip(normalised) {
+        let offsets: Vec<(u32, Vec3)> = field
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| **d != DVec3::ZERO)
+            .map(|(i, d)| (i as u32, d.as_vec3()))
+            .collect();
+        if let Some(&(vertex, _)) = offsets.iter().find(|(_, d)| !d.is_finite()) {
+            return Err(CloneError::NonFiniteOutput {
+                method: "fmc",
+                key: m.key,
+                vertex,
+            }
+            .into());
+        }
+        out.push(SurfaceMotion {
+            key: m.key,
+            value: m.value,
+            offsets,
+        });
+    }
+    timings.push("denormalise", t.elapsed().as_secs_f64());
+
+    Ok(SurfaceCloneResult {
+        motions: out,
+        timings,
+        stats,
+        warnings,
+    })
+}
+
+/// Where one target vertex samples the source: weights of source vertices.
+struct Mapped {
+    weights: Vec<(u32, f64)>,
+    outside: u32,
+    overlaps: u32,
+}
+
+/// Steps 3–7 of the paper (module docs): lip regions, alignment and the interpolation
+/// weights of every target vertex in the source's projected triangles.
+fn map_paper(
+    source: &CloneSurface,
+    target: &CloneSurface,
+    src: &Projected,
+    tgt: &Projected,
+    opts: &FmcOptions,
+    timings: &mut StepTimings,
+    stats: &mut BTreeMap<String, f64>,
+) -> Result<Vec<Mapped>> {
     // 7 (needed by 3 and 5). Lip regions, each face in its own projected space.
     let t = Instant::now();
     let (src_lips, tgt_lips) = if opts.lip_separation {
@@ -418,11 +574,6 @@ pub fn clone_fmc(
     } else {
         Vec::new()
     };
-    struct Mapped {
-        weights: Vec<(u32, f64)>,
-        outside: u32,
-        overlaps: u32,
-    }
     let mapped: Vec<Mapped> = aligned
         .points
         .par_iter()
@@ -489,62 +640,5 @@ pub fn clone_fmc(
     );
     stats.insert("source_triangles_used".into(), mesh.triangles.len() as f64);
     timings.push("map", t.elapsed().as_secs_f64());
-
-    // 5 and 8. Motion mapping; each source motion is normalised by its own vertex's region
-    // and denormalised by the target's factors of that same region (see step 8).
-    let t = Instant::now();
-    let ratio: Vec<DVec3> = src
-        .norm
-        .region
-        .iter()
-        .zip(&src.norm.motion_factors)
-        .map(|(id, n)| normalise::factors(&target.fapu, normalise::motion_kinds(id.group())) / *n)
-        .collect();
-    let normalised: Vec<Vec<DVec3>> = motions
-        .par_iter()
-        .map(|m| {
-            let mut dense = vec![DVec3::ZERO; source.positions.len()];
-            for &(v, d) in &m.offsets {
-                dense[v as usize] = d.as_dvec3() * ratio[v as usize];
-            }
-            mapped
-                .iter()
-                .map(|mp| mp.weights.iter().map(|&(v, w)| dense[v as usize] * w).sum())
-                .collect()
-        })
-        .collect();
-    timings.push("motions", t.elapsed().as_secs_f64());
-
-    // 8. Output (the target's factors were applied per source region above).
-    let t = Instant::now();
-    let mut out = Vec::with_capacity(motions.len());
-    for (m, field) in motions.iter().zip(normalised) {
-        let offsets: Vec<(u32, Vec3)> = field
-            .iter()
-            .enumerate()
-            .filter(|(_, d)| **d != DVec3::ZERO)
-            .map(|(i, d)| (i as u32, d.as_vec3()))
-            .collect();
-        if let Some(&(vertex, _)) = offsets.iter().find(|(_, d)| !d.is_finite()) {
-            return Err(CloneError::NonFiniteOutput {
-                method: "fmc",
-                key: m.key,
-                vertex,
-            }
-            .into());
-        }
-        out.push(SurfaceMotion {
-            key: m.key,
-            value: m.value,
-            offsets,
-        });
-    }
-    timings.push("denormalise", t.elapsed().as_secs_f64());
-
-    Ok(SurfaceCloneResult {
-        motions: out,
-        timings,
-        stats,
-        warnings,
-    })
+    Ok(mapped)
 }
