@@ -191,8 +191,16 @@ pub fn patch_arkit(face: &FaceModel, source: &GltfSource) -> Result<ArkitPatchEx
             },
         );
     }
-    // Feature points and FAPU travel with the asset, as with FAT targets.
-    patch.scene_extras = crate::face::gltf_fat::scene_record(face, 1.0);
+    // Feature points and FAPU travel with the asset; the FAT's own records do not (its
+    // tables are not these targets).
+    let mut scene = crate::face::gltf_fat::scene_record(face, 1.0, &[]);
+    if let Some(record) = scene
+        .get_mut(crate::face::gltf_fat::KEY)
+        .and_then(|r| r.as_object_mut())
+    {
+        record.retain(|k, _| matches!(k.as_str(), "version" | "featurePoints" | "fapu"));
+    }
+    patch.scene_extras = scene;
     let document = patch.apply(source)?;
     warnings.extend(document.warnings.iter().cloned());
     Ok(ArkitPatchExport {
