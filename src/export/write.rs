@@ -1,6 +1,6 @@
 //! The export front door: a face with its FAT written as the asset a pipeline needs.
 //!
-//! [`write`] picks the output by the path's extension and the face's origin:
+//! [`write()`] picks the output by the path's extension and the face's origin:
 //!
 //! | output | face read from glTF (fits its document) | any other face |
 //! |---|---|---|
@@ -34,7 +34,7 @@ use crate::face::FaceModel;
 use crate::format::OutputFormat;
 use crate::rig::arkit_export::ArkitExportReport;
 
-/// The outputs [`write`] makes.
+/// The outputs [`write()`] makes.
 pub const EXPORTS: &[OutputFormat] = &[
     OutputFormat::Glb,
     OutputFormat::Gltf,
@@ -44,7 +44,7 @@ pub const EXPORTS: &[OutputFormat] = &[
     OutputFormat::VrmlGz,
 ];
 
-/// How [`write`] writes a face.
+/// How [`write()`] writes a face.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ExportOptions {
     /// Morph target names: the FAT's keys, or the 52 ARKit shapes (glTF and OBJ outputs).
@@ -56,7 +56,7 @@ pub struct ExportOptions {
     pub new_document: bool,
 }
 
-/// What kind of asset [`write`] made.
+/// What kind of asset [`write()`] made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExportKind {
@@ -81,7 +81,7 @@ impl ExportKind {
     }
 }
 
-/// What [`write`] wrote.
+/// What [`write()`] wrote.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ExportReport {
     /// The path written (for a shape set: the neutral OBJ or the folder).
