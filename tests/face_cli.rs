@@ -378,8 +378,14 @@ fn hostile_inputs_are_clear_errors() {
     std::fs::write(p("fp.csv"), "fp,vertices\n2.1,1\n9.3,5;7\n").unwrap();
     let o = fbakit(&["face", "info", s(&p("tri.obj")), "--fp", s(&p("fp.csv"))]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("point 9.3: vertex 5"), "{}", stderr(&o));
-    assert!(stderr(&o).contains("fp.csv"), "{}", stderr(&o));
+    // The file and line, the point, the vertex and the mesh's range.
+    let e = stderr(&o);
+    assert!(e.contains("fp.csv:3:"), "{e}");
+    assert!(
+        e.contains("feature point 9.3") && e.contains("vertex 5"),
+        "{e}"
+    );
+    assert!(e.contains("ids 0 to 2"), "{e}");
 
     // Morph folder with junk: a text file is ignored; unknown names, other topologies and
     // non-OBJ content named .obj are errors naming the file.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use fbakit::error::Result;
 use fbakit::face::FaceModel;
 use fbakit::snapshot::{
-    diff, face_snapshot, fap_diff, DiffOptions, FapDiffOptions, SnapshotOptions, Tolerance,
+    face_snapshot, fap_diff, try_diff, DiffOptions, FapDiffOptions, SnapshotOptions, Tolerance,
     VertexMatch,
 };
 
@@ -115,7 +115,7 @@ pub fn face_diff(a: FaceDiffArgs) -> Result<u8> {
             MatchArg::Nearest => VertexMatch::Nearest,
         },
     };
-    let report = diff(&fa, &fb, &options)?;
+    let report = try_diff(&fa, &fb, &options)?;
     if a.json {
         print_json(&report)?;
     } else {

@@ -189,9 +189,56 @@ pub struct FaceDiff {
     pub feature_points: FeaturePointsDiff,
     /// FAP units.
     pub fapu: FapuDiff,
+    /// Why the faces could not be compared at all (no FAT, different vertex layouts, a bad
+    /// tolerance); `None` when they were. Only [`diff`] sets it; [`try_diff`] returns the
+    /// error instead. A report with a problem is never equal.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub problem: Option<String>,
 }
 
 impl FaceDiff {
+    /// The report of two faces that could not be compared: not equal, `problem` set.
+    fn refused(a: &FaceModel, b: &FaceModel, options: &DiffOptions, problem: String) -> Self {
+        let given = match options.tolerance {
+            Tolerance::Absolute(t) => t.to_string(),
+            Tolerance::Relative(r) => format!("{r}x"),
+        };
+        FaceDiff {
+            equal: false,
+            a: a.name.clone(),
+            b: b.name.clone(),
+            tolerance: ResolvedTolerance {
+                given,
+                absolute: f64::NAN,
+                face_size: f64::NAN,
+            },
+            rotation_tolerance_degrees: f64::NAN,
+            vertex_match: options.vertex_match,
+            tables: Vec::new(),
+            neutral: NeutralDiff {
+                equal: false,
+                vertices_a: a.meshes.iter().map(|m| m.mesh.vertex_count()).sum(),
+                vertices_b: b.meshes.iter().map(|m| m.mesh.vertex_count()).sum(),
+                max_difference: f64::NAN,
+                mean_difference: f64::NAN,
+                differing_vertices: 0,
+                meshes_only_in_a: Vec::new(),
+                meshes_only_in_b: Vec::new(),
+                transforms: Vec::new(),
+            },
+            feature_points: FeaturePointsDiff {
+                equal: false,
+                max_difference: f64::NAN,
+                differing: Vec::new(),
+            },
+            fapu: FapuDiff {
+                equal: false,
+                units: Vec::new(),
+            },
+            problem: Some(problem),
+        }
+    }
+
     /// True when everything is within tolerance.
     pub fn is_equal(&self) -> bool {
         self.equal
@@ -214,10 +261,11 @@ impl fmt::Display for FaceDiff {
     }
 }
 
-/// Compares the FATs (and neutrals, feature points, FAP units) of two faces as animation.
-///
-/// Both faces need a FAT. Faces with different vertex layouts are refused unless
-/// `options.vertex_match` is [`VertexMatch::Nearest`].
+/// Compares the FATs (and neutrals, feature points, FAP units) of two faces as animation,
+/// for a test's `assert!`: a pair that cannot be compared at all (a face without a FAT or
+/// without vertices, different vertex layouts under [`VertexMatch::Index`], a tolerance that
+/// is not a positive finite number) gives a report that is not equal and names the problem
+/// ([`FaceDiff::problem`]); [`try_diff`] returns it as an error instead.
 ///
 /// ```
 /// use fbakit::snapshot::{diff, DiffOptions};
@@ -225,13 +273,22 @@ impl fmt::Display for FaceDiff {
 /// let a = fbakit::face::read("alma")?;
 /// let mut b = a.clone();
 /// b.fat.tables[0].meshes[0].displacements[0].x += 0.01; // one vertex of one table
-/// let report = diff(&a, &b, &DiffOptions::default())?;
+/// let report = diff(&a, &b, &DiffOptions::default());
 /// assert!(!report.is_equal(), "{report}");
 /// assert_eq!(report.worst_table().unwrap().key, a.fat.tables[0].key);
-/// assert!(diff(&a, &a, &DiffOptions::default())?.is_equal());
+/// let opts = DiffOptions::default();
+/// let report = diff(&a, &a, &opts);
+/// assert!(report.is_equal(), "{report}");
 /// # Ok::<(), fbakit::error::Error>(())
 /// ```
-pub fn diff(a: &FaceModel, b: &FaceModel, options: &DiffOptions) -> Result<FaceDiff> {
+pub fn diff(a: &FaceModel, b: &FaceModel, options: &DiffOptions) -> FaceDiff {
+    try_diff(a, b, options).unwrap_or_else(|e| FaceDiff::refused(a, b, options, e.to_string()))
+}
+
+/// [`diff`], with the problems that stop a comparison as errors (all of them bad input):
+/// both faces need a FAT; faces with different vertex layouts are refused unless
+/// `options.vertex_match` is [`VertexMatch::Nearest`].
+pub fn try_diff(a: &FaceModel, b: &FaceModel, options: &DiffOptions) -> Result<FaceDiff> {
     let tolerance = options.tolerance.checked()?;
     let mut ma = FaceMotion::new(a, true)?;
     let mut mb = FaceMotion::new(b, true)?;
@@ -397,6 +454,7 @@ pub fn diff(a: &FaceModel, b: &FaceModel, options: &DiffOptions) -> Result<FaceD
         neutral,
         feature_points,
         fapu,
+        problem: None,
     })
 }
 

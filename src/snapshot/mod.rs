@@ -13,13 +13,15 @@
 //! use fbakit::snapshot::{diff, snapshot, DiffOptions};
 //!
 //! let face = fbakit::face::read("alma")?;
-//! let text = snapshot(&face, &Default::default())?;
-//! // in a test: insta::assert_snapshot!(text);
+//! let text = snapshot(&face, &Default::default());
+//! // in a test: insta::assert_snapshot!(fbakit::snapshot::snapshot(&face, &Default::default()));
 //! assert!(text.contains("table: \"open_jaw\""));
 //!
 //! let copy = face.clone();
-//! let report = diff(&face, &copy, &DiffOptions::default())?;
+//! let report = diff(&face, &copy, &DiffOptions::default());
 //! assert!(report.is_equal(), "{report}");
+//! // the same, with the problems that stop a comparison as errors:
+//! assert!(fbakit::snapshot::try_diff(&face, &copy, &DiffOptions::default())?.is_equal());
 //! # Ok::<(), fbakit::error::Error>(())
 //! ```
 //!
@@ -63,8 +65,8 @@ mod report;
 mod tolerance;
 
 pub use diff::{
-    diff, DiffOptions, FaceDiff, FapuDiff, FapuUnitDiff, FeaturePointDiff, FeaturePointsDiff,
-    NeutralDiff, TableDiff, TransformDiff, VertexMatch,
+    diff, try_diff, DiffOptions, FaceDiff, FapuDiff, FapuUnitDiff, FeaturePointDiff,
+    FeaturePointsDiff, NeutralDiff, TableDiff, TransformDiff, VertexMatch,
 };
 pub use error::{Side, SnapshotError};
 pub use face_snapshot::{
@@ -80,7 +82,28 @@ use crate::face::FaceModel;
 /// The snapshot text (YAML) of `face`: meshes, transforms, feature points, FAP units and per
 /// table its borders, values, moving vertices, largest and mean displacement and a digest of
 /// its displacements on the tolerance's grid (see the module docs for what it promises).
-/// A face without a FAT is refused.
-pub fn snapshot(face: &FaceModel, options: &SnapshotOptions) -> Result<String> {
+///
+/// Made for snapshot tests, it never fails: a face that cannot be snapshot (no FAT, no
+/// vertices, a tolerance that is not a positive finite number) gives a one-line text naming
+/// the problem (`error: "…"`), which no reviewed snapshot matches. [`try_snapshot`] returns
+/// the problem as an error instead.
+///
+/// ```
+/// let face = fbakit::face::read("alma")?;
+/// let text = fbakit::snapshot::snapshot(&face, &Default::default());
+/// // in a test: insta::assert_snapshot!(fbakit::snapshot::snapshot(&face, &Default::default()));
+/// assert!(text.contains("table: \"open_jaw\""));
+/// # Ok::<(), fbakit::error::Error>(())
+/// ```
+pub fn snapshot(face: &FaceModel, options: &SnapshotOptions) -> String {
+    try_snapshot(face, options).unwrap_or_else(|e| {
+        let message = serde_json::to_string(&e.to_string()).unwrap_or_default();
+        format!("error: {message}\n")
+    })
+}
+
+/// [`snapshot`], with the problems that stop it (a face without a FAT or vertices, a bad
+/// tolerance) as errors.
+pub fn try_snapshot(face: &FaceModel, options: &SnapshotOptions) -> Result<String> {
     Ok(face_snapshot(face, options)?.to_yaml())
 }

@@ -30,6 +30,10 @@ fn table_label(t: &TableDiff) -> String {
 /// The text report of a face comparison.
 pub fn face_diff_text(d: &FaceDiff) -> String {
     let mut o = String::new();
+    if let Some(problem) = &d.problem {
+        let _ = writeln!(o, "NOT COMPARED: {} and {}: {problem}", d.a, d.b);
+        return o;
+    }
     let tol = &d.tolerance;
     let differing: Vec<&TableDiff> = d.differing_tables().collect();
     let verdict = if d.equal { "EQUAL" } else { "DIFFERENT" };
