@@ -49,6 +49,12 @@ fn import_in_blender(files: &[&PathBuf]) -> Option<Vec<Value>> {
         }
     };
     let stdout = String::from_utf8_lossy(&out.stdout);
+    if out.status.code() == Some(3) {
+        let why = String::from_utf8_lossy(&out.stderr);
+        assert!(!required, "Blender test required but: {why}");
+        eprintln!("note: skipping Blender import test: {}", why.trim());
+        return None;
+    }
     assert!(
         out.status.success(),
         "Blender failed: {stdout}\n{}",
@@ -250,6 +256,8 @@ fn clone_play_export_and_shape_sets_import_in_blender() {
         &obj.target,
         &neutral,
         &jaw,
+        &o.rig_glb,
+        &o.from_rig_glb,
     ];
     let Some(r) = import_in_blender(&files) else {
         return;
@@ -322,4 +330,25 @@ fn clone_play_export_and_shape_sets_import_in_blender() {
             }
         }
     }
+
+    // `face from-rig` on the ICT head rig imports as the rig does, its shapes first, the FAT's
+    // targets after them.
+    let (rig, from_rig) = (objects(&r[11]), objects(&r[12]));
+    assert_eq!(
+        rig.keys().collect::<Vec<_>>(),
+        from_rig.keys().collect::<Vec<_>>()
+    );
+    let head = rig.values().find(|x| x["type"] == "MESH").unwrap();
+    let name = head["name"].as_str().unwrap();
+    assert_eq!(from_rig[name]["vertices"], head["vertices"]);
+    assert_eq!(from_rig[name]["polygons"], head["polygons"]);
+    let json = json_of(&o.from_rig_glb);
+    let keys = strings(&from_rig[name]["shapeKeys"]);
+    assert_eq!(
+        keys[1..],
+        strings(&json["meshes"][0]["extras"]["targetNames"])[..]
+    );
+    let own = strings(&head["shapeKeys"]);
+    assert_eq!(keys[..own.len()], own[..]);
+    assert!(keys.len() > own.len(), "{keys:?}");
 }

@@ -4,6 +4,7 @@
 #
 #   blender -b --factory-startup --python tests/support/blender_import.py -- FILE...
 #
+# Exit code 3: numpy missing (callers treat that as "skip").
 # .glb/.gltf go through the glTF importer, .obj through the OBJ importer with split_mode='OFF'
 # (one object, vertices in the file's order).
 import json
@@ -13,7 +14,11 @@ import warnings
 
 # Debian's Blender 3.4 glTF importer still uses `np.bool`, which numpy removed in 1.24; without
 # this alias every import stops with an AttributeError.
-import numpy
+try:
+    import numpy
+except ImportError:
+    print("numpy is missing (Debian: python3-numpy)", file=sys.stderr)
+    sys.exit(3)
 
 with warnings.catch_warnings():
     # numpy 1.24 warns on the very look-up that finds the alias gone.

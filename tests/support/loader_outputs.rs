@@ -1,7 +1,7 @@
 //! The files issue 19 says users open in other tools, made by the real `fbakit` binary: the
 //! test avatar ([`super::avatar`]) after `clone` and after `play` as `.glb` and as `.gltf` +
-//! `.bin` + image, its ARKit-named export, a new document (`play` on alma), and an OBJ shape
-//! set cloned onto an OBJ target. `tests/gltf_loaders.rs` (three.js) and
+//! `.bin` + image, its ARKit-named export, a new document (`play` on alma), the bundled ICT
+//! head rig after `face from-rig`, and an OBJ shape set cloned onto an OBJ target. `tests/gltf_loaders.rs` (three.js) and
 //! `tests/blender_import.rs` (Blender) load them.
 
 use std::path::{Path, PathBuf};
@@ -28,6 +28,10 @@ pub struct GltfOutputs {
     pub arkit_glb: PathBuf,
     /// `play alma speech.fap -o alma-play.glb`: a document fbakit made.
     pub alma_play_glb: PathBuf,
+    /// The bundled ICT head rig (`samples/faces/ict-head/ict-head.glb`, 35 ARKit shapes).
+    pub rig_glb: PathBuf,
+    /// `face from-rig ict-head.glb --fp ict-head-fp.csv -o from-rig.glb`.
+    pub from_rig_glb: PathBuf,
 }
 
 fn run(args: &[&std::ffi::OsStr]) {
@@ -62,6 +66,8 @@ pub fn gltf_outputs(dir: &Path) -> GltfOutputs {
         play_gltf: dir.join("out/play.gltf"),
         arkit_glb: dir.join("arkit.glb"),
         alma_play_glb: dir.join("alma-play.glb"),
+        rig_glb: sample("faces/ict-head/ict-head.glb"),
+        from_rig_glb: dir.join("from-rig.glb"),
         input_glb,
         input_gltf,
     };
@@ -103,6 +109,16 @@ pub fn gltf_outputs(dir: &Path) -> GltfOutputs {
         speech.as_os_str(),
         "-o".as_ref(),
         o.alma_play_glb.as_os_str(),
+    ]);
+    let rig_fp = sample("faces/ict-head/ict-head-fp.csv");
+    run(&[
+        "face".as_ref(),
+        "from-rig".as_ref(),
+        o.rig_glb.as_os_str(),
+        "--fp".as_ref(),
+        rig_fp.as_os_str(),
+        "-o".as_ref(),
+        o.from_rig_glb.as_os_str(),
     ]);
     o
 }
