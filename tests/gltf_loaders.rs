@@ -276,6 +276,15 @@ fn assert_avatar(r: &Value, input: &Value, output: &Value, played: bool) -> Vec<
 fn clone_play_and_export_outputs_load_in_three_js() {
     let dir = tempfile::tempdir().unwrap();
     let o = gltf_outputs(dir.path());
+    // The harness must see what three.js complains about: target names that do not match the
+    // targets are dropped with a console warning.
+    let broken = o.clone_gltf.with_file_name("broken.gltf");
+    let mut json = json_of(&o.clone_gltf);
+    json["meshes"][0]["extras"]["targetNames"]
+        .as_array_mut()
+        .unwrap()
+        .pop();
+    std::fs::write(&broken, serde_json::to_vec(&json).unwrap()).unwrap();
     let files = [
         &o.clone_glb,
         &o.play_glb,
@@ -284,6 +293,7 @@ fn clone_play_and_export_outputs_load_in_three_js() {
         &o.arkit_glb,
         &o.alma_play_glb,
         &o.from_rig_glb,
+        &broken,
     ];
     let Some(reports) = load_in_three(&files) else {
         return;
@@ -335,4 +345,10 @@ fn clone_play_and_export_outputs_load_in_three_js() {
     assert!(names.len() > own.len(), "{names:?}");
     assert_eq!(r["meshes"][0]["vertices"], 24_591);
     assert_eq!(r["animations"], Value::Array(vec![]));
+
+    let r = &reports[7];
+    let warned = r["consoleWarnings"].to_string();
+    assert!(warned.contains("targetNames"), "{r}");
+    // three.js then names the targets by their index.
+    assert!(meshes_of(r, 0).iter().all(|p| p["names"][0] == "0"), "{r}");
 }
