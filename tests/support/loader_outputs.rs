@@ -125,20 +125,20 @@ pub fn gltf_outputs(dir: &Path) -> GltfOutputs {
 
 /// An OBJ target and the shape set cloned onto it.
 pub struct ObjOutputs {
-    /// The user's OBJ (bruno, one object).
+    /// The user's OBJ (alma's meshes in one file).
     pub target: PathBuf,
-    /// `clone alma head.obj --fp-target fp.csv -o set/`: the folder.
+    /// `clone alma head.obj --fp-target head-fp.csv -o set/`: the folder.
     pub set: PathBuf,
 }
 
-/// bruno as the user's OBJ with its feature points by position, and alma cloned onto it as an
-/// OBJ shape set.
+/// alma as the user's OBJ with its feature points by position (a small head keeps Blender's
+/// OBJ importer quick), and alma cloned onto it as an OBJ shape set.
 pub fn obj_outputs(dir: &Path) -> ObjOutputs {
-    let bruno = fbakit::face::read("bruno").unwrap();
+    let head = fbakit::face::read("alma").unwrap();
     let target = dir.join("head.obj");
-    fbakit::face::write(&target, &bruno).unwrap();
+    fbakit::face::write(&target, &head).unwrap();
     let mut csv = String::from("fp,x,y,z\n");
-    for p in bruno.feature_points.iter() {
+    for p in head.feature_points.iter() {
         let q = p.position.unwrap();
         csv.push_str(&format!("{},{},{},{}\n", p.id, q.x, q.y, q.z));
     }
