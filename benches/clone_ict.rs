@@ -1,8 +1,9 @@
 //! Cloning between real heads: ICT head A (rig FAT, 14 FAPs) onto the reshaped head B of the
 //! ground truth (tests/support/ict_truth.rs), every method, alma onto the bundled
 //! one-mesh `ict` (parts split out), alma onto the `ict-head.glb` sample written back as a
-//! patched glb; dense CANDIDE-3 onto `ict` is `clone_candide_ict`. The
-//! ICT cases are skipped when `../shared/data/ict-facekit` is absent. Quality figures are printed once per case.
+//! patched glb and as a new glb (`--new-document`); dense CANDIDE-3 onto `ict` is
+//! `clone_candide_ict`. The ICT cases are skipped when `../shared/data/ict-facekit` is absent.
+//! Quality figures are printed once per case.
 //! `ict_to_its_dense_remesh`: the rig head onto itself subdivided once (105k vertices), `fit`.
 
 #[path = "../tests/support/ict_truth.rs"]
@@ -75,6 +76,17 @@ fn alma_to_bundled_ict(method: Method) {
 /// document with the new morph targets).
 #[divan::bench(sample_count = 5)]
 fn alma_to_ict_head_glb_patched() {
+    alma_to_ict_head_glb(false);
+}
+
+/// The same with `--new-document`: the clone written as a new glb (metres) instead of the
+/// user's document patched; the patched write should cost at most 1.2× this.
+#[divan::bench(sample_count = 5)]
+fn alma_to_ict_head_glb_new_document() {
+    alma_to_ict_head_glb(true);
+}
+
+fn alma_to_ict_head_glb(new_document: bool) {
     static F: OnceLock<FaceModel> = OnceLock::new();
     let alma = F.get_or_init(|| fbakit::face::read("alma").expect("alma"));
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/faces/ict-head");
@@ -85,7 +97,11 @@ fn alma_to_ict_head_glb_patched() {
     .expect("ict-head.glb");
     let out = clone_face(alma, &target, &opts(Method::Fit)).expect("clone");
     let tmp = tempfile::tempdir().expect("temp dir");
-    fbakit::export::write_face(tmp.path().join("out.glb"), &out.face).expect("write");
+    let options = fbakit::export::ExportOptions {
+        new_document,
+        ..Default::default()
+    };
+    fbakit::export::write(tmp.path().join("out.glb"), &out.face, &options).expect("write");
 }
 
 /// The ICT rig head (26 719 vertices, every table of its rig FAT) and its remesh 4× denser

@@ -2,7 +2,7 @@
 //! lash primitive rides on the eyelids (and not on the jaw); feature points given by
 //! position snap to the skin, or to the eye part for the pupils, never to lashes or a hat.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use fbakit::clone::face::{clone_face, CloneOptions};
 use fbakit::face::{FaceModel, FaceReadOptions};
@@ -14,55 +14,8 @@ use glam::Vec3;
 mod support;
 use support::avatar;
 
-/// The avatar's head sphere and eyes in its world frame (metres; the armature's 0.01).
-const CENTRE: Vec3 = Vec3::new(0.0, 1.6, 0.0);
-const RADIUS: f32 = 0.1;
-
 fn fp(s: &str) -> FeaturePointId {
     s.parse().unwrap()
-}
-
-/// Feature points for the avatar as a positions CSV: the source face's points, scaled so its
-/// pupils land on the avatar's, then pushed onto the head sphere (the pupils onto the eyes'
-/// front poles). Teeth and tongue points are left out (the avatar's mouth is no teeth).
-/// `extra` lines are appended as they are.
-fn avatar_fp_csv(source: &FaceModel, dir: &Path, extra: &str) -> PathBuf {
-    let s = &source.feature_points;
-    let (l, r) = (
-        s.position(fp("3.5")).unwrap(),
-        s.position(fp("3.6")).unwrap(),
-    );
-    // +x is the face's own left: 3.5 on the +x eye.
-    let (al, ar) = (
-        Vec3::new(0.032, 1.62, 0.087),
-        Vec3::new(-0.032, 1.62, 0.087),
-    );
-    let scale = al.distance(ar) / l.distance(r);
-    let mid = (l + r) / 2.0;
-    let amid = (al + ar) / 2.0;
-    let mut body = String::from("fp,x,y,z\n");
-    for p in s.iter() {
-        let id = p.id.to_string();
-        if id.starts_with("9.8")
-            || ["9.9", "9.10", "9.11"].contains(&id.as_str())
-            || id.starts_with("6.")
-        {
-            continue;
-        }
-        let q = match id.as_str() {
-            "3.5" => al,
-            "3.6" => ar,
-            _ => {
-                let q = amid + (s.position(p.id).unwrap() - mid) * scale;
-                CENTRE + (q - CENTRE).normalize() * RADIUS
-            }
-        };
-        body.push_str(&format!("{id},{},{},{}\n", q.x, q.y, q.z));
-    }
-    body.push_str(extra);
-    let path = dir.join("avatar-fp.csv");
-    std::fs::write(&path, body).unwrap();
-    path
 }
 
 fn read_avatar(dir: &Path, fp: &Path) -> FaceModel {
@@ -93,7 +46,7 @@ fn motion(face: &FaceModel, fap: u8, value: f64) -> Vec<Vec<Vec3>> {
 fn lash_primitive_follows_the_eyelid_not_the_jaw() {
     let source = fbakit::face::read("alma").unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let csv = avatar_fp_csv(&source, dir.path(), "");
+    let csv = avatar::fp_csv(&source, dir.path(), "");
     let target = read_avatar(dir.path(), &csv);
     let out = clone_face(&source, &target, &CloneOptions::default()).unwrap();
     let face = &out.face;
@@ -213,7 +166,7 @@ fn positions_snap_to_the_skin_and_the_pupils_to_the_eyes() {
     let world = |p: Vec3| p * 0.01;
     let (a, b) = (world(lash[1]), world(lash[2]));
     let extra = format!("3.1,{},{},{}\n", a.x, a.y, a.z);
-    let csv = avatar_fp_csv(&source, dir.path(), "");
+    let csv = avatar::fp_csv(&source, dir.path(), "");
     // Replace the 3.1 row and the 3.3 row by lash positions.
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut body: String = text

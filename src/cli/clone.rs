@@ -63,6 +63,10 @@ pub struct CloneArgs {
     /// FAP recipes, as `face export --names arkit`).
     #[arg(long, value_name = "fat|arkit", default_value = "fat")]
     pub names: super::face_export::NamesArg,
+    /// A .glb/.gltf output is a new document in metres even when the target was read from
+    /// glTF (default: the target's own document, patched).
+    #[arg(long)]
+    pub new_document: bool,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -333,6 +337,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     // ARKit-named shapes made from it.
     let export_opts = fbakit::export::ExportOptions {
         names: args.names.into(),
+        new_document: args.new_document,
         ..Default::default()
     };
     let mut written = fbakit::export::write(&args.output, &outcome.face, &export_opts)?;

@@ -454,3 +454,52 @@ impl Avatar {
         path
     }
 }
+
+/// Feature points for the avatar as a positions CSV: the source face's points, scaled so its
+/// pupils land on the avatar's, then pushed onto the head sphere (the pupils onto the eyes'
+/// front poles). Teeth and tongue points are left out (the avatar's mouth is no teeth).
+/// `extra` lines are appended as they are.
+pub fn fp_csv(
+    source: &fbakit::face::FaceModel,
+    dir: &std::path::Path,
+    extra: &str,
+) -> std::path::PathBuf {
+    let s = &source.feature_points;
+    let (l, r) = (
+        s.position("3.5".parse().unwrap()).unwrap(),
+        s.position("3.6".parse().unwrap()).unwrap(),
+    );
+    // +x is the face's own left: 3.5 on the +x eye.
+    let (al, ar) = (
+        Vec3::new(0.032, 1.62, 0.087),
+        Vec3::new(-0.032, 1.62, 0.087),
+    );
+    let scale = al.distance(ar) / l.distance(r);
+    let mid = (l + r) / 2.0;
+    let amid = (al + ar) / 2.0;
+    let mut body = String::from("fp,x,y,z\n");
+    for p in s.iter() {
+        let id = p.id.to_string();
+        if id.starts_with("9.8")
+            || ["9.9", "9.10", "9.11"].contains(&id.as_str())
+            || id.starts_with("6.")
+        {
+            continue;
+        }
+        let q = match id.as_str() {
+            "3.5" => al,
+            "3.6" => ar,
+            _ => {
+                let q = amid + (s.position(p.id).unwrap() - mid) * scale;
+                // The head sphere in the file's world frame (metres: the armature's 0.01).
+                let c = Vec3::new(0.0, 1.6, 0.0);
+                c + (q - c).normalize() * 0.1
+            }
+        };
+        body.push_str(&format!("{id},{},{},{}\n", q.x, q.y, q.z));
+    }
+    body.push_str(extra);
+    let path = dir.join("avatar-fp.csv");
+    std::fs::write(&path, body).unwrap();
+    path
+}

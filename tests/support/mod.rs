@@ -4,4 +4,5 @@ pub mod avatar;
 pub mod cli;
 pub mod gltf_scenes;
 pub mod gltf_transform;
+pub mod loader_outputs;
 pub mod validator;
