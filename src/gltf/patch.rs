@@ -147,7 +147,8 @@ impl Builder {
         self.view(&bytes)
     }
 
-    /// A sparse VEC3 target accessor of `count` vertices (zeros but the listed ones).
+    /// A VEC3 target accessor of `count` vertices (zeros but the listed ones): sparse, or dense
+    /// when that is smaller.
     fn sparse_target(&mut self, count: usize, s: &SparseOffsets) -> usize {
         let zero = SparseOffsets {
             vertices: vec![0],
@@ -164,6 +165,23 @@ impl Builder {
             // The unlisted vertices are zeros.
             min = min.min(Vec3::ZERO);
             max = max.max(Vec3::ZERO);
+        }
+        // A sparse entry costs 16 bytes (index + VEC3), a dense one 12: a target that moves
+        // more than three quarters of its vertices is smaller (and faster to write) dense.
+        if s.vertices.len() * 16 > count * 12 && s.vertices.iter().all(|&v| (v as usize) < count) {
+            let mut dense = vec![0.0f32; count * 3];
+            for (&v, o) in s.vertices.iter().zip(&s.offsets) {
+                dense[v as usize * 3..v as usize * 3 + 3].copy_from_slice(&o.to_array());
+            }
+            let dv = self.floats(&dense);
+            return self.accessor(json!({
+                "bufferView": dv,
+                "componentType": FLOAT,
+                "count": count,
+                "type": "VEC3",
+                "min": [min.x, min.y, min.z],
+                "max": [max.x, max.y, max.z],
+            }));
         }
         let idx: Vec<u8> = s.vertices.iter().flat_map(|v| v.to_le_bytes()).collect();
         let vals: Vec<f32> = s.offsets.iter().flat_map(|o| o.to_array()).collect();
@@ -697,4 +715,59 @@ fn uri_unescape(s: &str) -> String {
         }
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+#[cfg(test)]
+mod target_tests {
+    use super::*;
+
+    fn builder() -> Builder {
+        Builder {
+            json: json!({}),
+            bin: Vec::new(),
+        }
+    }
+
+    fn floats_of(b: &Builder, view: &Value) -> Vec<f32> {
+        let v = &b.json["bufferViews"][view.as_u64().unwrap() as usize];
+        let (o, n) = (
+            v["byteOffset"].as_u64().unwrap() as usize,
+            v["byteLength"].as_u64().unwrap() as usize,
+        );
+        b.bin[o..o + n]
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    }
+
+    #[test]
+    fn few_moving_vertices_stay_sparse_and_most_go_dense() {
+        let mut b = builder();
+        let few = SparseOffsets {
+            vertices: vec![1, 3],
+            offsets: vec![Vec3::X, Vec3::new(0.0, -2.0, 0.5)],
+        };
+        let a = b.sparse_target(10, &few);
+        let acc = b.json["accessors"][a].clone();
+        assert_eq!(acc["sparse"]["count"], 2);
+        assert!(acc.get("bufferView").is_none());
+        assert_eq!(acc["min"], json!([0.0, -2.0, 0.0]));
+        assert_eq!(acc["max"], json!([1.0, 0.0, 0.5]));
+
+        // 9 of 10 move: dense, the unlisted vertex a zero.
+        let most = SparseOffsets {
+            vertices: (0..10).filter(|&v| v != 4).collect(),
+            offsets: (0..9).map(|i| Vec3::splat(i as f32 + 1.0)).collect(),
+        };
+        let a = b.sparse_target(10, &most);
+        let acc = b.json["accessors"][a].clone();
+        assert!(acc.get("sparse").is_none());
+        assert_eq!(acc["count"], 10);
+        let values = floats_of(&b, &acc["bufferView"]);
+        assert_eq!(values.len(), 30);
+        assert_eq!(&values[12..15], &[0.0, 0.0, 0.0]);
+        assert_eq!(&values[15..18], &[5.0, 5.0, 5.0]);
+        assert_eq!(acc["min"], json!([0.0, 0.0, 0.0]));
+        assert_eq!(acc["max"], json!([9.0, 9.0, 9.0]));
+    }
 }
