@@ -5,6 +5,7 @@
 
 mod support;
 
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use fbakit::face::FaceModel;
@@ -482,4 +483,99 @@ proptest::proptest! {
         proptest::prop_assert_eq!(&before[..sb], &after[..sa]);
         proptest::prop_assert_eq!(&before[eb..], &after[ea..]);
     }
+}
+
+/// `face` written as `format` and read back: `.wrl`, `.wrl.gz`, `.glb`, `.gltf`, or an OBJ
+/// morph set (`morphs`, which merges the meshes: a new layout). Returns the face and the path
+/// the CLI reads it from.
+fn through(face: &FaceModel, format: &str, dir: &Path, tag: &str) -> (FaceModel, PathBuf) {
+    if format == "morphs" {
+        let set = dir.join(format!("{tag}-morphs"));
+        fbakit::face::morphs::write_morph_set(face, &set, None).unwrap();
+        let options = fbakit::face::morphs::MorphSetOptions {
+            feature_points: Some(set.join("feature-points.csv")),
+            manifest: None,
+            tolerance: None,
+        };
+        let back =
+            fbakit::face::morphs::face_from_morph_set(&set.join("neutral.obj"), &set, &options)
+                .unwrap()
+                .0;
+        return (back, set);
+    }
+    let path = dir.join(format!("{tag}.{format}"));
+    fbakit::export::write_face(&path, face).unwrap();
+    (fbakit::face::read(&path).unwrap(), path)
+}
+
+/// Issue 20: every pair of formats fbakit writes FATs in, one table perturbed by half and by
+/// twice the tolerance on the way: equal, then different with that table named first and its
+/// figure right. OBJ morph sets merge meshes, so pairs with one are matched by nearest vertex
+/// and differ in structure (meshes, transforms) while every table agrees.
+#[test]
+fn every_format_pair_sees_a_perturbation_above_the_tolerance_only() {
+    let tol = 1e-3;
+    let dir = tempfile::tempdir().unwrap();
+    let formats = ["wrl", "wrl.gz", "glb", "gltf", "morphs"];
+    let mut below = alma().clone();
+    perturb(&mut below, "open_jaw", 0.5 * tol);
+    let mut above = alma().clone();
+    perturb(&mut above, "open_jaw", 2.0 * tol);
+    for a_format in formats {
+        let (a, _) = through(alma(), a_format, dir.path(), &format!("a-{a_format}"));
+        for b_format in formats {
+            let pair = format!("{a_format} vs {b_format}");
+            let options = DiffOptions {
+                tolerance: Tolerance::Absolute(tol),
+                vertex_match: if a_format == "morphs" || b_format == "morphs" {
+                    VertexMatch::Nearest
+                } else {
+                    VertexMatch::Index
+                },
+            };
+            let tag = format!("{a_format}-{b_format}");
+            let (b, _) = through(&below, b_format, dir.path(), &format!("below-{tag}"));
+            let report = diff(&a, &b, &options);
+            // A morph set against a format that keeps the meshes differs in its structure
+            // (one merged mesh, transforms baked): the animation is what must agree.
+            let restructured = (a_format == "morphs") != (b_format == "morphs");
+            assert!(
+                report.differing_tables().count() == 0 && (restructured || report.is_equal()),
+                "{pair}: {report}"
+            );
+            let (b, _) = through(&above, b_format, dir.path(), &format!("above-{tag}"));
+            let report = diff(&a, &b, &options);
+            assert!(!report.is_equal(), "{pair}: {report}");
+            let worst = report.worst_table().unwrap();
+            assert_eq!(worst.table, "open_jaw", "{pair}: {report}");
+            assert_eq!(report.differing_tables().count(), 1, "{pair}: {report}");
+            assert!(
+                (worst.max_difference - 2.0 * tol).abs() < 0.05 * tol,
+                "{pair}: {}",
+                worst.max_difference
+            );
+        }
+    }
+}
+
+/// The same from the CLI, across a VRML file and a glTF file, with the JSON contract.
+#[test]
+fn cli_face_diff_across_formats() {
+    let tol = 1e-3;
+    let dir = tempfile::tempdir().unwrap();
+    let (_, a) = through(alma(), "wrl.gz", dir.path(), "a");
+    let mut above = alma().clone();
+    perturb(&mut above, "open_jaw", 2.0 * tol);
+    let (_, b) = through(&above, "glb", dir.path(), "b");
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let out = fbakit(&["face", "diff", a, b, "--tolerance", "0.001", "--json"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["equal"], false);
+    assert_eq!(json["tables"][0]["table"], "open_jaw");
+    assert_eq!(json["tables"][0]["fap"], 3);
+    assert_eq!(json["tables"][1]["equal"], true);
+    let out = fbakit(&["face", "diff", a, b, "--tolerance", "0.004"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).starts_with("EQUAL:"));
 }

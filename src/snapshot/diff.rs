@@ -530,6 +530,9 @@ fn nearest_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Vec<u32> {
         VertexIndex::new(&points)
     };
     let whole = index_of(0..mb.vertex_count());
+    // Coincident vertices (seam twins, a lid over an eyeball) written through f32 by one
+    // format and not another land a hair apart: count as ties what float noise separates.
+    let noise = ma.size() as f32 * 1e-6;
     let mut pairing = Vec::with_capacity(ma.vertex_count());
     for (i, m) in a.meshes.iter().enumerate() {
         let own = b.mesh_index(&m.name).map(|j| {
@@ -554,7 +557,7 @@ fn nearest_pairing(ma: &FaceMotion, mb: &FaceMotion) -> Vec<u32> {
                 pairing.push(0);
                 continue;
             };
-            let ties = index.within(p, d);
+            let ties = index.within(p, d + noise);
             let same = (same_base + k) as u32;
             let pick = ties
                 .iter()
