@@ -61,7 +61,7 @@ use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::Result;
 use crate::mesh::spatial::find_coincident_vertices;
 pub(crate) use correspond::Correspondence;
-use regions::{classify, triangle_masks};
+use regions::{classify, face_pieces, triangle_masks};
 use register::{register, Moving};
 use surface::{adjacency, QuerySurface};
 
@@ -268,6 +268,7 @@ fn register_and_correspond(
     let t_adj = adjacency(target.positions.len(), &target.triangles);
     let (s_sides, s_slits) = classify(source, &adj);
     let (t_sides, t_slits) = classify(target, &t_adj);
+    let (s_face, t_face) = (face_pieces(source), face_pieces(target));
     for (n, side) in [(s_slits, "source"), (t_slits, "target")] {
         if n < 3 {
             warnings.push(format!(
@@ -320,13 +321,14 @@ fn register_and_correspond(
     let fixed = QuerySurface::new(
         &target.positions,
         &target.triangles,
-        triangle_masks(&t_sides, &target.triangles),
+        triangle_masks(&t_sides, &t_face, &target.triangles),
     );
     let moving = Moving {
         positions: &source.positions,
         triangles: &source.triangles,
         adjacency: &adj,
         sides: &s_sides,
+        face: &s_face,
         landmarks: &landmarks,
         scale,
     };
@@ -340,14 +342,16 @@ fn register_and_correspond(
     let registered = QuerySurface::new(
         &reg.positions,
         &source.triangles,
-        triangle_masks(&s_sides, &source.triangles),
+        triangle_masks(&s_sides, &s_face, &source.triangles),
     );
     let corr = correspond::correspond(
         &target.positions,
         &target.triangles,
         &t_sides,
+        &t_face,
         &registered,
         &source.triangles,
+        &s_sides,
         scale,
         opts,
     );
