@@ -190,15 +190,19 @@ pub(crate) fn correspond(
                 // A vertex lying on the source (within `near`) whose compatible points are all
                 // farther than `near` beyond its closest point sits where the normals mislead
                 // (a lid margin's fold): its closest point stands in.
-                let on_source = source
-                    .closest_within(p, plain, near * 1.001)
-                    .filter(|h| h.point.distance(p) <= near);
+                // (Searched only when the compatible point is not itself that near.)
+                let on_source = || {
+                    source
+                        .closest_within(p, plain, near * 1.001)
+                        .filter(|h| h.point.distance(p) <= near)
+                };
                 match source.closest_within(p, oriented, far_probe) {
-                    Some(h) => match on_source {
+                    Some(h) if h.point.distance(p) <= near => h,
+                    Some(h) => match on_source() {
                         Some(c) if h.point.distance(p) > c.point.distance(p) + near => c,
                         _ => h,
                     },
-                    None => match on_source {
+                    None => match on_source() {
                         Some(c) => c,
                         // An oriented point beyond `far` fades to nothing; with no oriented
                         // triangle at all the plain closest point stands in.

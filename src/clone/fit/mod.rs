@@ -9,7 +9,11 @@
 //!    labelled upper or lower from the feature points (lip corners and inner-lip points,
 //!    eye corners and lid points). Every closest-point query below is restricted to its side:
 //!    an upper-lip vertex never lands on the lower lip, an upper lid never on the lower lid,
-//!    so a closed mouth or eye does not weld.
+//!    so a closed mouth or eye does not weld. A triangle bridging a slit (CANDIDE-3 covers
+//!    its eyes, iris vertices between the lids) is seen from both sides, but a vertex landing
+//!    on it takes none of the other side's corners. And a vertex of a *face piece* (a
+//!    connected piece holding a skin feature point) only matches face pieces: ICT's eye
+//!    occlusion shell lies against the lid margin and once took the upper lid's motion away.
 //! 2. **Registration** (`register.rs`, `system.rs`): the source's displacement field `u`
 //!    minimises, per step,
 //!    `Σ w_i‖p_i+u_i−c_i‖² + βΣ_l‖p_l+u_l−L_l‖² + α(‖Lu‖² + μ‖∇u‖²) + ε‖u‖²` —
@@ -22,8 +26,8 @@
 //!    right-hand sides, solved by a sparse Cholesky factorisation (faer) whose pattern and
 //!    symbolic analysis are built once.
 //! 3. **Correspondence** (`correspond.rs`): every target vertex takes its closest point on
-//!    the registered source (same side, compatible normal): a source triangle and barycentric
-//!    weights. Target vertices far from the source (beyond what the source covers) fade out.
+//!    the registered source (same side, compatible normal — either side's normal on a crease
+//!    such as a lid margin): a source triangle and barycentric weights. Target vertices far from the source (beyond what the source covers) fade out.
 //! 4. **Transfer** (`transfer.rs`): each motion's source displacements, interpolated at
 //!    those weights, times the target / source FAPU ratio of the FAP's unit — so the same FAP
 //!    value moves the target by its own FAPU (compliance), and no vertex exceeds the largest

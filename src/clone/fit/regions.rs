@@ -288,3 +288,39 @@ pub(crate) fn query_bit(s: Side, face: bool) -> TriMask {
 pub(crate) fn mask_passes(mask: TriMask, bit: TriMask) -> bool {
     mask & bit & SEEN_BY_ALL != 0 && (bit & FACE_PIECE == 0 || mask & FACE_PIECE != 0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_query_takes_no_motion_from_the_other_side_of_a_slit() {
+        let sides = [Side::Upper, Side::Lower, Side::Other];
+        let w = [0.2, 0.5, 0.3];
+        // An upper query keeps the upper and other corners, renormalised.
+        let up = own_side_weights(Side::Upper, [0, 1, 2], w, &sides);
+        assert!((up[0] - 0.4).abs() < 1e-6 && up[1] == 0.0 && (up[2] - 0.6).abs() < 1e-6);
+        // A lower query at the upper corner keeps its own corner.
+        let low = own_side_weights(Side::Lower, [0, 1, 2], [1.0, 0.0, 0.0], &sides);
+        assert_eq!(low, [0.0, 1.0, 0.0]);
+        // Other queries and one-sided triangles are unchanged.
+        assert_eq!(own_side_weights(Side::Other, [0, 1, 2], w, &sides), w);
+        assert_eq!(own_side_weights(Side::Upper, [0, 0, 2], w, &sides), w);
+    }
+
+    #[test]
+    fn bridging_triangles_are_seen_from_both_sides_and_pieces_stay_apart() {
+        let sides = [Side::Upper, Side::Lower, Side::Other, Side::Upper];
+        let face = [true, true, true, false];
+        let masks = triangle_masks(&sides, &face, &[[0, 1, 2], [3, 3, 3], [0, 2, 2]]);
+        // Bridging: every side, on the face.
+        assert!(mask_passes(masks[0], query_bit(Side::Upper, true)));
+        assert!(mask_passes(masks[0], query_bit(Side::Lower, true)));
+        // Off the face: not for a face vertex, fine for another piece's vertex.
+        assert!(!mask_passes(masks[1], query_bit(Side::Upper, true)));
+        assert!(mask_passes(masks[1], query_bit(Side::Upper, false)));
+        // Upper only: not for a lower query.
+        assert!(!mask_passes(masks[2], query_bit(Side::Lower, true)));
+        assert!(mask_passes(masks[2], query_bit(Side::Other, false)));
+    }
+}
