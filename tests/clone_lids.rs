@@ -209,7 +209,6 @@ fn blink(face: &FaceModel, eye: &Eye, v: f64) -> Vec<Activation> {
 /// The value of the eye's lid FAPs at which the source's lid points meet (bisection), if
 /// they do below 4096.
 fn closing_value(face: &FaceModel, eye: &Eye) -> Option<f64> {
-    let (u, l) = (fp(face, eye.points[0]), fp(face, eye.points[1]));
     let (um, lm) = (
         face.fp_vertex(eye.points[0].parse().unwrap())?,
         face.fp_vertex(eye.points[1].parse().unwrap())?,
@@ -233,16 +232,14 @@ fn closing_value(face: &FaceModel, eye: &Eye) -> Option<f64> {
     Some(hi)
 }
 
+/// One x band of a slit: its upper and lower margin vertices `(mesh, vertex)`.
+type Band = (Vec<(usize, u32)>, Vec<(usize, u32)>);
+
 /// A slit's margins on a face: for `bands` x bands between its corners, the upper and the
 /// lower margin vertices `(mesh, vertex)`: the border vertices (of the hole the slit is)
 /// of the pieces holding the slit's upper and lower feature points, else (a slit closed by
 /// triangles) the lowest upper and the highest lower vertex of each band.
-fn margins(
-    face: &FaceModel,
-    points: [&str; 4],
-    reach: f32,
-    bands: usize,
-) -> Vec<(Vec<(usize, u32)>, Vec<(usize, u32)>)> {
+fn margins(face: &FaceModel, points: [&str; 4], reach: f32, bands: usize) -> Vec<Band> {
     let neutral = face.pose(&[]).unwrap();
     let f = |s: &str| fp(face, s);
     let (up, low) = (f(points[0]), f(points[1]));
@@ -331,7 +328,7 @@ fn margins(
 
 /// Per band, the posed gap between the margins: the lowest upper margin point's y minus the
 /// highest lower one's (negative: the lids cross).
-fn gaps(posed: &[Vec<Vec3>], m: &[(Vec<(usize, u32)>, Vec<(usize, u32)>)]) -> Vec<f32> {
+fn gaps(posed: &[Vec<Vec3>], m: &[Band]) -> Vec<f32> {
     m.iter()
         .filter(|(u, l)| !u.is_empty() && !l.is_empty())
         .map(|(u, l)| {
@@ -430,6 +427,9 @@ fn blink_check(case: &Case) -> Vec<Option<Blink>> {
 fn check_slits(c: &Case) {
     for (i, b) in blink_check(c).iter().enumerate() {
         eprintln!("{} eye {i}: {b:?}", c.name);
+        if let Some(b) = b {
+            eprintln!("    closing value {:.0}", b.value);
+        }
         let Some(b) = b else { continue };
         let [_, clone, truth] = b.gap;
         assert!(
@@ -548,7 +548,7 @@ fn ict_identity_cases() {
 
 /// The mouth slit of `face`: margins between the inner lip corners (2.4, 2.5) around the
 /// inner lip midpoints (2.2, 2.3), within 0.5 MNS0 of the lip line.
-fn mouth(face: &FaceModel) -> Vec<(Vec<(usize, u32)>, Vec<(usize, u32)>)> {
+fn mouth(face: &FaceModel) -> Vec<Band> {
     let mns = face.fapu().unwrap().distances.mns0 as f32;
     margins(face, ["2.2", "2.3", "2.4", "2.5"], 0.5 * mns, 12)
 }

@@ -125,19 +125,28 @@ pub(crate) struct Correspondence {
     pub fade: f32,
 }
 
+/// A surface's vertex labels: slit sides and face pieces
+/// ([`super::regions::face_pieces`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Labels<'a> {
+    /// Slit side of each vertex.
+    pub sides: &'a [Side],
+    /// Whether each vertex lies on a face piece.
+    pub face: &'a [bool],
+}
+
 /// Correspondences of every target vertex (`None`: no allowed source triangle, or beyond
-/// the fade).
+/// the fade). `source_sides`: the slit side of every source vertex.
 pub(crate) fn correspond(
     target: &[Vec3],
     target_triangles: &[[u32; 3]],
-    sides: &[Side],
-    face: &[bool],
+    labels: Labels,
     source: &QuerySurface,
-    source_triangles: &[[u32; 3]],
-    source_sides: &[Side],
+    (source_triangles, source_sides): (&[[u32; 3]], &[Side]),
     scale: f32,
     opts: &FitOptions,
 ) -> Vec<Option<Correspondence>> {
+    let Labels { sides, face } = labels;
     let normals = vertex_normals(target, target_triangles);
     let creases = crease_normals(target, target_triangles, &normals);
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;

@@ -351,11 +351,12 @@ fn register_and_correspond(
     let corr = correspond::correspond(
         &target.positions,
         &target.triangles,
-        &t_sides,
-        &t_face,
+        correspond::Labels {
+            sides: &t_sides,
+            face: &t_face,
+        },
         &registered,
-        &source.triangles,
-        &s_sides,
+        (&source.triangles, &s_sides),
         scale,
         opts,
     );
