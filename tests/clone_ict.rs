@@ -106,14 +106,15 @@ fn both_cloners_against_the_real_head_truth() {
             // The targets are median ≤ 10 % and no FAP above 100 % (fit: ≤ 4 %).
             // Measured on B and B×10: fmc median 7.4 %, worst thrust_jaw 15.9 %; rbf median
             // 5.5 %, worst thrust_jaw 14.1 % (without refinement rounds, its default); fit
-            // median 2.6 %, worst thrust_jaw 13.7 % (the jaw error is the rigid teeth and
+            // median 2.2 %, worst thrust_jaw 13.8 % (the jaw error is the rigid teeth and
             // gums: on the skin alone open_jaw is 1.7 %). The subdivided target scores a little
-            // higher (rbf median 9.0 %, fit 3.3 %). The limits are those figures with a small
-            // margin, to catch regressions.
+            // higher (rbf median 9.0 %, fit 2.3 %; fit gave 2.6 % and 3.3 % before its lid
+            // and lip slit handling). The limits are those figures with a small margin, to
+            // catch regressions.
             let (med_max, worst_max) = match m {
                 Method::Fmc => (9.0, 18.0),
                 Method::Rbf => (9.5, 18.0),
-                Method::Fit => (4.0, 15.0),
+                Method::Fit => (3.0, 15.0),
             };
             assert!(med <= med_max, "{m:?} case {ci}: median {med}");
             assert!(worst.all < worst_max, "{m:?} case {ci}: {worst:?}");

@@ -151,9 +151,9 @@ fn single_change(case: &Case) -> bool {
 }
 
 /// `fit` on the known-FAT pairs: median ≤ 5 % everywhere; every FAP ≤ 8 % where one thing
-/// changes. (Where shape and density change at once, CANDIDE dense → shaped and back, its
-/// worst FAPs are CANDIDE's eyelids, whose iris vertices share triangles with the lids and
-/// take a share of their motion, and one cheek FAP the guard repairs.)
+/// changes and ≤ 25 % (issue 21's bound for CANDIDE's coarse lids) where shape and density
+/// change at once (CANDIDE dense → shaped and back: its worst FAPs are the eyelids, measured
+/// 17.8 % and 13.8 %, 43 % and 81 % before the slit handling of `fit::regions`).
 #[test]
 fn fit_meets_the_known_fat_targets() {
     for case in cases() {
@@ -165,11 +165,8 @@ fn fit_meets_the_known_fat_targets() {
             r.median_all
         );
         let (key, worst) = r.worst.clone().unwrap_or_default();
-        assert!(
-            !single_change(case) || worst <= 8.0,
-            "{}: worst {key} {worst:.2} %",
-            case.name
-        );
+        let limit = if single_change(case) { 8.0 } else { 25.0 };
+        assert!(worst <= limit, "{}: worst {key} {worst:.2} %", case.name);
     }
 }
 

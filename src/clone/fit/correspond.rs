@@ -2,8 +2,13 @@
 //!
 //! Each target vertex takes the closest point of the registered source that its slit side
 //! allows ([`super::regions`]) among triangles whose normal is within
-//! [`FitOptions::normal_degrees`] of the vertex normal (without that condition if none is,
-//! or if the vertex already lies on the source: creases have no one normal);
+//! [`FitOptions::normal_degrees`] of the vertex normal — or, for a vertex on a crease (an
+//! incident face more than 45° from its vertex normal: a lid margin, a lip's edge), of that
+//! face's normal, since a crease has no one normal. Without that condition if no triangle
+//! passes, if the vertex already lies on the source, or if it lies within
+//! [`FitOptions::fade`]`.0` × ES0 of the source while every compatible point is farther
+//! than that beyond the closest one (the normals mislead there: ICT's lid margin
+//! triangulated gave its upper-lid point no motion at all);
 //! the point is kept as a triangle and barycentric weights. Target vertices the source does
 //! not cover (a source mask onto a whole head: the back of the head, the neck) lie far from
 //! it; their weight fades from 1 at [`FitOptions::fade`]`.0` × ES0 to 0 at `.1` × ES0, so
@@ -19,10 +24,10 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::regions::{query_bit, Side};
+use super::regions::{own_side_weights, query_bit, Side};
 use super::surface::{Filter, QuerySurface};
 use super::FitOptions;
-use crate::mesh::geometry::vertex_normals;
+use crate::mesh::geometry::{triangle_normals, vertex_normals};
 use crate::mesh::spatial::find_coincident_vertices;
 
 /// Points closer than this (× ES0) to the surface match without the normal test.
@@ -80,6 +85,35 @@ fn seam_probes(target: &[Vec3], triangles: &[[u32; 3]], scale: f32) -> Vec<Optio
     probes
 }
 
+/// Incident face normals this far (cosine) from the vertex normal make a vertex a crease.
+const CREASE_COS: f32 = 0.7;
+
+/// For every vertex on a crease (module docs), the incident face normal farthest from its
+/// vertex normal; `None` elsewhere.
+fn crease_normals(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    normals: &[Vec3],
+) -> Vec<Option<Vec3>> {
+    let faces = triangle_normals(positions, triangles);
+    let mut out: Vec<(f32, Option<Vec3>)> = vec![(CREASE_COS, None); positions.len()];
+    for (t, f) in triangles.iter().zip(&faces) {
+        if *f == Vec3::ZERO {
+            continue;
+        }
+        for &v in t {
+            let (Some(n), Some(o)) = (normals.get(v as usize), out.get_mut(v as usize)) else {
+                continue;
+            };
+            let d = f.dot(*n);
+            if d < o.0 {
+                *o = (d, Some(*f));
+            }
+        }
+    }
+    out.into_iter().map(|o| o.1).collect()
+}
+
 /// Where one target vertex lies on the source.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Correspondence {
@@ -91,18 +125,30 @@ pub(crate) struct Correspondence {
     pub fade: f32,
 }
 
+/// A surface's vertex labels: slit sides and face pieces
+/// ([`super::regions::face_pieces`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Labels<'a> {
+    /// Slit side of each vertex.
+    pub sides: &'a [Side],
+    /// Whether each vertex lies on a face piece.
+    pub face: &'a [bool],
+}
+
 /// Correspondences of every target vertex (`None`: no allowed source triangle, or beyond
-/// the fade).
+/// the fade). `source_sides`: the slit side of every source vertex.
 pub(crate) fn correspond(
     target: &[Vec3],
     target_triangles: &[[u32; 3]],
-    sides: &[Side],
+    labels: Labels,
     source: &QuerySurface,
-    source_triangles: &[[u32; 3]],
+    (source_triangles, source_sides): (&[[u32; 3]], &[Side]),
     scale: f32,
     opts: &FitOptions,
 ) -> Vec<Option<Correspondence>> {
+    let Labels { sides, face } = labels;
     let normals = vertex_normals(target, target_triangles);
+    let creases = crease_normals(target, target_triangles, &normals);
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let (near, far) = (opts.fade.0 as f32 * scale, opts.fade.1 as f32 * scale);
     let snap = SNAP * scale;
@@ -113,12 +159,19 @@ pub(crate) fn correspond(
         .par_iter()
         .enumerate()
         .map(|(i, &p)| {
-            let bit = query_bit(sides.get(i).copied().unwrap_or(Side::Other));
+            let bit = query_bit(
+                sides.get(i).copied().unwrap_or(Side::Other),
+                face.get(i).copied().unwrap_or(true),
+            );
             let nrm = normals.get(i).copied().unwrap_or(Vec3::ZERO);
             // A point on the surface is its own match, whatever the normals at a crease say.
             // Every search is bounded: beyond `far` nothing matches, and a bounded search
             // does not scan the whole source for triangles the filters reject.
-            let plain = Filter { bit, normal: None };
+            let plain = Filter {
+                bit,
+                normal: None,
+                crease: None,
+            };
             // A seam copy takes its own side's triangle (module docs), unless that lies
             // clearly farther than the closest one (the seam opened during registration).
             let seam = probes.get(i).copied().flatten().and_then(|q| {
@@ -141,13 +194,30 @@ pub(crate) fn correspond(
                 let oriented = Filter {
                     bit,
                     normal: Some((nrm, cos)),
+                    crease: creases.get(i).copied().flatten(),
+                };
+                // A vertex lying on the source (within `near`) whose compatible points are all
+                // farther than `near` beyond its closest point sits where the normals mislead
+                // (a lid margin's fold): its closest point stands in.
+                // (Searched only when the compatible point is not itself that near.)
+                let on_source = || {
+                    source
+                        .closest_within(p, plain, near * 1.001)
+                        .filter(|h| h.point.distance(p) <= near)
                 };
                 match source.closest_within(p, oriented, far_probe) {
-                    Some(h) => h,
-                    // An oriented point beyond `far` fades to nothing; with no oriented
-                    // triangle at all the plain closest point stands in.
-                    None if source.any_allowed(oriented) => return None,
-                    None => source.closest_within(p, plain, far_probe)?,
+                    Some(h) if h.point.distance(p) <= near => h,
+                    Some(h) => match on_source() {
+                        Some(c) if h.point.distance(p) > c.point.distance(p) + near => c,
+                        _ => h,
+                    },
+                    None => match on_source() {
+                        Some(c) => c,
+                        // An oriented point beyond `far` fades to nothing; with no oriented
+                        // triangle at all the plain closest point stands in.
+                        None if source.any_allowed(oriented) => return None,
+                        None => source.closest_within(p, plain, far_probe)?,
+                    },
                 }
             };
             let d = hit.point.distance(p);
@@ -159,9 +229,10 @@ pub(crate) fn correspond(
                 1.0 - (d - near) / (far - near)
             };
             let tri = source_triangles.get(hit.triangle as usize)?;
+            let side = sides.get(i).copied().unwrap_or(Side::Other);
             (fade > 0.0 && fade.is_finite()).then_some(Correspondence {
                 vertices: *tri,
-                weights: hit.weights,
+                weights: own_side_weights(side, *tri, hit.weights, source_sides),
                 fade,
             })
         })

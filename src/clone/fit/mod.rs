@@ -9,7 +9,11 @@
 //!    labelled upper or lower from the feature points (lip corners and inner-lip points,
 //!    eye corners and lid points). Every closest-point query below is restricted to its side:
 //!    an upper-lip vertex never lands on the lower lip, an upper lid never on the lower lid,
-//!    so a closed mouth or eye does not weld.
+//!    so a closed mouth or eye does not weld. A triangle bridging a slit (CANDIDE-3 covers
+//!    its eyes, iris vertices between the lids) is seen from both sides, but a vertex landing
+//!    on it takes none of the other side's corners. And a vertex of a *face piece* (a
+//!    connected piece holding a skin feature point) only matches face pieces: ICT's eye
+//!    occlusion shell lies against the lid margin and once took the upper lid's motion away.
 //! 2. **Registration** (`register.rs`, `system.rs`): the source's displacement field `u`
 //!    minimises, per step,
 //!    `Σ w_i‖p_i+u_i−c_i‖² + βΣ_l‖p_l+u_l−L_l‖² + α(‖Lu‖² + μ‖∇u‖²) + ε‖u‖²` —
@@ -22,8 +26,8 @@
 //!    right-hand sides, solved by a sparse Cholesky factorisation (faer) whose pattern and
 //!    symbolic analysis are built once.
 //! 3. **Correspondence** (`correspond.rs`): every target vertex takes its closest point on
-//!    the registered source (same side, compatible normal): a source triangle and barycentric
-//!    weights. Target vertices far from the source (beyond what the source covers) fade out.
+//!    the registered source (same side, compatible normal — either side's normal on a crease
+//!    such as a lid margin): a source triangle and barycentric weights. Target vertices far from the source (beyond what the source covers) fade out.
 //! 4. **Transfer** (`transfer.rs`): each motion's source displacements, interpolated at
 //!    those weights, times the target / source FAPU ratio of the FAP's unit — so the same FAP
 //!    value moves the target by its own FAPU (compliance), and no vertex exceeds the largest
@@ -61,7 +65,7 @@ use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
 use crate::error::Result;
 use crate::mesh::spatial::find_coincident_vertices;
 pub(crate) use correspond::Correspondence;
-use regions::{classify, triangle_masks};
+use regions::{classify, face_pieces, triangle_masks};
 use register::{register, Moving};
 use surface::{adjacency, QuerySurface};
 
@@ -268,6 +272,7 @@ fn register_and_correspond(
     let t_adj = adjacency(target.positions.len(), &target.triangles);
     let (s_sides, s_slits) = classify(source, &adj);
     let (t_sides, t_slits) = classify(target, &t_adj);
+    let (s_face, t_face) = (face_pieces(source), face_pieces(target));
     for (n, side) in [(s_slits, "source"), (t_slits, "target")] {
         if n < 3 {
             warnings.push(format!(
@@ -320,13 +325,14 @@ fn register_and_correspond(
     let fixed = QuerySurface::new(
         &target.positions,
         &target.triangles,
-        triangle_masks(&t_sides, &target.triangles),
+        triangle_masks(&t_sides, &t_face, &target.triangles),
     );
     let moving = Moving {
         positions: &source.positions,
         triangles: &source.triangles,
         adjacency: &adj,
         sides: &s_sides,
+        face: &s_face,
         landmarks: &landmarks,
         scale,
     };
@@ -340,14 +346,17 @@ fn register_and_correspond(
     let registered = QuerySurface::new(
         &reg.positions,
         &source.triangles,
-        triangle_masks(&s_sides, &source.triangles),
+        triangle_masks(&s_sides, &s_face, &source.triangles),
     );
     let corr = correspond::correspond(
         &target.positions,
         &target.triangles,
-        &t_sides,
+        correspond::Labels {
+            sides: &t_sides,
+            face: &t_face,
+        },
         &registered,
-        &source.triangles,
+        (&source.triangles, &s_sides),
         scale,
         opts,
     );

@@ -9,8 +9,11 @@
 //! faces of a clone are cut the same anatomical way whatever their meshing.
 //!
 //! Queries from an upper vertex see only upper and other triangles, from a lower vertex only
-//! lower and other ones; triangles with both an upper and a lower vertex (across the slit)
-//! are seen by other vertices only.
+//! lower and other ones. Triangles with both an upper and a lower vertex (bridging the slit:
+//! CANDIDE-3 covers its eyes, iris vertices between the lids) are seen by every query, but a
+//! target vertex that lands on one takes no motion from the corners of the other side
+//! ([`own_side_weights`]): an upper lid never reads the lower lid's motion, and the iris
+//! between them reads only the still iris and its own lid.
 
 use glam::{Vec2, Vec3};
 
@@ -33,6 +36,39 @@ pub(crate) type TriMask = u8;
 
 /// A triangle seen by every query.
 pub(crate) const SEEN_BY_ALL: TriMask = 0b111;
+
+/// Triangle bit: on a face piece ([`face_pieces`]). Query bit: sees only such triangles.
+pub(crate) const FACE_PIECE: TriMask = 0b1000;
+
+/// Per vertex, whether it lies on a face piece: a connected piece of the surface holding a
+/// skin feature point. The other pieces — ICT's eye occlusion and lacrimal shells, lashes,
+/// a one-mesh source's eyeballs and teeth — may touch the skin (the occlusion shell lies
+/// against the lid margin) but never stand for it: a lid vertex of the target that landed
+/// on one took no lid motion at all.
+pub(crate) fn face_pieces(s: &CloneSurface) -> Vec<bool> {
+    let n = s.positions.len();
+    let mut uf = crate::mesh::components::UnionFind::new(n);
+    for t in &s.triangles {
+        if t.iter().all(|&v| (v as usize) < n) {
+            uf.union(t[0], t[1]);
+            uf.union(t[1], t[2]);
+        }
+    }
+    let (label, count) = uf.labels();
+    let mut face = vec![false; count];
+    for (&id, &v) in &s.fp_vertices {
+        if crate::clone::face::Part::of_feature_point(id).is_none() {
+            if let Some(&l) = label.get(v as usize) {
+                face[l as usize] = true;
+            }
+        }
+    }
+    if !face.iter().any(|&f| f) {
+        // No skin feature point on any piece: every piece is the face.
+        return vec![true; n];
+    }
+    label.iter().map(|&l| face[l as usize]).collect()
+}
 
 /// One slit: the split line (sorted by x) and the box around it.
 struct Slit {
@@ -175,27 +211,116 @@ pub(crate) fn classify(s: &CloneSurface, adj: &[Vec<u32>]) -> (Vec<Side>, usize)
     (sides, slits.len())
 }
 
-/// Triangle masks from vertex sides (module docs).
-pub(crate) fn triangle_masks(sides: &[Side], triangles: &[[u32; 3]]) -> Vec<TriMask> {
+/// Triangle masks from vertex sides (module docs) and face pieces (`face`, per vertex).
+pub(crate) fn triangle_masks(
+    sides: &[Side],
+    face: &[bool],
+    triangles: &[[u32; 3]],
+) -> Vec<TriMask> {
     triangles
         .iter()
         .map(|t| {
+            let piece = if face.get(t[0] as usize).copied().unwrap_or(true) {
+                FACE_PIECE
+            } else {
+                0
+            };
             let has = |w: Side| t.iter().any(|&v| sides.get(v as usize) == Some(&w));
-            match (has(Side::Upper), has(Side::Lower)) {
-                (true, true) => 0b100,
-                (true, false) => 0b101,
-                (false, true) => 0b110,
-                (false, false) => SEEN_BY_ALL,
-            }
+            piece
+                | match (has(Side::Upper), has(Side::Lower)) {
+                    // A triangle bridging the slit (a mesh that covers the eye, a mouth not cut
+                    // open) is seen from both sides; a query from one side then takes none of
+                    // the other side's corners (`own_side_weights`).
+                    (true, true) => SEEN_BY_ALL,
+                    (true, false) => 0b101,
+                    (false, true) => 0b110,
+                    (false, false) => SEEN_BY_ALL,
+                }
         })
         .collect()
 }
 
-/// The mask bit a query from a vertex of side `s` needs.
-pub(crate) fn query_bit(s: Side) -> TriMask {
-    match s {
+/// Weights `w` of a hit in triangle `tri` seen from a query of side `query`: the corners
+/// of the opposite slit side get none, the others share it (unchanged when no corner or
+/// every corner is opposite).
+pub(crate) fn own_side_weights(
+    query: Side,
+    tri: [u32; 3],
+    w: [f32; 3],
+    sides: &[Side],
+) -> [f32; 3] {
+    let opposite = match query {
+        Side::Upper => Side::Lower,
+        Side::Lower => Side::Upper,
+        Side::Other => return w,
+    };
+    let keep: [bool; 3] = tri.map(|v| sides.get(v as usize) != Some(&opposite));
+    let total: f32 = (0..3).filter(|&k| keep[k]).map(|k| w[k]).sum();
+    if keep.iter().all(|&k| k) || !keep.iter().any(|&k| k) {
+        return w;
+    }
+    if total <= 1e-6 {
+        // The hit lies on the opposite corners' edge: the nearest own corner takes it all.
+        let k = (0..3).find(|&k| keep[k]).unwrap_or(0);
+        let mut out = [0.0; 3];
+        out[k] = 1.0;
+        return out;
+    }
+    std::array::from_fn(|k| if keep[k] { w[k] / total } else { 0.0 })
+}
+
+/// The mask bits a query from a vertex of side `s` needs (`face`: the vertex lies on a
+/// face piece, and sees only face-piece triangles).
+pub(crate) fn query_bit(s: Side, face: bool) -> TriMask {
+    let side = match s {
         Side::Upper => 0b001,
         Side::Lower => 0b010,
         Side::Other => 0b100,
+    };
+    if face {
+        side | FACE_PIECE
+    } else {
+        side
+    }
+}
+
+/// Whether a triangle of mask `mask` passes a query of bits `bit` ([`query_bit`]).
+pub(crate) fn mask_passes(mask: TriMask, bit: TriMask) -> bool {
+    mask & bit & SEEN_BY_ALL != 0 && (bit & FACE_PIECE == 0 || mask & FACE_PIECE != 0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_query_takes_no_motion_from_the_other_side_of_a_slit() {
+        let sides = [Side::Upper, Side::Lower, Side::Other];
+        let w = [0.2, 0.5, 0.3];
+        // An upper query keeps the upper and other corners, renormalised.
+        let up = own_side_weights(Side::Upper, [0, 1, 2], w, &sides);
+        assert!((up[0] - 0.4).abs() < 1e-6 && up[1] == 0.0 && (up[2] - 0.6).abs() < 1e-6);
+        // A lower query at the upper corner keeps its own corner.
+        let low = own_side_weights(Side::Lower, [0, 1, 2], [1.0, 0.0, 0.0], &sides);
+        assert_eq!(low, [0.0, 1.0, 0.0]);
+        // Other queries and one-sided triangles are unchanged.
+        assert_eq!(own_side_weights(Side::Other, [0, 1, 2], w, &sides), w);
+        assert_eq!(own_side_weights(Side::Upper, [0, 0, 2], w, &sides), w);
+    }
+
+    #[test]
+    fn bridging_triangles_are_seen_from_both_sides_and_pieces_stay_apart() {
+        let sides = [Side::Upper, Side::Lower, Side::Other, Side::Upper];
+        let face = [true, true, true, false];
+        let masks = triangle_masks(&sides, &face, &[[0, 1, 2], [3, 3, 3], [0, 2, 2]]);
+        // Bridging: every side, on the face.
+        assert!(mask_passes(masks[0], query_bit(Side::Upper, true)));
+        assert!(mask_passes(masks[0], query_bit(Side::Lower, true)));
+        // Off the face: not for a face vertex, fine for another piece's vertex.
+        assert!(!mask_passes(masks[1], query_bit(Side::Upper, true)));
+        assert!(mask_passes(masks[1], query_bit(Side::Upper, false)));
+        // Upper only: not for a lower query.
+        assert!(!mask_passes(masks[2], query_bit(Side::Lower, true)));
+        assert!(mask_passes(masks[2], query_bit(Side::Other, false)));
     }
 }

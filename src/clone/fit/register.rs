@@ -58,6 +58,8 @@ pub(crate) struct Moving<'a> {
     pub adjacency: &'a [Vec<u32>],
     /// Slit side of each vertex.
     pub sides: &'a [Side],
+    /// Whether each vertex lies on a face piece ([`super::regions::face_pieces`]).
+    pub face: &'a [bool],
     /// `(vertex, landmark position on the fixed surface)`.
     pub landmarks: &'a [(u32, Vec3)],
     /// A length of the face (ES0), for the distance limits.
@@ -132,7 +134,7 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
                     fixed,
                     x[i],
                     normals[i],
-                    query_bit(m.sides[i]),
+                    query_bit(m.sides[i], m.face.get(i).copied().unwrap_or(true)),
                     b,
                     previous[i],
                 )
@@ -229,7 +231,11 @@ fn match_point(
     b: Bounds,
     previous: Option<u32>,
 ) -> Option<(Vec3, f32, u32)> {
-    let plain = Filter { bit, normal: None };
+    let plain = Filter {
+        bit,
+        normal: None,
+        crease: None,
+    };
     let h = if nrm == Vec3::ZERO {
         fixed.closest(x, plain)?
     } else if let Some(h) = fixed
@@ -241,6 +247,7 @@ fn match_point(
         let oriented = Filter {
             bit,
             normal: Some((nrm, b.cos)),
+            crease: None,
         };
         let warm = previous
             .and_then(|t| fixed.distance_to(x, oriented, t))

@@ -43,17 +43,25 @@ pub(crate) struct Filter {
     /// Unit normal of the querying vertex and the least cosine a triangle normal must reach;
     /// `None`: any orientation.
     pub normal: Option<(Vec3, f32)>,
+    /// A second normal a triangle may match instead (the querying vertex sits on a crease:
+    /// the incident face normal farthest from its vertex normal).
+    pub crease: Option<Vec3>,
 }
 
 impl QuerySurface {
     /// Whether triangle `i` passes `filter` (side mask and normal compatibility).
     fn allowed(&self, filter: Filter, i: u32) -> bool {
         let i = i as usize;
-        let mask_ok = self.masks.get(i).is_none_or(|m| m & filter.bit != 0);
+        let mask_ok = self
+            .masks
+            .get(i)
+            .is_none_or(|&m| super::regions::mask_passes(m, filter.bit));
         mask_ok
-            && filter
-                .normal
-                .is_none_or(|(n, c)| self.normals.get(i).is_none_or(|t| t.dot(n) >= c))
+            && filter.normal.is_none_or(|(n, c)| {
+                self.normals
+                    .get(i)
+                    .is_none_or(|t| t.dot(n) >= c || filter.crease.is_some_and(|m| t.dot(m) >= c))
+            })
     }
 }
 
