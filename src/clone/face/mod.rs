@@ -140,6 +140,7 @@ mod report;
 mod rescale;
 mod rigid;
 mod skin_surface;
+mod smooth;
 mod split;
 mod target_check;
 
@@ -166,8 +167,9 @@ use crate::fat::{Fat, TableKey};
 use align::{alignment_rms, face_alignment};
 use assemble::{assemble_fat, ClonedMotions, SourceMotions};
 use motions::surface_motions;
-use rescale::{guard_motions, rescale_to_fapu};
+use rescale::{gain_to_fapu, guard_motions, rescale_to_fapu};
 use rigid::RigidPlan;
+use smooth::smooth_motions;
 
 /// Motions of the surface method on already built surfaces.
 pub fn clone_surface(
@@ -438,6 +440,14 @@ fn clone_skin_motions(
         )));
     }
     report.timings.push("guard", clock.elapsed().as_secs_f64());
+    // No crease, fold or spike the source does not have; then each feature point moves by
+    // its FAPU.
+    let clock = Instant::now();
+    report.smoothed = smooth_motions(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+    report.timings.push("smooth", clock.elapsed().as_secs_f64());
+    let clock = Instant::now();
+    report.fapu_gain = gain_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+    report.timings.push("gain", clock.elapsed().as_secs_f64());
     Ok(result.motions)
 }
 

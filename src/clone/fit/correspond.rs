@@ -3,7 +3,9 @@
 //! Each target vertex takes the closest point of the registered source that its slit side
 //! allows ([`super::regions`]) among triangles whose normal is within
 //! [`FitOptions::normal_degrees`] of the vertex normal (without that condition if none is,
-//! or if the vertex already lies on the source: creases have no one normal);
+//! or if the vertex already lies on the source: creases have no one normal, and a vertex
+//! within the fade's near distance of the source that no oriented triangle matches takes
+//! the plain closest point rather than none);
 //! the point is kept as a triangle and barycentric weights. Target vertices the source does
 //! not cover (a source mask onto a whole head: the back of the head, the neck) lie far from
 //! it; their weight fades from 1 at [`FitOptions::fade`]`.0` × ES0 to 0 at `.1` × ES0, so
@@ -142,12 +144,19 @@ pub(crate) fn correspond(
                     bit,
                     normal: Some((nrm, cos)),
                 };
+                // On the source but facing elsewhere (a real lid's margin turning into the
+                // eye socket where a stylised lid is a plain sheet): the plain closest point,
+                // not a still vertex among moving ones.
+                let on_source = || source.closest_within(p, plain, near);
                 match source.closest_within(p, oriented, far_probe) {
                     Some(h) => h,
-                    // An oriented point beyond `far` fades to nothing; with no oriented
-                    // triangle at all the plain closest point stands in.
-                    None if source.any_allowed(oriented) => return None,
-                    None => source.closest_within(p, plain, far_probe)?,
+                    None => match on_source() {
+                        Some(h) => h,
+                        // An oriented point beyond `far` fades to nothing; with no oriented
+                        // triangle at all the plain closest point stands in.
+                        None if source.any_allowed(oriented) => return None,
+                        None => source.closest_within(p, plain, far_probe)?,
+                    },
                 }
             };
             let d = hit.point.distance(p);
