@@ -66,7 +66,8 @@
 //!    the FAPU-scaled source motion by a smooth gain field around it (Wendland C² bump over
 //!    half an ES0, gain 1/4–4; [`CloneReport::fapu_gain`]): a registration that put the
 //!    target's feature point off the source's peak (a stylised brow onto a real one) no
-//!    longer leaves the FAP half as strong.
+//!    longer leaves the FAP half as strong. Not with FAPU scaling off
+//!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
@@ -459,9 +460,18 @@ fn clone_skin_motions(
     let clock = Instant::now();
     report.smoothed = smooth_motions(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
     report.timings.push("smooth", clock.elapsed().as_secs_f64());
-    let clock = Instant::now();
-    report.fapu_gain = gain_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
-    report.timings.push("gain", clock.elapsed().as_secs_f64());
+    // Not when FAPU scaling is turned off (the RBF paper's mode, fit without it).
+    let scaled = match opts.method {
+        Method::Rbf => opts.rbf_fapu_rescale,
+        Method::Fit => opts.fit.fapu_scale,
+        Method::Fmc => true,
+    };
+    if scaled {
+        let clock = Instant::now();
+        report.fapu_gain =
+            gain_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+        report.timings.push("gain", clock.elapsed().as_secs_f64());
+    }
     Ok(result.motions)
 }
 
