@@ -126,6 +126,20 @@ fn print(p: &Pair) {
             .map(|f| (&f.fap, f.value, f.repaired))
             .collect::<Vec<_>>()
     );
+    let steps: Vec<String> = p
+        .outcome
+        .report
+        .timings
+        .steps
+        .iter()
+        .filter(|(n, _)| matches!(n.as_str(), "guard" | "smooth" | "gain") || n.starts_with("fit:"))
+        .map(|(n, t)| format!("{n} {:.0} ms", t * 1e3))
+        .collect();
+    eprintln!(
+        "    steps: {}; smoothed {} motions",
+        steps.join(", "),
+        p.outcome.report.smoothed.len()
+    );
     let mut c = p.compliance.faps.clone();
     c.sort_by(|a, b| b.along_error.total_cmp(&a.along_error));
     for f in c.iter().take(5) {

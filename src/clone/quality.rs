@@ -57,7 +57,7 @@ pub fn max_normal_turn(neutral: &[Vec3], posed: &[Vec3], triangles: &[[u32; 3]])
             continue;
         };
         let a0 = n0.length();
-        if !(a0 > 1e-12 * l0) {
+        if a0.is_nan() || a0 <= 1e-12 * l0 {
             continue;
         }
         let a1 = n1.length();
