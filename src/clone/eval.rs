@@ -18,6 +18,12 @@
 //!   is the truth without its FAT) and measures the result with [`ground_truth_error`]:
 //!   `fbakit eval ground-truth`.
 //!
+//! - [`normal_turns`]: smoothness of a clone against its source: per morph target of the
+//!   source's FAT, the largest turn of a triangle's normal on each face posed at that table
+//!   and value ([`super::quality::max_normal_turn`]), and their ratio
+//!   ([`super::quality::normal_turn_ratio`]). A crease, fold or spike the source does not
+//!   have shows as a ratio well above 1.
+//!
 //! Posing composes a FAT rotation after the neutral one (`R₀·ΔR`), as [`super::face`] does.
 
 use std::collections::BTreeMap;
@@ -179,6 +185,88 @@ pub fn compliance(face: &FaceModel) -> Result<ComplianceReport> {
         report.mean =
             report.faps.iter().map(|f| f.along_error).sum::<f64>() / report.faps.len() as f64;
     }
+    Ok(report)
+}
+
+/// Normal turns of one morph target on the source and on the clone.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct KeyNormalTurn {
+    /// Table name.
+    pub key: String,
+    /// The table value posed (an interval border of the source's table).
+    pub value: f64,
+    /// Largest normal turn on the source, degrees.
+    pub source_degrees: f64,
+    /// Largest normal turn on the clone, degrees.
+    pub target_degrees: f64,
+    /// [`super::quality::normal_turn_ratio`] of the two.
+    pub ratio: f64,
+    /// Neutral centroid (face frame) of the clone's triangle turning most.
+    pub target_at: Option<[f32; 3]>,
+}
+
+/// Result of [`normal_turns`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct NormalTurnReport {
+    /// Per morph target of the source's FAT.
+    pub keys: Vec<KeyNormalTurn>,
+    /// The largest ratio, or 0 without keys.
+    pub worst_ratio: f64,
+}
+
+impl NormalTurnReport {
+    /// The entry with the largest ratio.
+    pub fn worst(&self) -> Option<&KeyNormalTurn> {
+        self.keys.iter().max_by(|a, b| a.ratio.total_cmp(&b.ratio))
+    }
+}
+
+/// Every mesh's triangles (polygons triangulated) as indices into the meshes' concatenated
+/// vertices.
+fn face_triangles(face: &FaceModel) -> Vec<[u32; 3]> {
+    let mut out = Vec::new();
+    let mut start = 0u32;
+    for m in &face.meshes {
+        let (tris, _) = crate::mesh::geometry::triangulate(&m.mesh.positions, &m.mesh.polygons);
+        out.extend(tris.iter().map(|t| t.map(|v| v + start)));
+        start += m.mesh.positions.len() as u32;
+    }
+    out
+}
+
+/// Normal turns of `cloned` against `source` (module docs): for every morph target of the
+/// source's FAT (each table at each non-zero interval border), both faces posed at it with
+/// every mesh and transform, the largest turn of a triangle's normal on each.
+pub fn normal_turns(source: &FaceModel, cloned: &FaceModel) -> Result<NormalTurnReport> {
+    use super::quality::{max_normal_turn, normal_turn_ratio};
+    let (ts, tc) = (face_triangles(source), face_triangles(cloned));
+    let (mut es, mut ec) = (source.evaluator()?, cloned.evaluator()?);
+    let (mut os, mut oc) = (es.output(), ec.output());
+    let flat = |p: Vec<Vec<Vec3>>| p.into_iter().flatten().collect::<Vec<Vec3>>();
+    let ns = flat(source.pose_with(&mut es, &mut os, &[]));
+    let nc = flat(cloned.pose_with(&mut ec, &mut oc, &[]));
+    let mut report = NormalTurnReport::default();
+    for t in fat_to_morph_targets(&source.fat) {
+        let a = [Activation {
+            key: t.key,
+            value: t.value,
+        }];
+        let ps = flat(source.pose_with(&mut es, &mut os, &a));
+        let pc = flat(cloned.pose_with(&mut ec, &mut oc, &a));
+        let s = max_normal_turn(&ns, &ps, &ts);
+        let c = max_normal_turn(&nc, &pc, &tc);
+        report.keys.push(KeyNormalTurn {
+            key: t.key.name(),
+            value: t.value,
+            source_degrees: s.angle.to_degrees(),
+            target_degrees: c.angle.to_degrees(),
+            ratio: normal_turn_ratio(s.angle, c.angle),
+            target_at: c
+                .triangle
+                .map(|i| (tc[i].iter().map(|&v| nc[v as usize]).sum::<Vec3>() / 3.0).to_array()),
+        });
+    }
+    report.worst_ratio = report.keys.iter().map(|k| k.ratio).fold(0.0, f64::max);
     Ok(report)
 }
 

@@ -54,6 +54,20 @@
 //!    It is repaired by a direct transfer (nearest source vertex in the aligned frame, times
 //!    r) and re-checked; if that fails too the FAP's table is dropped. Either way it is
 //!    listed in [`CloneReport::failed_faps`] and warned about.
+//!    **`smooth`** (every method, `smooth.rs`): a motion must not crease, fold or spike where
+//!    its source does not. Target triangles whose normal turns more than 1.25× the source
+//!    motion's largest turn ([`crate::clone::quality::max_normal_turn`], at least 1°) are
+//!    rough; their corners and one ring around them are smoothed by damped Laplacian steps
+//!    (the FAP's own feature point held) until none is rough, at most 40 rounds. Such defects
+//!    come from cloning across styles: target vertices reading unrelated parts of the source
+//!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
+//!    changed. Smoothed motions are listed in [`CloneReport::smoothed`].
+//!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
+//!    the FAPU-scaled source motion by a smooth gain field around it (Wendland C² bump over
+//!    half an ES0, gain 1/4–4; [`CloneReport::fapu_gain`]): a registration that put the
+//!    target's feature point off the source's peak (a stylised brow onto a real one) no
+//!    longer leaves the FAP half as strong. Not with FAPU scaling off
+//!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
@@ -122,7 +136,8 @@
 //! [`options`](CloneOptions) and [`report`](CloneReport) hold the settings and the report;
 //! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
 //! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
-//! the surface (steps 4 and 8), `rescale` step 6 and the guard, `rigid` and `part_motion`
+//! the surface (steps 4 and 8), `rescale` step 6, the guard and the gain, `smooth` the smooth
+//! step, `rigid` and `part_motion`
 //! step 7, `assemble` step 8 and `fold` step 9. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
@@ -140,6 +155,7 @@ mod report;
 mod rescale;
 mod rigid;
 mod skin_surface;
+mod smooth;
 mod split;
 mod target_check;
 
@@ -166,8 +182,9 @@ use crate::fat::{Fat, TableKey};
 use align::{alignment_rms, face_alignment};
 use assemble::{assemble_fat, ClonedMotions, SourceMotions};
 use motions::surface_motions;
-use rescale::{guard_motions, rescale_to_fapu};
+use rescale::{gain_to_fapu, guard_motions, rescale_to_fapu};
 use rigid::RigidPlan;
+use smooth::smooth_motions;
 
 /// Motions of the surface method on already built surfaces.
 pub fn clone_surface(
@@ -438,6 +455,23 @@ fn clone_skin_motions(
         )));
     }
     report.timings.push("guard", clock.elapsed().as_secs_f64());
+    // No crease, fold or spike the source does not have; then each feature point moves by
+    // its FAPU.
+    let clock = Instant::now();
+    report.smoothed = smooth_motions(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+    report.timings.push("smooth", clock.elapsed().as_secs_f64());
+    // Not when FAPU scaling is turned off (the RBF paper's mode, fit without it).
+    let scaled = match opts.method {
+        Method::Rbf => opts.rbf_fapu_rescale,
+        Method::Fit => opts.fit.fapu_scale,
+        Method::Fmc => true,
+    };
+    if scaled {
+        let clock = Instant::now();
+        report.fapu_gain =
+            gain_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+        report.timings.push("gain", clock.elapsed().as_secs_f64());
+    }
     Ok(result.motions)
 }
 

@@ -57,6 +57,11 @@ pub struct CloneReport {
     pub tables: usize,
     /// RBF FAPU rescaling factors applied, per FAP name.
     pub fapu_rescale: BTreeMap<String, f64>,
+    /// Compliance gains at the feature points (`gain` step), per FAP name and value.
+    pub fapu_gain: BTreeMap<String, f64>,
+    /// Motions the `smooth` step re-solved, per FAP name and value: how many target surface
+    /// vertices.
+    pub smoothed: BTreeMap<String, usize>,
     /// Rigid-part handling.
     pub rigid: RigidReport,
     /// Part meshes cut out of a one-mesh target (step 1).

@@ -37,7 +37,11 @@ pub struct FapFailure {
 }
 
 /// The feature point a low-level translation FAP is measured at, if both surfaces have it.
-fn fap_fp(key: TableKey, a: &CloneSurface, b: &CloneSurface) -> Option<(FeaturePointId, FapuKind)> {
+pub(super) fn fap_fp(
+    key: TableKey,
+    a: &CloneSurface,
+    b: &CloneSurface,
+) -> Option<(FeaturePointId, FapuKind)> {
     let TableKey::LowLevel(f) = key else {
         return None;
     };
@@ -107,6 +111,76 @@ pub(super) fn rescale_to_fapu(
         factors.insert(format!("{}@{}", src.key.name(), src.value), k);
     }
     factors
+}
+
+/// Reach of the compliance gain ([`gain_to_fapu`]), in ES0: about one feature (a lid, a
+/// brow, half the lips) around the FAP's feature point.
+const GAIN_REACH_ES0: f32 = 0.5;
+/// Compliance errors under this share of the expected motion are left alone.
+const GAIN_TOLERANCE: f64 = 0.01;
+
+/// Wendland's C² bump `(1 − x)⁴ (4x + 1)` on `[0, 1]`, 0 beyond: 1 at the centre, flat at
+/// both ends.
+fn bump(x: f32) -> f32 {
+    if x >= 1.0 {
+        0.0
+    } else {
+        let y = 1.0 - x.max(0.0);
+        y * y * y * y * (4.0 * x.max(0.0) + 1.0)
+    }
+}
+
+/// Makes each low-level translation FAP's feature point move by the FAPU-scaled source
+/// displacement (the compliance MPEG-4 asks for), smoothly: the cloned motion `d` becomes
+/// `g·d` with the gain field `g(x) = 1 + (k − 1)·φ(‖x − f‖ / R)` — `f` the target's feature
+/// point, `φ` [`bump`], `R` = [`GAIN_REACH_ES0`] × ES0 and `k = (w·d_f)/(d_f·d_f)` the
+/// least-squares factor taking the cloned feature-point displacement `d_f` to the wanted
+/// `w` = source displacement × target/source FAPU of the FAP's unit. At `f` the motion is
+/// exactly `k·d_f`; beyond `R` it is untouched; in between the gain is smooth, so the motion
+/// stays as smooth as it was (its gradient gains `d·∇g`, with `‖∇g‖ ≤ 1.5·|k − 1| / R`) and
+/// still vertices stay still. A cloned motion whose registration put the feature point off
+/// the source's peak (a cartoon's brow onto a real one) so moves its feature point by the
+/// FAPU without a uniform rescale of the whole motion. Motions within 1 % of the wanted
+/// displacement, and those the guard would reject (a gain outside `[1/4, 4]`, a feature point
+/// that barely moves), are left alone. Returns the gains by FAP name and value.
+pub(super) fn gain_to_fapu(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    target: &CloneSurface,
+    out: &mut [SurfaceMotion],
+) -> BTreeMap<String, f64> {
+    let mut gains = BTreeMap::new();
+    let reach = GAIN_REACH_ES0 * target.fapu.distances.es0 as f32;
+    if !(reach > 0.0 && reach.is_finite()) {
+        return gains;
+    }
+    for (src, dst) in motions.iter().zip(out.iter_mut()) {
+        let Some((fp, kind)) = fap_fp(src.key, source, target) else {
+            continue;
+        };
+        let (sv, tv) = (source.fp_vertices[&fp], target.fp_vertices[&fp]);
+        let r = fapu_ratio(source, target, kind);
+        let want = offset_at(src, sv).as_dvec3() * r;
+        let got = offset_at(dst, tv).as_dvec3();
+        let (wl, gl) = (want.length(), got.length());
+        if !(wl > 0.0 && gl >= MIN_MOTION_SHARE * wl) {
+            continue;
+        }
+        if (want - got).length() <= GAIN_TOLERANCE * wl {
+            continue;
+        }
+        let k = want.dot(got) / got.length_squared();
+        if !(k.is_finite() && (1.0 / MAX_FACTOR_RATIO..=MAX_FACTOR_RATIO).contains(&k)) {
+            continue;
+        }
+        let centre = target.positions[tv as usize];
+        for (v, d) in &mut dst.offsets {
+            let x = target.positions[*v as usize].distance(centre) / reach;
+            *d *= 1.0 + (k as f32 - 1.0) * bump(x);
+        }
+        gains.insert(format!("{}@{}", src.key.name(), src.value), k);
+    }
+    gains
 }
 
 /// Why a motion whose feature point moved `dt` (source `ds`, FAPU ratio `r`, rescale factor
@@ -282,6 +356,32 @@ mod tests {
         assert_eq!(f.len(), 1);
         assert!(!f[0].repaired);
         assert!(out[0].offsets.is_empty());
+    }
+
+    #[test]
+    fn the_gain_makes_the_feature_point_compliant_and_leaves_far_vertices() {
+        // ES0 = 1: the gain reaches half a unit around 2.5 (vertex 0 at the origin).
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y * 0.25];
+        let (s, t) = (surface(pos.clone(), 1.0), surface(pos, 1.0));
+        let src = vec![motion(vec![(0, Vec3::new(0.0, 0.1, 0.0))])];
+        let mut out = vec![motion(vec![
+            (0, Vec3::new(0.0, 0.05, 0.0)),
+            (1, Vec3::new(0.0, 0.05, 0.0)),
+            (2, Vec3::new(0.0, 0.05, 0.0)),
+        ])];
+        let gains = gain_to_fapu(&s, &src, &t, &mut out);
+        assert!(
+            (gains.values().next().unwrap() - 2.0).abs() < 1e-6,
+            "{gains:?}"
+        );
+        assert!(offset_at(&out[0], 0).distance(Vec3::new(0.0, 0.1, 0.0)) < 1e-6);
+        assert_eq!(offset_at(&out[0], 1), Vec3::new(0.0, 0.05, 0.0));
+        let mid = offset_at(&out[0], 2).y;
+        assert!(mid > 0.05 && mid < 0.1, "{mid}");
+        // A compliant motion is left alone.
+        let before = out.clone();
+        assert!(gain_to_fapu(&s, &src, &t, &mut out).is_empty());
+        assert_eq!(out, before);
     }
 
     #[test]

@@ -1,0 +1,300 @@
+//! The `smooth` step (module docs of [`super`]): a cloned motion must not crease, fold or
+//! spike where its source does not. Cloning between faces of different styles leaves such
+//! defects where the target's neighbouring vertices read unrelated parts of the source motion
+//! — a vertex the correspondence left still between moving ones, lips or lids read across
+//! the slit at a corner, a guard repair by nearest vertex (piecewise constant) — and they
+//! show as triangles whose normals turn far more than any of the source's.
+//!
+//! Per motion, with `θ_s` the source's largest normal turn
+//! ([`crate::clone::quality::max_normal_turn`]) and `τ = 1.25 · max(θ_s, 1°)`: every target
+//! triangle turning more than `τ` is *rough*. Its corners and one ring of neighbours around
+//! them are smoothed by damped Laplacian steps (`d_v ← ½ d_v + ½ · mean of its mesh
+//! neighbours`, [`SWEEPS`] of them, everything else held), the rough triangles found again,
+//! and so on up to [`ROUNDS`] times. Small steps take out a spike or a crease (high
+//! frequencies go first) while a motion's broad peak, which has no rough triangle, keeps its
+//! height; every vertex away from the defects keeps its motion exactly, and so does every
+//! low-level FAP's own feature point (its motion is what the FAP defines). A smooth clone (no
+//! triangle above `τ`, the usual case between faces of one style) is not changed at all. The fill follows mesh edges, so the open lips and lids of the target (not
+//! joined by edges across the slit) do not mix.
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::rescale::fap_fp;
+use crate::clone::quality::{max_normal_turn, NORMAL_TURN_FLOOR};
+use crate::clone::{CloneSurface, SurfaceMotion};
+use crate::mesh::geometry::adjacency;
+
+/// Slack over the source's largest turn before a target triangle counts as rough.
+const SLACK: f64 = 1.25;
+/// Smoothing rounds at most (each re-finds the rough triangles).
+const ROUNDS: usize = 40;
+/// Damped Laplacian sweeps per round.
+const SWEEPS: usize = 2;
+
+/// Unit normal and doubled area of each triangle at `positions` (zero normal: degenerate or
+/// out of range).
+fn normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    triangles
+        .iter()
+        .map(|t| {
+            let [Some(&a), Some(&b), Some(&c)] = t.map(|v| positions.get(v as usize)) else {
+                return Vec3::ZERO;
+            };
+            let n = (b - a).cross(c - a);
+            let l = n.length();
+            let longest = (b - a)
+                .length_squared()
+                .max((c - a).length_squared())
+                .max((c - b).length_squared());
+            if l > 1e-12 * longest && l.is_finite() {
+                n / l
+            } else {
+                Vec3::ZERO
+            }
+        })
+        .collect()
+}
+
+/// Whether triangle `t` (neutral unit normal `n0`) turns by more than the angle whose cosine
+/// is `cos_tau` under displacements `d`.
+fn rough(positions: &[Vec3], d: &[Vec3], t: &[u32; 3], n0: Vec3, cos_tau: f32) -> bool {
+    if n0 == Vec3::ZERO {
+        return false;
+    }
+    let p = |k: usize| positions[t[k] as usize] + d[t[k] as usize];
+    let n1 = (p(1) - p(0)).cross(p(2) - p(0));
+    let l = n1.length();
+    // A collapsed triangle is a fold ([`max_normal_turn`]).
+    if !(l.is_finite() && l > 0.0) {
+        return true;
+    }
+    n0.dot(n1) / l < cos_tau
+}
+
+/// The smoothing of every cloned motion (module docs). Returns, per smoothed motion
+/// (`name@value`), how many target vertices were re-solved.
+pub(super) fn smooth_motions(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    target: &CloneSurface,
+    out: &mut [SurfaceMotion],
+) -> BTreeMap<String, usize> {
+    let n = target.positions.len();
+    let adj = adjacency(n, &target.triangles);
+    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (i, t) in target.triangles.iter().enumerate() {
+        for &v in t {
+            if let Some(l) = incident.get_mut(v as usize) {
+                l.push(i as u32);
+            }
+        }
+    }
+    let tn = normals(&target.positions, &target.triangles);
+    let results: Vec<Option<(String, usize)>> = motions
+        .par_iter()
+        .zip(out.par_iter_mut())
+        .map(|(src, dst)| {
+            if dst.offsets.is_empty() {
+                return None;
+            }
+            let mut sd = source.positions.clone();
+            for &(v, o) in &src.offsets {
+                if let Some(p) = sd.get_mut(v as usize) {
+                    *p += o;
+                }
+            }
+            let theta = max_normal_turn(&source.positions, &sd, &source.triangles).angle;
+            let tau = SLACK * theta.max(NORMAL_TURN_FLOOR);
+            if tau >= std::f64::consts::PI {
+                return None;
+            }
+            let cos_tau = tau.cos() as f32;
+            let mut d = vec![Vec3::ZERO; n];
+            for &(v, o) in &dst.offsets {
+                if let Some(s) = d.get_mut(v as usize) {
+                    *s = o;
+                }
+            }
+            let pos = &target.positions;
+            let tris = &target.triangles;
+            let mut bad: Vec<u32> = (0..tris.len() as u32)
+                .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+                .collect();
+            if bad.is_empty() {
+                return None;
+            }
+            // A FAP's own feature point keeps its motion: it is what the FAP defines.
+            let mut pinned = vec![false; n];
+            if let Some((fp, _)) = fap_fp(src.key, source, target) {
+                if let Some(p) = pinned.get_mut(target.fp_vertices[&fp] as usize) {
+                    *p = true;
+                }
+            }
+            let mut touched = vec![false; n];
+            let mut count = 0usize;
+            let mut next = d.clone();
+            for _ in 0..ROUNDS {
+                // The corners of the rough triangles and one ring around them.
+                let mut region: Vec<u32> = Vec::new();
+                let mut marked = vec![false; n];
+                for &i in &bad {
+                    for &v in &tris[i as usize] {
+                        for w in std::iter::once(v).chain(adj[v as usize].iter().copied()) {
+                            if !marked[w as usize] && !pinned[w as usize] {
+                                marked[w as usize] = true;
+                                region.push(w);
+                            }
+                        }
+                    }
+                }
+                for _ in 0..SWEEPS {
+                    for &v in &region {
+                        let nb = &adj[v as usize];
+                        if !nb.is_empty() {
+                            let mean =
+                                nb.iter().map(|&w| d[w as usize]).sum::<Vec3>() / nb.len() as f32;
+                            next[v as usize] = 0.5 * (d[v as usize] + mean);
+                        }
+                    }
+                    for &v in &region {
+                        d[v as usize] = next[v as usize];
+                    }
+                }
+                for &v in &region {
+                    if !touched[v as usize] {
+                        touched[v as usize] = true;
+                        count += 1;
+                    }
+                }
+                let mut seen = std::collections::HashSet::new();
+                bad = region
+                    .iter()
+                    .flat_map(|&v| incident[v as usize].iter().copied())
+                    .filter(|&i| seen.insert(i))
+                    .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+                    .collect();
+                if bad.is_empty() {
+                    break;
+                }
+            }
+            dst.offsets = d
+                .iter()
+                .enumerate()
+                .filter(|(_, o)| **o != Vec3::ZERO && o.is_finite())
+                .map(|(v, &o)| (v as u32, o))
+                .collect();
+            Some((format!("{}@{}", src.key.name(), src.value), count))
+        })
+        .collect();
+    results.into_iter().flatten().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fat::TableKey;
+    use crate::fdp::{Fapu, FapuDistances};
+    use crate::spec::FapId;
+
+    /// A flat grid of `k × k` vertices (spacing 1) in the xy plane.
+    fn grid(k: u32) -> CloneSurface {
+        let mut positions = Vec::new();
+        for j in 0..k {
+            for i in 0..k {
+                positions.push(Vec3::new(i as f32, j as f32, 0.0));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..k - 1 {
+            for i in 0..k - 1 {
+                let v = j * k + i;
+                triangles.push([v, v + 1, v + k + 1]);
+                triangles.push([v, v + k + 1, v + k]);
+            }
+        }
+        let d = FapuDistances {
+            irisd0: 1.0,
+            es0: 1.0,
+            ens0: 1.0,
+            mns0: 1.0,
+            mw0: 1.0,
+        };
+        CloneSurface {
+            positions,
+            triangles,
+            fp_vertices: Default::default(),
+            fp_positions: Default::default(),
+            fapu: Fapu::from_distances(d).unwrap(),
+        }
+    }
+
+    fn motion(offsets: Vec<(u32, Vec3)>) -> SurfaceMotion {
+        SurfaceMotion {
+            key: TableKey::LowLevel(FapId::new(3).unwrap()),
+            value: 512.0,
+            offsets,
+        }
+    }
+
+    /// A smooth bump in z: `h · cos²` over a radius of 4 around the grid's centre.
+    fn bump(s: &CloneSurface, h: f32) -> Vec<(u32, Vec3)> {
+        let c = Vec3::new(5.0, 5.0, 0.0);
+        s.positions
+            .iter()
+            .enumerate()
+            .filter_map(|(v, p)| {
+                let r = p.distance(c) / 4.0;
+                (r < 1.0).then(|| {
+                    let y = (r * std::f32::consts::FRAC_PI_2).cos();
+                    (v as u32, Vec3::Z * h * y * y)
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_smooth_clone_is_untouched_and_a_spike_is_filled() {
+        let s = grid(11);
+        let src = vec![motion(bump(&s, 1.0))];
+        // The same smooth motion on the target: nothing to do.
+        let mut out = src.clone();
+        assert!(smooth_motions(&s, &src, &s, &mut out).is_empty());
+        assert_eq!(out, src);
+        // One vertex left still inside the bump (a hole in the correspondence) is a spike.
+        let centre = 5 * 11 + 5;
+        let mut holed = src.clone();
+        holed[0].offsets.retain(|o| o.0 != centre);
+        let before = max_normal_turn(
+            &s.positions,
+            &s.positions
+                .iter()
+                .enumerate()
+                .map(|(v, p)| *p + crate::clone::quality::dense(&holed[0], 121)[v])
+                .collect::<Vec<_>>(),
+            &s.triangles,
+        );
+        let done = smooth_motions(&s, &src, &s, &mut holed);
+        assert_eq!(done.len(), 1, "{done:?}");
+        let d = crate::clone::quality::dense(&holed[0], 121);
+        let posed: Vec<Vec3> = s.positions.iter().zip(&d).map(|(p, o)| *p + *o).collect();
+        let after = max_normal_turn(&s.positions, &posed, &s.triangles);
+        let source = max_normal_turn(
+            &s.positions,
+            &s.positions
+                .iter()
+                .zip(crate::clone::quality::dense(&src[0], 121))
+                .map(|(p, o)| *p + o)
+                .collect::<Vec<_>>(),
+            &s.triangles,
+        );
+        assert!(before.angle > 1.5 * source.angle, "{before:?} {source:?}");
+        assert!(after.angle <= SLACK * source.angle, "{after:?} {source:?}");
+        // The hole is lifted towards the bump (smoothing stops once nothing is rough, here
+        // at about half the height); the bump's border stays where it was.
+        assert!(d[centre as usize].z > 0.4, "{:?}", d[centre as usize]);
+        assert_eq!(d[0], Vec3::ZERO);
+    }
+}
