@@ -31,6 +31,11 @@ fn check_page(page: &Path) -> Option<Value> {
     let mut cmd = Command::new("node");
     cmd.arg(root().join("tests/support/viewer-check.mjs"))
         .arg(page);
+    // Screenshots for a person to look at: `$VIEWER_SCREENSHOTS=DIR` keeps one per page.
+    if let Some(dir) = std::env::var_os("VIEWER_SCREENSHOTS") {
+        let name = page.file_stem().unwrap_or_default().to_string_lossy();
+        cmd.arg(Path::new(&dir).join(format!("{name}.png")));
+    }
     if std::env::var_os("VIEWER_BROWSER_DIR").is_none() {
         let local = root().join("target/viewer-browser");
         if local.is_dir() {
@@ -134,6 +139,7 @@ fn speech_page_plays_and_poses_in_chromium() {
     assert!((f(&r["stateAfterScrub"]["time"]) - picked / 2.0).abs() < 0.02);
 
     assert_slider_moves_the_mouth(&r);
+    assert_eyes_and_framing(&r);
 }
 
 #[test]
@@ -157,4 +163,69 @@ fn neutral_page_from_the_cli_poses_in_chromium() {
     assert_eq!(r["stateOnLoad"]["mode"], "pose");
     assert_eq!(r["stateOnLoad"]["playing"], false);
     assert_slider_moves_the_mouth(&r);
+}
+
+/// The neutral face at the default camera: both pupils drawn dark (an iris and a pupil on the
+/// eyeballs, not blank white), the skin lighter, and every feature point — the chin included —
+/// above the transport bar and inside the canvas.
+fn assert_eyes_and_framing(r: &Value) {
+    let v = &r["neutralView"];
+    assert!(f(&v["eyes"]) >= 2.0, "no eyeballs to paint: {v}");
+    let pupils = v["pupils"].as_array().unwrap();
+    assert_eq!(pupils.len(), 2, "{v}");
+    let skin: Vec<f64> = v["skin"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| f(&p["luminance"]))
+        .collect();
+    assert!(!skin.is_empty(), "{v}");
+    let skin_mean = skin.iter().sum::<f64>() / skin.len() as f64;
+    for p in pupils {
+        let l = f(&p["luminance"]);
+        assert!(
+            l < 70.0 && l < 0.5 * skin_mean,
+            "pupil {} not dark: {l} (skin {skin_mean}): {v}",
+            p["id"]
+        );
+    }
+    let bar = f(&v["barTop"]);
+    assert!(f(&v["chin"]["y"]) < bar, "chin under the control bar: {v}");
+    assert!(
+        f(&v["lowestPoint"]) < bar,
+        "a feature point under the bar: {v}"
+    );
+    assert!(
+        f(&v["highestPoint"]) > 0.0,
+        "a feature point above the canvas: {v}"
+    );
+}
+
+#[test]
+fn real_head_page_shows_pupils_above_the_controls_in_chromium() {
+    let (face, _) = fbakit::face::BundledFace::Ict.read().unwrap();
+    let (stream, _) =
+        read_stream_file(root().join("samples/speech.fap"), &ReadOptions::lenient()).unwrap();
+    let player = Player::new(&face, &stream, &PlayOptions::default()).unwrap();
+    let frames = player.animation().unwrap();
+    let anim = ViewerAnimation {
+        frames: &frames,
+        fps: player.fps(),
+        name: "speech.fap",
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let page: PathBuf = dir.path().join("ict-speech.html");
+    ViewerPage::new(&face, Some(&anim))
+        .unwrap()
+        .write(&page)
+        .unwrap();
+
+    let Some(r) = check_page(&page) else { return };
+    assert_clean(&r);
+    assert_eq!(r["ready"]["frames"], 75);
+    assert_eq!(r["stateOnLoad"]["playing"], true);
+    assert_eq!(r["timeAdvanced"], true);
+    assert_eq!(r["stateAfterPauseClick"]["playing"], false);
+    assert!((f(&r["stateAfterScrub"]["time"]) - f(&r["pickedFrame"]["time"]) / 2.0).abs() < 0.02);
+    assert_eyes_and_framing(&r);
 }

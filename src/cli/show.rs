@@ -129,8 +129,38 @@ pub fn demo(a: DemoArgs) -> Result<u8> {
         print!("{report}");
         if a.verbose {
             print!("{}", report.timings_text());
+            super::print_warnings(&report.warnings);
+        } else {
+            // One line per kind of warning: a newcomer sees what kinds there are, not 40 lines.
+            let kinds = fbakit::demo::group_warnings(&report.warnings);
+            for k in &kinds {
+                let more = if k.count > 1 {
+                    format!(" (+{} more like it)", k.count - 1)
+                } else {
+                    String::new()
+                };
+                eprintln!(
+                    "warning: {}{more}",
+                    fbakit::error::escape_control(&shorten(&k.first, 110))
+                );
+            }
+            if kinds
+                .iter()
+                .any(|k| k.count > 1 || k.first.chars().count() > 110)
+            {
+                eprintln!("note: `fbakit demo --verbose` prints every warning in full");
+            }
         }
-        super::print_warnings(&report.warnings);
     }
     Ok(EXIT_OK)
+}
+
+/// `text` cut to at most `max` characters, with `…` when cut.
+fn shorten(text: &str, max: usize) -> String {
+    if text.chars().count() <= max {
+        return text.to_string();
+    }
+    let mut out: String = text.chars().take(max.saturating_sub(1)).collect();
+    out.push('…');
+    out
 }

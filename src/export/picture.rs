@@ -4,7 +4,11 @@
 //! Everything here is glue over [`crate::render`], [`crate::player`] and [`crate::clone`]:
 //! a face is drawn from world (face-frame) positions per mesh, its polygons triangulated once,
 //! each mesh in its own colour, from a front camera framed on the *neutral* face so that
-//! frames of one face share a camera and motion shows as motion, not as re-framing.
+//! frames of one face share a camera and motion shows as motion, not as re-framing. Contact
+//! sheets and the cloning grid frame the face from its feature points
+//! ([`FaceView::face_camera`]), not the whole head with its neck.
+
+pub mod eyes;
 
 use glam::Vec3;
 
@@ -18,6 +22,7 @@ use crate::fat::TableKey;
 use crate::mesh::orient::orient_outwards;
 use crate::mesh::Aabb;
 use crate::player::{PlayOptions, Player, PlayerFrame};
+
 use crate::render::{
     bounds, contact_sheet, grid, render, turntable, Camera, Image, RenderMesh, RenderOptions,
 };
@@ -38,6 +43,9 @@ const CELL_CAPTION: [u8; 4] = [235, 235, 235, 255];
 pub struct FaceView {
     parts: Vec<DrawPart>,
     neutral_bounds: Aabb,
+    /// The box around the neutral face's facial feature points
+    /// ([`crate::export::movie::feature_point_box`]), when it has enough of them.
+    face_box: Option<Aabb>,
 }
 
 /// Triangles of one mesh drawn in one material.
@@ -54,15 +62,40 @@ impl FaceView {
     /// neutral pose. Errors when the face has no finite vertex.
     pub fn new(face: &FaceModel) -> Result<FaceView> {
         let neutral = face.neutral_world_positions();
+        let eyes = eyes::eyeballs(face, &neutral);
         let mut parts = Vec::new();
         for (i, m) in face.meshes.iter().enumerate() {
-            let triangles = orient_outwards(&m.mesh.triangles(), &neutral[i]);
+            let mut triangles = orient_outwards(&m.mesh.triangles(), &neutral[i]);
             let mesh_part = FacePart::of_mesh_name(&m.name);
-            for (part, triangles) in
-                split_mesh(mesh_part, &neutral[i], &triangles, &face.feature_points)
-            {
+            // Eyeballs inside another mesh (a one-mesh head) get their own parts first.
+            let mut groups: Vec<(FacePart, Vec<[u32; 3]>)> = Vec::new();
+            if mesh_part != FacePart::EyeWhite {
+                for e in eyes.iter().filter(|e| e.mesh == i) {
+                    let (inside, rest): (Vec<[u32; 3]>, Vec<[u32; 3]>) = triangles
+                        .into_iter()
+                        .partition(|t| t.iter().all(|&v| e.contains(v)));
+                    triangles = rest;
+                    for t in inside {
+                        let c = t.iter().map(|&v| neutral[i][v as usize]).sum::<Vec3>() / 3.0;
+                        let part = e.part_at(c);
+                        match groups.iter_mut().find(|(p, _)| *p == part) {
+                            Some((_, g)) => g.push(t),
+                            None => groups.push((part, vec![t])),
+                        }
+                    }
+                }
+            }
+            groups.extend(split_mesh(
+                mesh_part,
+                &neutral[i],
+                &triangles,
+                &face.feature_points,
+            ));
+            for (part, triangles) in groups {
+                // A mesh's colour is its own part's: eyeballs found inside it keep theirs.
+                let own = part == mesh_part || mesh_part == FacePart::EyeWhite;
                 let colour = match m.color {
-                    Some(c) if part.takes_mesh_colour() => c,
+                    Some(c) if own && part.takes_mesh_colour() => c,
                     _ if part == FacePart::Skin => DEFAULT_COLOUR,
                     _ => part.default_colour(),
                 };
@@ -81,6 +114,7 @@ impl FaceView {
         Ok(FaceView {
             parts,
             neutral_bounds,
+            face_box: super::movie::feature_point_box(face),
         })
     }
 
@@ -89,9 +123,26 @@ impl FaceView {
         self.neutral_bounds
     }
 
-    /// The front camera framed on the neutral face.
+    /// The front camera framed on the whole neutral face (every mesh, neck and back of
+    /// the head included).
     pub fn front_camera(&self) -> Camera {
         Camera::framing(&self.neutral_bounds, 0.0, 0.0)
+    }
+
+    /// The front camera framed on the face itself: the box around its facial feature points
+    /// (chin to hairline, cheek to cheek, with a margin; see [`crate::export::movie`]), or
+    /// [`FaceView::front_camera`] when the face has too few of them. What contact sheets
+    /// and the cloning grid use, so a face fills its cell however long its neck is.
+    pub fn face_camera(&self) -> Camera {
+        match &self.face_box {
+            Some(b) => Camera::framing(b, 0.0, 0.0),
+            None => self.front_camera(),
+        }
+    }
+
+    /// Whether [`FaceView::face_camera`] frames the feature points.
+    pub fn framed_on_feature_points(&self) -> bool {
+        self.face_box.is_some()
     }
 
     /// Draws world positions (one list per mesh, as [`crate::face::FacePose::world_positions_into`]
@@ -163,7 +214,7 @@ fn played_cells(
     size: (u32, u32),
 ) -> Result<(Vec<Image>, Vec<usize>)> {
     let view = FaceView::new(face)?;
-    let camera = view.front_camera();
+    let camera = view.face_camera();
     let opts = RenderOptions::sized(size.0, size.1);
     let numbers = spread_frames(player.frame_range(), n);
     let mut frame = player.new_frame();
@@ -290,7 +341,7 @@ fn posed_cell(
     let positions = face.pose_with(&mut eval, &mut out, &[Activation { key, value }]);
     let mut img = view.render(
         &positions,
-        &view.front_camera(),
+        &view.face_camera(),
         &RenderOptions::sized(size, size),
     );
     let scale = (size / 256 + 1).min(4);

@@ -103,6 +103,25 @@ pub struct ViewerModel {
     pub transforms: Vec<TransformRig>,
     /// Per key with a table that the stream moves: its value at every frame.
     pub tracks: Vec<KeyTrack>,
+    /// Eyeballs to paint an iris and pupil on (the exported glb gives a mesh one material).
+    pub eyes: Vec<EyePaint>,
+}
+
+/// An eyeball of a glTF mesh node and which of its triangles are iris and pupil (by their
+/// centres, as pictures paint them: [`crate::export::picture::eyes`]); the script gives them
+/// their own materials.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EyePaint {
+    /// glTF node index of the mesh holding it.
+    pub node: u32,
+    /// Every vertex of the eyeball, ascending.
+    pub vertices: Vec<u32>,
+    /// Its iris triangles (corner vertices, any order).
+    pub iris: Vec<[u32; 3]>,
+    /// Its pupil triangles.
+    pub pupil: Vec<[u32; 3]>,
+    /// Colours (sRGB) of the eye white, the iris and the pupil.
+    pub colours: [[f32; 3]; 3],
 }
 
 /// The stream shown by the page.
@@ -445,6 +464,7 @@ impl ViewerModel {
             meshes,
             transforms,
             tracks,
+            eyes: eye_paints(face, &mesh_node),
         })
     }
 
@@ -604,6 +624,42 @@ fn camera_frame(face: &FaceModel) -> CameraFrame {
         radius,
         half_extent: ((hi - lo) * 0.5).max(Vec3::splat(radius * 0.01)).to_array(),
     }
+}
+
+/// The eyeballs of `face` on their glTF nodes (see [`EyePaint`]).
+fn eye_paints(face: &FaceModel, mesh_node: &dyn Fn(&str) -> Option<u32>) -> Vec<EyePaint> {
+    use crate::face::parts::FacePart;
+    let neutral = face.neutral_world_positions();
+    crate::export::picture::eyes::eyeballs(face, &neutral)
+        .into_iter()
+        .filter_map(|e| {
+            let node = mesh_node(&face.meshes[e.mesh].name)?;
+            let positions = &neutral[e.mesh];
+            let (mut iris, mut pupil) = (Vec::new(), Vec::new());
+            for t in face.meshes[e.mesh].mesh.triangles() {
+                if !t.iter().all(|&v| e.contains(v)) {
+                    continue;
+                }
+                let c = t.iter().map(|&v| positions[v as usize]).sum::<Vec3>() / 3.0;
+                match e.part_at(c) {
+                    FacePart::Pupil => pupil.push(t),
+                    FacePart::Iris => iris.push(t),
+                    _ => {}
+                }
+            }
+            Some(EyePaint {
+                node,
+                iris,
+                pupil,
+                vertices: e.vertices,
+                colours: [
+                    FacePart::EyeWhite.default_colour(),
+                    FacePart::Iris.default_colour(),
+                    FacePart::Pupil.default_colour(),
+                ],
+            })
+        })
+        .collect()
 }
 
 fn feature_point_markers(

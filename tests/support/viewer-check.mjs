@@ -204,6 +204,56 @@ try {
     report.sliderOutput = await page.locator(`#fap-${slider.key} + output`).textContent();
   }
 
+  // The neutral face at the default camera: where the pupils, the skin and the chin land, and
+  // how dark the pixels inside the pupils are (eyes must show an iris and a pupil, and the
+  // whole face must sit above the transport bar).
+  await page.click("#reset-pose");
+  await page.click("#reset-camera");
+  report.neutralView = await page.evaluate(() => {
+    const v = window.fbakitViewer;
+    v.renderNow();
+    const c = document.getElementById("view");
+    const cr = c.getBoundingClientRect();
+    const tr = document.getElementById("transport");
+    const barTop = tr.hidden ? cr.height : tr.getBoundingClientRect().top - cr.top;
+    const pts = v.projectFeaturePoints();
+    const get = (id) => pts.find((p) => p.id === id);
+    const sx = c.width / c.clientWidth;
+    const sy = c.height / c.clientHeight;
+    const tmp = document.createElement("canvas");
+    tmp.width = c.width;
+    tmp.height = c.height;
+    const g = tmp.getContext("2d");
+    g.drawImage(c, 0, 0);
+    // Mean luminance (0-255) of the drawn pixels in a 3x3 box of device pixels around `p`.
+    const lum = (p) => {
+      const x = Math.round(p.x * sx);
+      const y = Math.round(p.y * sy);
+      const d = g.getImageData(x - 1, y - 1, 3, 3).data;
+      let s = 0;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        if (d[i + 3] === 0) continue;
+        s += 0.2126 * d[i] + 0.7152 * d[i + 1] + 0.0722 * d[i + 2];
+        n++;
+      }
+      return n ? s / n : null;
+    };
+    const at = (ids) => ids.map(get).filter(Boolean).map((p) => ({ id: p.id, x: p.x, y: p.y, luminance: lum(p) }));
+    const ys = pts.map((p) => p.y);
+    return {
+      barTop,
+      canvasHeight: cr.height,
+      chin: get("2.1") || null,
+      pupils: at(["3.5", "3.6"]),
+      skin: at(["9.3", "5.3", "5.4"]),
+      lowestPoint: Math.max(...ys),
+      highestPoint: Math.min(...ys),
+      eyes: (v.model.eyes || []).length,
+    };
+  });
+  if (screenshot) await page.screenshot({ path: screenshot.replace(/\.png$/, "") + "-neutral.png" });
+
   if (screenshot) {
     if (animated) await page.evaluate((t) => window.fbakitViewer.seek(t), pick.time);
     await page.screenshot({ path: screenshot });

@@ -46,12 +46,48 @@
   const target = new T.Vector3().fromArray(model.camera.target);
   const radius = model.camera.radius;
 
+  /** The rows of the canvas (CSS pixels from its top) not covered by the caption above or
+   * the transport bar below: where the face is framed. */
+  function freeBand() {
+    const c = canvas.getBoundingClientRect();
+    const h = Math.max(1, c.height);
+    let top = 0;
+    let bottom = h;
+    const tr = $('transport');
+    if (tr && !tr.hidden) bottom = Math.min(bottom, tr.getBoundingClientRect().top - c.top - 6);
+    const cap = $('caption');
+    if (cap) top = Math.max(top, cap.getBoundingClientRect().bottom - c.top);
+    // A very small window keeps at least half its height for the face.
+    if (bottom - top < h * 0.5) {
+      top = 0;
+      bottom = Math.max(bottom, h * 0.5);
+    }
+    return { top, bottom, height: h };
+  }
+
+  /** Shifts the image so that the view's centre is the middle of the free band. */
+  function applyViewOffset() {
+    const c = canvas.getBoundingClientRect();
+    const w = Math.max(1, c.width);
+    const band = freeBand();
+    const shift = band.height / 2 - (band.top + band.bottom) / 2;
+    if (Math.abs(shift) < 0.5) {
+      camera.clearViewOffset();
+    } else {
+      camera.setViewOffset(w, band.height, 0, shift, w, band.height);
+    }
+  }
+
   function frameFace() {
     const vfov = T.MathUtils.degToRad(camera.fov);
     const hfov = 2 * Math.atan(Math.tan(vfov / 2) * camera.aspect);
     const [ex, ey, ez] = model.camera.half_extent;
-    // Fit the face's x-y rectangle with a margin, from in front of its depth.
-    const dist = 1.12 * Math.max(ey / Math.tan(vfov / 2), ex / Math.tan(hfov / 2)) + ez;
+    // Fit the face's x-y rectangle with a margin into the band above the controls, from in
+    // front of its depth.
+    const band = freeBand();
+    const tanV = Math.tan(vfov / 2) * Math.max(0.2, (band.bottom - band.top) / band.height);
+    const dist = 1.12 * Math.max(ey / tanV, ex / Math.tan(hfov / 2)) + ez;
+    applyViewOffset();
     // A little from the side and above, so the face reads as 3D from the first frame.
     const yaw = T.MathUtils.degToRad(14);
     const pitch = T.MathUtils.degToRad(5);
@@ -72,6 +108,7 @@
     const h = Math.max(1, stage.clientHeight);
     renderer.setSize(w, h, false);
     camera.aspect = w / h;
+    applyViewOffset();
     camera.updateProjectionMatrix();
   }
 
@@ -448,6 +485,65 @@
     note.textContent = p ? `${p.id} — ${p.description}` : '';
   });
 
+  // ---- Eyes -------------------------------------------------------------------------------
+
+  /** Gives the triangles of every eyeball (model.eyes) an eye-white, iris or pupil material:
+   * the glb has one material per mesh, which would draw eyes blank. */
+  function paintEyes() {
+    const byNode = new Map();
+    for (const e of model.eyes || []) {
+      if (!byNode.has(e.node)) byNode.set(e.node, []);
+      byNode.get(e.node).push(e);
+    }
+    const keyOf = (a, b, c) => [a, b, c].sort((x, y) => x - y).join(',');
+    for (const [node, eyes] of byNode) {
+      const o = (meshObjects.get(node) || [])[0];
+      if (!o || !o.geometry || !o.geometry.index || Array.isArray(o.material)) continue;
+      const sets = eyes.map((e) => ({
+        ball: new Set(e.vertices),
+        iris: new Set(e.iris.map((t) => keyOf(...t))),
+        pupil: new Set(e.pupil.map((t) => keyOf(...t))),
+      }));
+      const index = o.geometry.index.array;
+      const buckets = [[], [], [], []];
+      for (let t = 0; t + 2 < index.length; t += 3) {
+        const a = index[t];
+        const b = index[t + 1];
+        const c = index[t + 2];
+        let m = 0;
+        for (const s of sets) {
+          if (!(s.ball.has(a) && s.ball.has(b) && s.ball.has(c))) continue;
+          const k = keyOf(a, b, c);
+          m = s.pupil.has(k) ? 3 : s.iris.has(k) ? 2 : 1;
+          break;
+        }
+        buckets[m].push(a, b, c);
+      }
+      if (buckets[1].length + buckets[2].length + buckets[3].length === 0) continue;
+      const out = new index.constructor(index.length);
+      const geo = o.geometry;
+      geo.clearGroups();
+      let start = 0;
+      buckets.forEach((tris, m) => {
+        out.set(tris, start);
+        if (tris.length) geo.addGroup(start, tris.length, m);
+        start += tris.length;
+      });
+      geo.setIndex(new T.BufferAttribute(out, 1));
+      const base = o.material;
+      const [white, iris, pupil] = eyes[0].colours;
+      const paint = (rgb, roughness) => {
+        const m = base.clone();
+        if (m.color) m.color.setRGB(rgb[0], rgb[1], rgb[2], T.SRGBColorSpace);
+        m.map = null;
+        if ('roughness' in m) m.roughness = roughness;
+        if ('metalness' in m) m.metalness = 0;
+        return m;
+      };
+      o.material = [base, paint(white, 0.35), paint(iris, 0.45), paint(pupil, 0.3)];
+    }
+  }
+
   // ---- Loading and the frame loop --------------------------------------------------------------
 
   function decodeBase64(text) {
@@ -547,6 +643,7 @@
         if (meshes.length) meshObjects.set(a.nodes, meshes);
       }
     });
+    paintEyes();
     buildFeaturePoints();
     const clip = gltf.animations[0];
     if (clip && stream) {
