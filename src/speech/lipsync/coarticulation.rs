@@ -344,10 +344,7 @@ mod tests {
             .map(|n| n as f64 / 25.0)
             .collect();
         assert!(!pp.is_empty(), "{shown:?}");
-        assert!(
-            pp.iter().all(|t| (0.36..=0.52).contains(t)),
-            "{shown:?}"
-        );
+        assert!(pp.iter().all(|t| (0.36..=0.52).contains(t)), "{shown:?}");
     }
 
     #[test]
