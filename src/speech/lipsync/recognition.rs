@@ -81,7 +81,7 @@ pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<
     let mut pending: Vec<i16> = Vec::new();
     let mut offset = 0usize;
     let mut phones: Vec<AlignedPhone> = Vec::new();
-    let mut recognise = |samples: &[i16], offset: usize, phones: &mut Vec<AlignedPhone>| {
+    let recognise = |samples: &[i16], offset: usize, phones: &mut Vec<AlignedPhone>| {
         write_piece(&wav, samples)?;
         let start = offset as f64 / rate as f64;
         for mut p in run_recogniser(&wav, &hmm, &lm)? {
