@@ -64,7 +64,8 @@ fn transcript_alignment_meets_the_issue_targets() {
     assert!(total.closures >= 30, "{total:?}");
     assert!(total.closure_rate() >= 0.95, "{total:?}");
     assert!(total.agreement() >= 0.85, "{total:?}");
-    // Issue target 2 %; measured 2.3 % on the full evaluation (see the CHANGELOG line).
+    // Issue target 2 %; measured 1.6 % on the full evaluation (examples/lipsync_eval.rs); this
+    // subset of 8 cases is held to 3 %.
     assert!(total.false_closure_rate() <= 0.03, "{total:?}");
     // Better than stretching the rendition over the recording.
     assert!(total.closure_rate() >= baseline.closure_rate());

@@ -10,7 +10,9 @@
 //! measured: it showed fewer closures on the evaluation set, so it is not done.)
 //!
 //! The recording is read a chunk at a time ([`analyse_chunks`]): only its features (about
-//! 60 bytes per 10 ms) are kept, and the warp's memory grows linearly with the length.
+//! 60 bytes per 10 ms) are kept, and the warp's memory grows linearly with the length. The
+//! transcript's rendition is spoken a few sentences at a time and kept as features too
+//! ([`rendition`]), so an hour-long recording stays in bounded memory.
 //!
 //! ```no_run
 //! use fbakit::speech::lipsync::{analyse_file, lipsync_transcript, LipsyncOptions};
