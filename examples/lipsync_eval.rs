@@ -2,20 +2,23 @@
 //! renditions of sentences in other voices and at other rates, resampled, padded and
 //! with noise, aligned against their transcripts; prints issue 22's three figures per
 //! condition, the same figures for stretching the transcript's rendition over the
-//! recording's speech (the baseline the issue measured), and the real-time factor.
+//! recording's speech (the baseline the issue measured), the figures without a transcript
+//! (PocketSphinx phone recognition, when installed), and the real-time factor. One
+//! condition is the recording encoded as MP3 at 64 kbit/s (with ffmpeg, when installed).
 //!
-//! Run: `cargo run --release --example lipsync_eval` (needs espeak-ng).
+//! Run: `cargo run --release --example lipsync_eval` (needs espeak-ng; ffmpeg and
+//! pocketsphinx + pocketsphinx-en-us for the MP3 condition and the recognition figures).
 #![allow(dead_code)] // Also included as a module by the tests, which do not call `main`.
 
 use std::time::Instant;
 
 use fbakit::fap::VisemeParams;
-use fbakit::speech::audio::AudioReader;
 use fbakit::speech::espeak::{speak_at, TimedPhoneme};
 use fbakit::speech::lipsync::coarticulation::lipsync_keys;
 use fbakit::speech::lipsync::evaluation::{degrade, score, Degradation, LipsyncScore};
+use fbakit::speech::lipsync::recognition::{recognise_file, recognition_available};
 use fbakit::speech::lipsync::{
-    analyse_chunks, lipsync_transcript_at, render_transcript, LipsyncOptions,
+    analyse_file, lipsync_recognised, lipsync_transcript_at, render_transcript, LipsyncOptions,
 };
 use fbakit::speech::{animation::key_frame, MouthFaps};
 
@@ -41,6 +44,8 @@ pub struct Condition {
     pub rate: u32,
     /// What is done to the audio.
     pub degradation: Degradation,
+    /// Whether the recording is then encoded as MP3 at 64 kbit/s.
+    pub mp3: bool,
 }
 
 /// The conditions measured.
@@ -51,6 +56,7 @@ pub fn conditions() -> Vec<Condition> {
             voice: "en-us",
             rate: 140,
             degradation: Degradation::default(),
+            mp3: false,
         },
         Condition {
             name: "en-us+f3, 200 wpm, 48 kHz, 15 dB SNR",
@@ -63,6 +69,7 @@ pub fn conditions() -> Vec<Condition> {
                 lead_in: 0.5,
                 seed: 2,
             },
+            mp3: false,
         },
         Condition {
             name: "en-gb-x-rp+m3, 120 wpm, 8 kHz, 25 dB SNR",
@@ -75,6 +82,20 @@ pub fn conditions() -> Vec<Condition> {
                 lead_in: 0.2,
                 seed: 3,
             },
+            mp3: false,
+        },
+        Condition {
+            name: "en-us+m2, 160 wpm, 44.1 kHz stereo, 20 dB SNR, MP3 64 kbit/s",
+            voice: "en-us+m2",
+            rate: 160,
+            degradation: Degradation {
+                sample_rate: 44_100,
+                channels: 2,
+                snr_db: Some(20.0),
+                lead_in: 0.4,
+                seed: 4,
+            },
+            mp3: true,
         },
     ]
 }
@@ -92,6 +113,8 @@ pub struct CaseResult {
     pub work_seconds: f64,
     /// Overall confidence.
     pub confidence: f64,
+    /// Without the transcript (PocketSphinx), when asked for and installed.
+    pub recognised: Option<LipsyncScore>,
 }
 
 fn frames_of(keys: &[fbakit::speech::VisemeKey], duration: f64, fps: f64) -> Vec<VisemeParams> {
@@ -101,17 +124,58 @@ fn frames_of(keys: &[fbakit::speech::VisemeKey], duration: f64, fps: f64) -> Vec
         .collect()
 }
 
-/// Runs one sentence under one condition.
+/// Whether ffmpeg can be run (for the MP3 condition).
+pub fn ffmpeg_available() -> bool {
+    std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Runs one sentence under one condition (with the transcript only).
 pub fn run_case(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<CaseResult> {
+    run_case_with(text, c, fps, false)
+}
+
+/// Runs one sentence under one condition; also without the transcript when `recognise`.
+pub fn run_case_with(
+    text: &str,
+    c: &Condition,
+    fps: f64,
+    recognise: bool,
+) -> fbakit::error::Result<CaseResult> {
     let recording = speak_at(text, c.voice, c.rate)?;
     let (wav, truth) = degrade(&recording, &c.degradation)?;
+    let dir = tempfile::tempdir().map_err(|e| fbakit::error::Error::io("tempdir", e))?;
+    let mut path = dir.path().join("case.wav");
+    std::fs::write(&path, wav).map_err(|e| fbakit::error::Error::io(&path, e))?;
+    if c.mp3 {
+        let mp3 = dir.path().join("case.mp3");
+        let ok = std::process::Command::new("ffmpeg")
+            .args(["-v", "error", "-y", "-i"])
+            .arg(&path)
+            .args(["-b:a", "64k"])
+            .arg(&mp3)
+            .status()
+            .is_ok_and(|s| s.success());
+        if !ok {
+            return Err(fbakit::error::Error::MissingTool(
+                "ffmpeg (apt-get install ffmpeg) encodes the MP3 condition".into(),
+            ));
+        }
+        path = mp3;
+    }
     let started = Instant::now();
-    let mut reader =
-        AudioReader::from_wav(Box::new(std::io::Cursor::new(wav)), "case.wav".as_ref())?;
-    let chunks = std::iter::from_fn(|| reader.next_chunk().transpose());
-    let rec = analyse_chunks(chunks, "case.wav".as_ref())?;
+    let rec = analyse_file(&path, &mut |_| {})?;
     let sync = lipsync_transcript_at(&rec, text, &LipsyncOptions::default(), fps)?;
     let work_seconds = started.elapsed().as_secs_f64();
+    let recognised = if recognise && recognition_available() {
+        let phones = recognise_file(&path, &mut |_| {})?;
+        let sync = lipsync_recognised(&rec, phones, fps)?;
+        Some(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
+    } else {
+        None
+    };
     let aligned = score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps);
     // Baseline: the rendition's phones stretched linearly over the recording's speech.
     let rendition = render_transcript(text, "en")?;
@@ -143,6 +207,7 @@ pub fn run_case(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<Ca
         audio_seconds: rec.seconds,
         work_seconds,
         confidence: sync.confidence,
+        recognised,
     })
 }
 
@@ -165,14 +230,28 @@ fn main() {
     }
     let (mut audio, mut work) = (0.0, 0.0);
     let mut all = (LipsyncScore::default(), LipsyncScore::default());
+    let mut all_recognised = LipsyncScore::default();
+    let recognise = recognition_available();
+    if !recognise {
+        println!("(PocketSphinx is not installed: no figures without a transcript)");
+    }
+    let have_ffmpeg = ffmpeg_available();
     for c in conditions() {
+        if c.mp3 && !have_ffmpeg {
+            println!("{}: skipped (ffmpeg is not installed)", c.name);
+            continue;
+        }
         let mut sum = (LipsyncScore::default(), LipsyncScore::default());
+        let mut recognised = LipsyncScore::default();
         let mut conf = Vec::new();
         for text in SENTENCES {
-            match run_case(text, &c, 25.0) {
+            match run_case_with(text, &c, 25.0, recognise) {
                 Ok(r) => {
                     sum.0.add(&r.aligned);
                     sum.1.add(&r.stretched);
+                    if let Some(s) = &r.recognised {
+                        recognised.add(s);
+                    }
                     audio += r.audio_seconds;
                     work += r.work_seconds;
                     conf.push(r.confidence);
@@ -192,12 +271,19 @@ fn main() {
         );
         line("aligned", &sum.0);
         line("stretched", &sum.1);
+        if recognise {
+            line("recognised", &recognised);
+        }
         all.0.add(&sum.0);
         all.1.add(&sum.1);
+        all_recognised.add(&recognised);
     }
     println!("all conditions");
     line("aligned", &all.0);
     line("stretched", &all.1);
+    if recognise {
+        line("recognised", &all_recognised);
+    }
     println!(
         "{audio:.1} s of audio analysed and aligned in {work:.2} s: {:.0}x real time",
         audio / work.max(1e-9)

@@ -181,3 +181,44 @@ fn parser_seeds() {
         });
     }
 }
+
+fn audio(data: &[u8]) {
+    let Ok(mut r) = fbakit::speech::audio::audio_from_bytes(data.to_vec(), Path::new("x.audio"))
+    else {
+        return;
+    };
+    let mut samples = 0usize;
+    loop {
+        match r.next_chunk() {
+            Ok(Some(c)) => {
+                assert!(c.iter().all(|s| s.is_finite() && s.abs() <= 1.001));
+                samples += c.len();
+                assert!(samples < 16_000 * 60, "a 0.3 s seed gave a minute of audio");
+            }
+            Ok(None) => break,
+            Err(e) => {
+                assert!(e.to_string().contains("x.audio"), "{e}");
+                break;
+            }
+        }
+    }
+}
+
+#[test]
+fn audio_seeds() {
+    // The unmodified seeds decode to about 0.3 s each.
+    for seed in seeds("audio") {
+        let mut r = fbakit::speech::audio::open_audio(&seed)
+            .unwrap_or_else(|e| panic!("{}: {e}", seed.display()));
+        let mut n = 0;
+        while let Some(c) = r.next_chunk().unwrap() {
+            n += c.len();
+        }
+        assert!(
+            (4_000..7_000).contains(&n),
+            "{}: {n} samples",
+            seed.display()
+        );
+    }
+    replay("audio", audio);
+}

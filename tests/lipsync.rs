@@ -64,7 +64,8 @@ fn transcript_alignment_meets_the_issue_targets() {
     assert!(total.closures >= 30, "{total:?}");
     assert!(total.closure_rate() >= 0.95, "{total:?}");
     assert!(total.agreement() >= 0.85, "{total:?}");
-    // Issue target 2 %; measured 2.3 % on the full evaluation (see the CHANGELOG line).
+    // Issue target 2 %; measured 1.6 % on the full evaluation (examples/lipsync_eval.rs); this
+    // subset of 8 cases is held to 3 %.
     assert!(total.false_closure_rate() <= 0.03, "{total:?}");
     // Better than stretching the rendition over the recording.
     assert!(total.closure_rate() >= baseline.closure_rate());
@@ -161,7 +162,7 @@ fn bad_recordings_and_transcripts_exit_2_naming_the_file_and_write_nothing() {
     let cases: [(&str, &str, &str); 8] = [
         ("empty.wav", "hello", "empty"),
         ("cut.wav", "hello", "truncated"),
-        ("song.mp3", "hello", "MP3"),
+        ("song.mp3", "hello", "song.mp3"),
         ("one-hz.wav", "hello", "1 Hz"),
         ("silence.wav", "hello", "silent"),
         ("noise.wav", "hello", "no speech"),
@@ -222,4 +223,227 @@ fn without_a_transcript_english_phones_are_recognised() {
         .unwrap()
         .iter()
         .any(|v| v["viseme"] != "sil"));
+}
+
+fn ffmpeg_available() -> bool {
+    std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Encodes `wav` in `dir` to `name` with ffmpeg arguments `args`.
+fn encode(dir: &Path, wav: &str, name: &str, args: &[&str]) {
+    let o = std::process::Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-i", wav])
+        .args(args)
+        .arg(name)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "ffmpeg {name}: {}", stderr(&o));
+}
+
+/// The whole recording at the analysis rate.
+fn decoded(path: &Path) -> (fbakit::speech::audio::AudioInfo, Vec<f32>) {
+    let mut r = fbakit::speech::audio::open_audio(path).unwrap();
+    let mut all = Vec::new();
+    while let Some(c) = r.next_chunk().unwrap() {
+        all.extend(c);
+    }
+    (r.info().clone(), all)
+}
+
+/// The best normalised correlation of `a` and `b` over lags of ±`max_lag` samples, and
+/// its lag.
+fn best_correlation(a: &[f32], b: &[f32], max_lag: i64) -> (f64, i64) {
+    let mut best = (f64::MIN, 0);
+    for lag in -max_lag..=max_lag {
+        let (mut ab, mut aa, mut bb) = (0f64, 0f64, 0f64);
+        for (i, &x) in a.iter().enumerate() {
+            let j = i as i64 + lag;
+            if j < 0 || j >= b.len() as i64 {
+                continue;
+            }
+            let y = b[j as usize];
+            ab += f64::from(x) * f64::from(y);
+            aa += f64::from(x) * f64::from(x);
+            bb += f64::from(y) * f64::from(y);
+        }
+        let r = ab / (aa * bb).sqrt().max(1e-12);
+        if r > best.0 {
+            best = (r, lag);
+        }
+    }
+    best
+}
+
+fn viseme_labels(report: &serde_json::Value) -> Vec<String> {
+    report["visemes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["viseme"].as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn compressed_recordings_decode_like_the_wav_and_give_the_same_visemes() {
+    if skip("compressed_recordings_decode_like_the_wav_and_give_the_same_visemes") {
+        return;
+    }
+    if !ffmpeg_available() {
+        eprintln!(
+            "skip compressed_recordings_decode_like_the_wav_and_give_the_same_visemes: \
+             ffmpeg is not installed (apt-get install ffmpeg)"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = "Bob brought a big blue balloon to the beach. My mother bought a map of Bombay.";
+    recording(d, "voice.wav", text);
+    // Stereo 44.1 kHz MP3 at 64 kbit/s, FLAC, Vorbis at 48 kHz, AAC in M4A; the names
+    // do not say what the files are.
+    let formats: [(&str, &[&str], &str); 4] = [
+        ("voice.mp3", &["-b:a", "64k"], "MP3"),
+        ("voice.flac", &[], "FLAC"),
+        (
+            "voice-vorbis.bin",
+            &["-f", "ogg", "-c:a", "libvorbis", "-ar", "48000"],
+            "Vorbis",
+        ),
+        (
+            "voice.m4a",
+            &["-c:a", "aac", "-b:a", "96k", "-ac", "1"],
+            "AAC",
+        ),
+    ];
+    let (wav_info, wav) = decoded(&d.join("voice.wav"));
+    let wav_report = {
+        let o = fbakit(
+            d,
+            &[
+                "lipsync",
+                "voice.wav",
+                "--text",
+                text,
+                "-o",
+                "wav.fap",
+                "--json",
+            ],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let wav_visemes = viseme_labels(&wav_report);
+    for (name, args, codec) in formats {
+        encode(d, "voice.wav", name, args);
+        let (info, samples) = decoded(&d.join(name));
+        assert!(info.format.contains(codec), "{name}: {}", info.format);
+        // Same length (AAC's padding at the end is not trimmed: within 60 ms) …
+        let (a, b) = (wav.len() as f64 / 16_000.0, samples.len() as f64 / 16_000.0);
+        assert!((a - b).abs() < 0.06, "{name}: {a} s vs {b} s");
+        assert!((info.seconds - wav_info.seconds).abs() < 0.06 || info.seconds == 0.0);
+        // … the same signal, not shifted by more than a millisecond.
+        let (r, lag) = best_correlation(&wav, &samples, 48);
+        assert!(r > 0.9, "{name}: correlation {r}");
+        assert!(lag.abs() <= 16, "{name}: lag {lag} samples");
+        // And the same visemes, frame for frame but for a few.
+        let out = format!("{name}.fap");
+        let o = fbakit(d, &["lipsync", name, "--text", text, "-o", &out, "--json"]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let visemes = viseme_labels(&report);
+        assert!(visemes.len().abs_diff(wav_visemes.len()) <= 2, "{name}");
+        let same = wav_visemes
+            .iter()
+            .zip(&visemes)
+            .enumerate()
+            .filter(|(n, (w, _))| {
+                visemes[n.saturating_sub(1)..(n + 2).min(visemes.len())].contains(w)
+            })
+            .count();
+        let share = same as f64 / wav_visemes.len() as f64;
+        assert!(share >= 0.95, "{name}: {share}");
+    }
+}
+
+#[test]
+fn hostile_compressed_files_exit_2_naming_the_file_and_write_nothing() {
+    if skip("hostile_compressed_files_exit_2_naming_the_file_and_write_nothing") {
+        return;
+    }
+    if !ffmpeg_available() {
+        eprintln!(
+            "skip hostile_compressed_files_exit_2_naming_the_file_and_write_nothing: ffmpeg \
+             is not installed (apt-get install ffmpeg)"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    recording(d, "voice.wav", "My mother bought a map of Bombay.");
+    encode(d, "voice.wav", "voice.mp3", &["-b:a", "64k"]);
+    encode(d, "voice.wav", "voice.flac", &[]);
+    encode(d, "voice.wav", "voice.ogg", &["-c:a", "libvorbis"]);
+    encode(d, "voice.wav", "voice.m4a", &["-c:a", "aac"]);
+    encode(d, "voice.wav", "voice.opus", &["-c:a", "libopus"]);
+    let mut cases: Vec<(String, &str)> = vec![
+        ("voice.opus".into(), "Opus"),
+        ("empty.mp3".into(), "empty"),
+        ("song.mp3".into(), "song.mp3"),
+    ];
+    std::fs::write(d.join("empty.mp3"), b"").unwrap();
+    std::fs::write(d.join("song.mp3"), b"ID3\x04\0\0\0\0\0\0junkjunkjunk").unwrap();
+    for ext in ["mp3", "flac", "ogg", "m4a"] {
+        let bytes = std::fs::read(d.join(format!("voice.{ext}"))).unwrap();
+        let name = format!("cut.{ext}");
+        std::fs::write(d.join(&name), &bytes[..bytes.len() / 3]).unwrap();
+        cases.push((name, "truncated"));
+        // Bytes flipped all through the data: refused or read, never a panic.
+        let mut flipped = bytes.clone();
+        for k in (64..flipped.len()).step_by(97) {
+            flipped[k] ^= 0x5A;
+        }
+        std::fs::write(d.join(format!("flipped.{ext}")), flipped).unwrap();
+    }
+    for (file, says) in &cases {
+        let o = fbakit(d, &["lipsync", file, "--text", "hello", "-o", "out.fap"]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{file}: {err}");
+        assert!(err.contains(file.as_str()), "{file}: {err}");
+        if *says == "truncated" {
+            // M4A without its index at the end says so differently.
+            assert!(
+                err.contains("truncated") || err.contains("damaged"),
+                "{file}: {err}"
+            );
+        } else {
+            assert!(err.contains(says), "{file}: {err}");
+        }
+        assert_eq!(err.trim().lines().count(), 1, "{file}: {err}");
+        assert!(!d.join("out.fap").exists(), "{file}");
+    }
+    for ext in ["mp3", "flac", "ogg", "m4a"] {
+        let file = format!("flipped.{ext}");
+        let o = fbakit(
+            d,
+            &[
+                "lipsync",
+                &file,
+                "--text",
+                "My mother bought a map of Bombay.",
+                "-o",
+                "out.fap",
+            ],
+        );
+        let code = o.status.code();
+        assert!(code == Some(0) || code == Some(2), "{file}: {}", stderr(&o));
+        if code == Some(2) {
+            assert!(stderr(&o).contains(&file), "{file}: {}", stderr(&o));
+            assert!(!d.join("out.fap").exists(), "{file}");
+        }
+        let _ = std::fs::remove_file(d.join("out.fap"));
+    }
 }

@@ -25,8 +25,8 @@ const MAX_TRANSCRIPT_BYTES: u64 = 1 << 20;
 /// Arguments of `lipsync`.
 #[derive(Debug, Args)]
 pub struct LipsyncArgs {
-    /// The voice recording: WAV (8/16/24/32-bit integer or 32-bit float, any rate from 4 kHz,
-    /// stereo mixed down).
+    /// The voice recording: WAV (8/16/24/32-bit integer or 32-bit float), MP3, FLAC, Ogg
+    /// Vorbis or M4A/MP4 (AAC), told apart by content; any rate from 4 kHz, stereo mixed down.
     pub recording: PathBuf,
     /// What the recording says (its transcript). Without --text or --text-file, English
     /// phones are recognised with PocketSphinx (Debian: pocketsphinx pocketsphinx-en-us).

@@ -1,14 +1,17 @@
-//! Recordings in: WAV through `hound` (8/16/24/32-bit integer and float, any channel count,
-//! mixed down to mono), decoded a chunk at a time and resampled to [`ANALYSIS_RATE`] for
+//! Recordings in: WAV through `hound` (8/16/24/32-bit integer and float, any channel count),
+//! MP3, FLAC, Ogg Vorbis and M4A/MP4 (AAC) through `symphonia` ([`super::decode`]), told
+//! apart by their first bytes, mixed down to mono, decoded a chunk at a time and resampled to [`ANALYSIS_RATE`] for
 //! analysis, so a long recording never has to be in memory whole.
 //!
-//! Every problem names the file: a 0-byte or truncated file, a format that is not WAV, a
+//! Every problem names the file: a 0-byte or truncated file, a format not read, a
 //! sample rate outside [`MIN_SAMPLE_RATE`]..=[`MAX_SAMPLE_RATE`] or a recording longer than
 //! [`MAX_AUDIO_SECONDS`].
 
-use std::io::{BufReader, Read};
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
+use super::decode::CompressedSource;
+pub use super::decode::Container;
 use super::SpeechError;
 use crate::error::{Error, Result};
 
@@ -43,12 +46,20 @@ pub struct AudioInfo {
 /// A recording read a chunk at a time as mono samples in `[-1, 1]` at [`ANALYSIS_RATE`].
 pub struct AudioReader {
     info: AudioInfo,
-    wav: hound::WavReader<Box<dyn Read + Send>>,
-    spec: hound::WavSpec,
+    source: Source,
     resampler: Resampler,
     /// Input frames read so far.
     frames_read: u64,
     done: bool,
+}
+
+/// Where the samples come from.
+enum Source {
+    Wav {
+        wav: Box<hound::WavReader<Box<dyn Read + Send>>>,
+        spec: hound::WavSpec,
+    },
+    Compressed(Box<CompressedSource>),
 }
 
 impl std::fmt::Debug for AudioReader {
@@ -67,28 +78,46 @@ fn bad(path: &Path, detail: impl Into<String>) -> Error {
     .into()
 }
 
-/// Opens the recording at `path`.
+/// Opens the recording at `path`: WAV, MP3, FLAC, Ogg Vorbis or M4A/MP4 (AAC), told apart by
+/// their first bytes.
 pub fn open_audio(path: &Path) -> Result<AudioReader> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
     if len == 0 {
         return Err(bad(path, "the file is empty (0 bytes)"));
     }
     let mut head = [0u8; 12];
-    let mut reader = BufReader::new(file);
-    let n = read_up_to(&mut reader, &mut head).map_err(|e| Error::io(path, e))?;
-    let chained: Box<dyn Read + Send> =
-        Box::new(std::io::Cursor::new(head[..n].to_vec()).chain(reader));
-    if n < 12 || &head[..4] != b"RIFF" || &head[8..12] != b"WAVE" {
-        return Err(bad(
-            path,
-            format!(
-                "{}; fbakit reads WAV (RIFF/WAVE) recordings",
-                sniff(&head[..n])
-            ),
-        ));
+    let n = read_up_to(&mut file, &mut head).map_err(|e| Error::io(path, e))?;
+    file.seek(SeekFrom::Start(0))
+        .map_err(|e| Error::io(path, e))?;
+    match Container::sniff(&head[..n]) {
+        Some(Container::Wav) => AudioReader::from_wav(Box::new(BufReader::new(file)), path),
+        Some(c) => AudioReader::from_compressed(Box::new(file), c, path),
+        None => Err(unknown(path, &head[..n])),
     }
-    AudioReader::from_wav(chained, path)
+}
+
+/// A recording held in memory (`path` names it in errors), told apart as [`open_audio`] does.
+pub fn audio_from_bytes(bytes: Vec<u8>, path: &Path) -> Result<AudioReader> {
+    if bytes.is_empty() {
+        return Err(bad(path, "the file is empty (0 bytes)"));
+    }
+    let head = &bytes[..bytes.len().min(12)];
+    match Container::sniff(head) {
+        Some(Container::Wav) => AudioReader::from_wav(Box::new(std::io::Cursor::new(bytes)), path),
+        Some(c) => AudioReader::from_compressed(Box::new(std::io::Cursor::new(bytes)), c, path),
+        None => Err(unknown(path, head)),
+    }
+}
+
+fn unknown(path: &Path, head: &[u8]) -> Error {
+    bad(
+        path,
+        format!(
+            "{}; fbakit reads WAV, MP3, FLAC, Ogg Vorbis and M4A/MP4 (AAC) recordings",
+            sniff(head)
+        ),
+    )
 }
 
 fn read_up_to(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
@@ -102,27 +131,49 @@ fn read_up_to(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     Ok(n)
 }
 
-/// A name for what a file that is not WAV looks like, from its first bytes.
+/// A name for what a file that is no recording fbakit reads looks like, from its first bytes.
 fn sniff(head: &[u8]) -> String {
-    let what = if head.starts_with(b"ID3")
-        || head.starts_with(&[0xFF, 0xFB])
-        || head.starts_with(&[0xFF, 0xF3])
-    {
-        "an MP3 file"
-    } else if head.starts_with(b"fLaC") {
-        "a FLAC file"
-    } else if head.starts_with(b"OggS") {
-        "an Ogg file"
-    } else if head.len() >= 8 && &head[4..8] == b"ftyp" {
-        "an MP4/M4A file"
-    } else if head.starts_with(b"RIFF") {
+    let what = if head.starts_with(b"RIFF") {
         "a RIFF file that is not WAVE"
+    } else if head.starts_with(&[0x1A, 0x45, 0xDF, 0xA3]) {
+        "a Matroska/WebM file"
+    } else if head.starts_with(b"FORM") {
+        "an AIFF/IFF file"
+    } else if head.starts_with(b"#!AMR") {
+        "an AMR file"
+    } else if head.len() >= 4 && &head[..4] == b"caff" {
+        "a Core Audio file"
     } else if head.len() < 12 {
         "too short to be a recording (truncated?)"
     } else {
         "not a recording fbakit knows"
     };
     format!("it is {what}")
+}
+
+fn check_rate(path: &Path, rate: u32) -> Result<()> {
+    if !(MIN_SAMPLE_RATE..=MAX_SAMPLE_RATE).contains(&rate) {
+        return Err(SpeechError::BadSampleRate {
+            path: path.to_path_buf(),
+            rate,
+            min: MIN_SAMPLE_RATE,
+            max: MAX_SAMPLE_RATE,
+        }
+        .into());
+    }
+    Ok(())
+}
+
+fn check_length(path: &Path, seconds: f64) -> Result<()> {
+    if seconds > MAX_AUDIO_SECONDS {
+        return Err(SpeechError::RecordingTooLong {
+            path: path.to_path_buf(),
+            seconds,
+            limit: MAX_AUDIO_SECONDS,
+        }
+        .into());
+    }
+    Ok(())
 }
 
 impl AudioReader {
@@ -136,25 +187,10 @@ impl AudioReader {
                 format!("{} channels (1 to {MAX_CHANNELS} accepted)", spec.channels),
             ));
         }
-        if !(MIN_SAMPLE_RATE..=MAX_SAMPLE_RATE).contains(&spec.sample_rate) {
-            return Err(SpeechError::BadSampleRate {
-                path: path.to_path_buf(),
-                rate: spec.sample_rate,
-                min: MIN_SAMPLE_RATE,
-                max: MAX_SAMPLE_RATE,
-            }
-            .into());
-        }
+        check_rate(path, spec.sample_rate)?;
         let frames = u64::from(wav.duration());
         let seconds = frames as f64 / f64::from(spec.sample_rate);
-        if seconds > MAX_AUDIO_SECONDS {
-            return Err(SpeechError::RecordingTooLong {
-                path: path.to_path_buf(),
-                seconds,
-                limit: MAX_AUDIO_SECONDS,
-            }
-            .into());
-        }
+        check_length(path, seconds)?;
         let kind = match spec.sample_format {
             hound::SampleFormat::Int => "integer",
             hound::SampleFormat::Float => "float",
@@ -176,9 +212,45 @@ impl AudioReader {
                 channels: spec.channels,
                 seconds,
             },
-            wav,
-            spec,
+            source: Source::Wav {
+                wav: Box::new(wav),
+                spec,
+            },
             resampler: Resampler::new(spec.sample_rate, ANALYSIS_RATE),
+            frames_read: 0,
+            done: false,
+        })
+    }
+
+    /// A compressed recording (MP3, FLAC, Ogg Vorbis, M4A) from `source`, whose first bytes
+    /// said `container`; `path` names it in errors.
+    pub fn from_compressed(
+        source: Box<dyn symphonia::core::io::MediaSource>,
+        container: Container,
+        path: &Path,
+    ) -> Result<AudioReader> {
+        let c = CompressedSource::open(source, container, path)?;
+        if c.channels > MAX_CHANNELS {
+            return Err(bad(
+                path,
+                format!("{} channels (1 to {MAX_CHANNELS} accepted)", c.channels),
+            ));
+        }
+        check_rate(path, c.sample_rate)?;
+        let seconds = c
+            .declared_frames()
+            .map_or(0.0, |f| f as f64 / f64::from(c.sample_rate));
+        check_length(path, seconds)?;
+        Ok(AudioReader {
+            info: AudioInfo {
+                path: path.to_path_buf(),
+                format: c.format.clone(),
+                sample_rate: c.sample_rate,
+                channels: c.channels,
+                seconds,
+            },
+            resampler: Resampler::new(c.sample_rate, ANALYSIS_RATE),
+            source: Source::Compressed(Box::new(c)),
             frames_read: 0,
             done: false,
         })
@@ -194,57 +266,29 @@ impl AudioReader {
         if self.done {
             return Ok(None);
         }
-        let channels = usize::from(self.spec.channels);
-        let want = CHUNK_FRAMES * channels;
-        let mut interleaved: Vec<f32> = Vec::with_capacity(want);
         let path = self.info.path.clone();
-        match self.spec.sample_format {
-            hound::SampleFormat::Float => {
-                for s in self.wav.samples::<f32>().take(want) {
-                    let s = s.map_err(|e| bad(&path, wav_detail(&e)))?;
-                    interleaved.push(if s.is_finite() {
-                        s.clamp(-1.0, 1.0)
-                    } else {
-                        0.0
-                    });
-                }
+        let (mono, more) = match &mut self.source {
+            Source::Wav { wav, spec } => {
+                let mono = wav_chunk(wav, spec, &path)?;
+                let more = mono.len() >= CHUNK_FRAMES;
+                (mono, more)
             }
-            hound::SampleFormat::Int => {
-                let scale = 1.0 / (1u64 << (self.spec.bits_per_sample.clamp(1, 32) - 1)) as f32;
-                for s in self.wav.samples::<i32>().take(want) {
-                    let s = s.map_err(|e| bad(&path, wav_detail(&e)))?;
-                    interleaved.push(s as f32 * scale);
-                }
+            Source::Compressed(c) => {
+                let mut mono = Vec::with_capacity(CHUNK_FRAMES + 4_096);
+                let more = c.read_mono(CHUNK_FRAMES, &mut mono)?;
+                (mono, more)
             }
-        }
-        if interleaved.len() % channels != 0 {
-            return Err(bad(
-                &path,
-                "the file ends inside a sample frame (truncated?)",
-            ));
-        }
-        let mono: Vec<f32> = interleaved
-            .chunks_exact(channels)
-            .map(|f| f.iter().sum::<f32>() / channels as f32)
-            .collect();
+        };
         self.frames_read += mono.len() as u64;
-        if (self.frames_read as f64) / f64::from(self.spec.sample_rate) > MAX_AUDIO_SECONDS {
-            return Err(SpeechError::RecordingTooLong {
-                path,
-                seconds: self.frames_read as f64 / f64::from(self.spec.sample_rate),
-                limit: MAX_AUDIO_SECONDS,
-            }
-            .into());
-        }
+        let rate = f64::from(self.info.sample_rate);
+        check_length(&path, self.frames_read as f64 / rate)?;
         let mut out = Vec::with_capacity(
-            mono.len() * ANALYSIS_RATE as usize / self.spec.sample_rate as usize + 2,
+            mono.len() * ANALYSIS_RATE as usize / self.info.sample_rate as usize + 2,
         );
-        if mono.len() < CHUNK_FRAMES {
+        self.resampler.push(&mono, &mut out);
+        if !more {
             self.done = true;
-            self.resampler.push(&mono, &mut out);
             self.resampler.finish(&mut out);
-        } else {
-            self.resampler.push(&mono, &mut out);
         }
         Ok(Some(out))
     }
@@ -253,6 +297,46 @@ impl AudioReader {
     pub fn frames_read(&self) -> u64 {
         self.frames_read
     }
+}
+
+/// Up to [`CHUNK_FRAMES`] frames of a WAV file, mixed down.
+fn wav_chunk(
+    wav: &mut hound::WavReader<Box<dyn Read + Send>>,
+    spec: &hound::WavSpec,
+    path: &Path,
+) -> Result<Vec<f32>> {
+    let channels = usize::from(spec.channels);
+    let want = CHUNK_FRAMES * channels;
+    let mut interleaved: Vec<f32> = Vec::with_capacity(want);
+    match spec.sample_format {
+        hound::SampleFormat::Float => {
+            for s in wav.samples::<f32>().take(want) {
+                let s = s.map_err(|e| bad(path, wav_detail(&e)))?;
+                interleaved.push(if s.is_finite() {
+                    s.clamp(-1.0, 1.0)
+                } else {
+                    0.0
+                });
+            }
+        }
+        hound::SampleFormat::Int => {
+            let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f32;
+            for s in wav.samples::<i32>().take(want) {
+                let s = s.map_err(|e| bad(path, wav_detail(&e)))?;
+                interleaved.push(s as f32 * scale);
+            }
+        }
+    }
+    if interleaved.len() % channels != 0 {
+        return Err(bad(
+            path,
+            "the file ends inside a sample frame (truncated?)",
+        ));
+    }
+    Ok(interleaved
+        .chunks_exact(channels)
+        .map(|f| f.iter().sum::<f32>() / channels as f32)
+        .collect())
 }
 
 fn wav_detail(e: &hound::Error) -> String {
@@ -484,6 +568,6 @@ mod tests {
         assert!(e.to_string().contains("truncated"), "{e}");
         let e = read_all(b"RIFF\0\0\0\0WAVEjunk".to_vec()).unwrap_err();
         assert!(e.is_input_error(), "{e}");
-        assert!(sniff(b"fLaC\0\0\0\0\0\0\0\0").contains("FLAC"));
+        assert!(sniff(b"RIFF\0\0\0\0AVI LIST").contains("not WAVE"));
     }
 }

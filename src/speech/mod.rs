@@ -28,6 +28,7 @@
 pub mod animation;
 pub mod articulation;
 pub mod audio;
+pub mod decode;
 mod error;
 pub mod espeak;
 pub mod lipsync;

@@ -133,7 +133,51 @@ pub fn lipsync_keys(
         }
     }
     keys.sort_by(|x, y| x.time.total_cmp(&y.time));
+    quick_closure_edges(&mut keys, &closures, frame);
     (merge_close_keys(keys, frame), unmapped)
+}
+
+/// Lips close and open within a frame: the shapes before and after a closure are held until
+/// a frame from it (a key of the neighbour's viseme there), instead of blending over the
+/// whole gap to the neighbour's key, where half the gap would show the closure on the
+/// vowel next to it.
+fn quick_closure_edges(keys: &mut Vec<VisemeKey>, closures: &[(f64, f64)], frame: f64) {
+    let mut added = Vec::new();
+    for &(a, b) in closures {
+        let before = keys
+            .iter()
+            .rev()
+            .find(|k| k.time < a - 0.5 * frame)
+            .filter(|k| k.viseme.number() != 1);
+        if let Some(k) = before {
+            if a - k.time > 1.5 * frame {
+                added.push(VisemeKey {
+                    time: a - frame,
+                    viseme: k.viseme,
+                });
+            }
+        }
+        let after = keys
+            .iter()
+            .find(|k| k.time > b + 0.5 * frame)
+            .filter(|k| k.viseme.number() != 1);
+        if let Some(k) = after {
+            if k.time - b > 1.5 * frame {
+                added.push(VisemeKey {
+                    time: b + frame,
+                    viseme: k.viseme,
+                });
+            }
+        }
+    }
+    // Only where no closure key is within a frame (closures close together keep PP between).
+    added.retain(|n| {
+        !keys
+            .iter()
+            .any(|k| k.viseme.number() == 1 && (k.time - n.time).abs() < 0.999 * frame)
+    });
+    keys.extend(added);
+    keys.sort_by(|x, y| x.time.total_cmp(&y.time));
 }
 
 /// Share of a phone at each end given to the transitions: the shape is held between.
@@ -287,6 +331,20 @@ mod tests {
         let mid = dominant_at(&keys, 15, 25.0); // 0.6 s, inside the silence
         assert_eq!(mid, 0);
         assert!((0..33).any(|n| dominant_at(&keys, n, 25.0) == 1));
+    }
+
+    #[test]
+    fn a_closure_does_not_spill_onto_the_long_vowels_around_it() {
+        // "aaa m aaa" with long vowels: PP only within a frame of the m.
+        let ph = vec![p("A:", 0.0, 0.4), p("m", 0.4, 0.48), p("A:", 0.48, 0.9)];
+        let (keys, _) = lipsync_keys(&ph, 0.9, &[], 25.0);
+        let shown: Vec<u8> = (0..23).map(|n| dominant_at(&keys, n, 25.0)).collect();
+        let pp: Vec<f64> = (0..23)
+            .filter(|&n| shown[n] == 1)
+            .map(|n| n as f64 / 25.0)
+            .collect();
+        assert!(!pp.is_empty(), "{shown:?}");
+        assert!(pp.iter().all(|t| (0.36..=0.52).contains(t)), "{shown:?}");
     }
 
     #[test]

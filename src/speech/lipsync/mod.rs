@@ -10,7 +10,9 @@
 //! measured: it showed fewer closures on the evaluation set, so it is not done.)
 //!
 //! The recording is read a chunk at a time ([`analyse_chunks`]): only its features (about
-//! 60 bytes per 10 ms) are kept, and the warp's memory grows linearly with the length.
+//! 60 bytes per 10 ms) are kept, and the warp's memory grows linearly with the length. The
+//! transcript's rendition is spoken a few sentences at a time and kept as features too
+//! ([`rendition`]), so an hour-long recording stays in bounded memory.
 //!
 //! ```no_run
 //! use fbakit::speech::lipsync::{analyse_file, lipsync_transcript, LipsyncOptions};
@@ -26,6 +28,7 @@ pub mod coarticulation;
 pub mod evaluation;
 pub mod features;
 pub mod recognition;
+pub mod rendition;
 
 use std::path::{Path, PathBuf};
 
@@ -35,9 +38,10 @@ use self::activity::{activity, Activity};
 use self::alignment::{unrelated_distance, warp, DEFAULT_RADIUS};
 use self::coarticulation::lipsync_keys;
 use self::features::{frame_at, frame_time, normalise, FeatureExtractor, FeatureFrame};
+pub use self::rendition::{render_features, render_transcript, Rendition};
 use super::animation::{frame_count, key_frame, MouthFaps, SpeechOptions, VisemeKey};
-use super::audio::{open_audio, AudioInfo, Resampler, ANALYSIS_RATE};
-use super::espeak::{espeak_available, speak_at, TimedPhoneme, Utterance, DEFAULT_RATE};
+use super::audio::{open_audio, AudioInfo, ANALYSIS_RATE};
+use super::espeak::TimedPhoneme;
 use super::SpeechError;
 use crate::error::Result;
 use crate::fap::{FapFrame, FapStream};
@@ -176,123 +180,9 @@ fn confidence_of(ratio: f64) -> f64 {
     ((RATIO_NONE - ratio) / (RATIO_NONE - RATIO_FULL)).clamp(0.0, 1.0)
 }
 
-/// espeak-ng's rendition of `text`, spoken in pieces of at most a few sentences when the
-/// text is long (espeak-ng renders at most 10 minutes at once).
-pub fn render_transcript(text: &str, voice: &str) -> Result<Utterance> {
-    if !espeak_available() {
-        return Err(SpeechError::EngineMissing {
-            engine: "espeak-ng".into(),
-            why: "lip sync with a transcript speaks it with libespeak-ng".into(),
-            package: "espeak-ng".into(),
-        }
-        .into());
-    }
-    const PIECE: usize = 4_000;
-    let mut pieces: Vec<&str> = Vec::new();
-    let mut rest = text.trim();
-    while rest.len() > PIECE {
-        // Cut after the last sentence end (or space) before the limit.
-        let window = &rest[..floor_char_boundary(rest, PIECE)];
-        let cut = window
-            .rfind(['.', '!', '?', ';', '\n'])
-            .or_else(|| window.rfind(' '))
-            .map_or(window.len(), |i| i + 1);
-        pieces.push(&rest[..cut]);
-        rest = rest[cut..].trim_start();
-    }
-    if !rest.trim().is_empty() || pieces.is_empty() {
-        pieces.push(rest);
-    }
-    let mut whole: Option<Utterance> = None;
-    for piece in pieces {
-        let u = speak_at(piece, voice, DEFAULT_RATE)?;
-        match &mut whole {
-            None => whole = Some(u),
-            Some(w) => {
-                let offset = w.duration();
-                w.samples.extend_from_slice(&u.samples);
-                w.phonemes
-                    .extend(u.phonemes.into_iter().map(|p| TimedPhoneme {
-                        start: p.start + offset,
-                        end: p.end + offset,
-                        ..p
-                    }));
-            }
-        }
-    }
-    whole.ok_or_else(|| SpeechError::EmptyText.into())
-}
-
-fn floor_char_boundary(s: &str, mut i: usize) -> usize {
-    while i > 0 && !s.is_char_boundary(i) {
-        i -= 1;
-    }
-    i
-}
-
-/// Features of espeak-ng's audio (resampled to the analysis rate).
-///
-/// espeak-ng's pauses are digital silence, which no recording has: a faint noise (about
-/// −60 dBFS) makes them look like a quiet room, so the recording's pauses match them
-/// rather than its quietest phones (nasals).
-fn rendition_features(u: &Utterance) -> Vec<FeatureFrame> {
-    let mut rs = Resampler::new(u.sample_rate, ANALYSIS_RATE);
-    let mut fx = FeatureExtractor::new();
-    let mut out = Vec::new();
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut dither = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        ((state >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 0.003
-    };
-    for chunk in u.samples.chunks(16_384) {
-        out.clear();
-        let f: Vec<f32> = chunk
-            .iter()
-            .map(|&s| f32::from(s) / 32_768.0 + dither())
-            .collect();
-        rs.push(&f, &mut out);
-        fx.push(&out);
-    }
-    out.clear();
-    rs.finish(&mut out);
-    fx.push(&out);
-    fx.finish()
-}
-
 /// Pause added before and after the rendition, seconds: room for the recording's own
 /// lead-in and tail to match silence rather than stretch the first and last phones.
 const RENDITION_PAD: f64 = 0.3;
-
-/// `u` with `pad` seconds of silence before and after, covered by pause phones.
-fn padded(mut u: Utterance, pad: f64) -> Utterance {
-    let n = (pad * f64::from(u.sample_rate)) as usize;
-    let pad = n as f64 / f64::from(u.sample_rate.max(1));
-    let mut samples = vec![0i16; n];
-    samples.extend_from_slice(&u.samples);
-    samples.extend(std::iter::repeat_n(0i16, n));
-    let first = u.phonemes.first().map_or(0.0, |p| p.start);
-    let mut phonemes = vec![TimedPhoneme {
-        symbol: "_".into(),
-        start: 0.0,
-        end: first + pad,
-    }];
-    phonemes.extend(u.phonemes.drain(..).map(|p| TimedPhoneme {
-        start: p.start + pad,
-        end: p.end + pad,
-        ..p
-    }));
-    let total = samples.len() as f64 / f64::from(u.sample_rate.max(1));
-    if let Some(last) = phonemes.last_mut() {
-        last.end = total;
-    }
-    Utterance {
-        sample_rate: u.sample_rate,
-        samples,
-        phonemes,
-    }
-}
 
 /// Aligns `text` with the analysed recording and makes its viseme keys at `fps`.
 pub fn lipsync_transcript(
@@ -318,8 +208,8 @@ pub fn lipsync_transcript_at(
         }
         .into());
     }
-    let rendition = padded(render_transcript(text, &opts.lang)?, RENDITION_PAD);
-    let synth = rendition_features(&rendition);
+    let mut rendition = render_features(text, &opts.lang, RENDITION_PAD)?;
+    let synth = std::mem::take(&mut rendition.frames);
     let cannot = |detail: String| -> crate::error::Error {
         SpeechError::CannotAlign {
             path: rec.source.clone(),
@@ -335,6 +225,7 @@ pub fn lipsync_transcript_at(
         )));
     }
     let a = normalise(&synth);
+    drop(synth);
     let b = normalise(&rec.frames);
     let unrelated = unrelated_distance(&a, &b);
     let penalty = (opts.step_penalty * unrelated) as f32;

@@ -58,40 +58,107 @@ pub fn check_recogniser() -> Result<()> {
         .map_err(|e| missing(&format!("cannot run {PROGRAM}: {e}")))
 }
 
+/// Longest stretch of audio given to the recogniser at once, seconds: its memory grows with
+/// the length of what it reads (about 250 MB for 40 minutes), so a long recording is
+/// recognised in pieces.
+pub const SEGMENT_SECONDS: f64 = 300.0;
+/// A piece ends at the quietest 10 ms within this many seconds before its limit, so that a
+/// cut falls in a pause rather than inside a phone.
+const CUT_SEARCH_SECONDS: f64 = 20.0;
+
 /// The ARPAbet phones of the recording at `path` with their times; the share of the file
 /// read goes to `progress`.
 pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<AlignedPhone>> {
     let (hmm, lm) = model()?;
-    // The recogniser reads 16 kHz mono 16-bit; write the recording so, a chunk at a time.
+    // The recogniser reads 16 kHz mono 16-bit: pieces of the recording are written so, one
+    // at a time, and recognised in turn.
     let scratch = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
-    let wav = scratch.path().join("recording.wav");
-    {
-        let mut reader = open_audio(path)?;
-        let total = (reader.info().seconds * f64::from(reader.info().sample_rate)).max(1.0);
-        let spec = hound::WavSpec {
-            channels: 1,
-            sample_rate: ANALYSIS_RATE,
-            bits_per_sample: 16,
-            sample_format: hound::SampleFormat::Int,
-        };
-        let encode = |e: hound::Error| -> Error { crate::error::EncodeError::new("WAV", e).into() };
-        let mut w = hound::WavWriter::create(&wav, spec).map_err(encode)?;
-        while let Some(chunk) = reader.next_chunk()? {
-            for s in chunk {
-                w.write_sample((s.clamp(-1.0, 1.0) * 32_767.0).round() as i16)
-                    .map_err(encode)?;
-            }
-            progress((reader.frames_read() as f64 / total).min(1.0));
+    let wav = scratch.path().join("piece.wav");
+    let rate = ANALYSIS_RATE as usize;
+    let limit = (SEGMENT_SECONDS * rate as f64) as usize;
+    let mut reader = open_audio(path)?;
+    let total = (reader.info().seconds * f64::from(reader.info().sample_rate)).max(1.0);
+    let mut pending: Vec<i16> = Vec::new();
+    let mut offset = 0usize;
+    let mut phones: Vec<AlignedPhone> = Vec::new();
+    let recognise = |samples: &[i16], offset: usize, phones: &mut Vec<AlignedPhone>| {
+        write_piece(&wav, samples)?;
+        let start = offset as f64 / rate as f64;
+        for mut p in run_recogniser(&wav, &hmm, &lm)? {
+            p.start += start;
+            p.end += start;
+            let floor = phones.last().map_or(0.0, |q: &AlignedPhone| q.end);
+            p.start = p.start.max(floor);
+            p.end = p.end.max(p.start);
+            phones.push(p);
         }
-        w.finalize().map_err(encode)?;
+        Ok::<(), Error>(())
+    };
+    while let Some(chunk) = reader.next_chunk()? {
+        pending.extend(
+            chunk
+                .iter()
+                .map(|s| (s.clamp(-1.0, 1.0) * 32_767.0).round() as i16),
+        );
+        progress((reader.frames_read() as f64 / total).min(1.0));
+        if pending.len() >= limit {
+            let cut = quietest_cut(&pending, limit, (CUT_SEARCH_SECONDS * rate as f64) as usize);
+            recognise(&pending[..cut], offset, &mut phones)?;
+            pending.drain(..cut);
+            offset += cut;
+        }
     }
+    if !pending.is_empty() || phones.is_empty() {
+        recognise(&pending, offset, &mut phones)?;
+    }
+    Ok(phones)
+}
+
+/// Where to end a piece of `samples` at most `limit` long: the start of the quietest 10 ms
+/// in the `search` samples before `limit`.
+fn quietest_cut(samples: &[i16], limit: usize, search: usize) -> usize {
+    const FRAME: usize = 160;
+    let end = limit.min(samples.len());
+    let from = end.saturating_sub(search);
+    let mut best = (u64::MAX, end);
+    let mut k = from;
+    while k + FRAME <= end {
+        let e: u64 = samples[k..k + FRAME]
+            .iter()
+            .map(|&s| (i64::from(s) * i64::from(s)) as u64)
+            .sum();
+        if e < best.0 {
+            best = (e, k);
+        }
+        k += FRAME;
+    }
+    best.1.max(1)
+}
+
+fn write_piece(path: &Path, samples: &[i16]) -> Result<()> {
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: ANALYSIS_RATE,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let encode = |e: hound::Error| -> Error { crate::error::EncodeError::new("WAV", e).into() };
+    let mut w = hound::WavWriter::create(path, spec).map_err(encode)?;
+    for &s in samples {
+        w.write_sample(s).map_err(encode)?;
+    }
+    w.finalize().map_err(encode)
+}
+
+/// Runs the recogniser on the 16 kHz WAV file `wav`.
+fn run_recogniser(wav: &Path, hmm: &Path, lm: &Path) -> Result<Vec<AlignedPhone>> {
     let out = Command::new(PROGRAM)
         .arg("-infile")
-        .arg(&wav)
+        .arg(wav)
         .arg("-hmm")
-        .arg(&hmm)
+        .arg(hmm)
         .arg("-allphone")
-        .arg(&lm)
+        .arg(lm)
         .args(["-allphone_ci", "yes", "-backtrace", "yes", "-time", "yes"])
         .args([
             "-beam",
@@ -212,6 +279,18 @@ mod tests {
         assert_eq!(s, ["SIL", "AA", "B"]);
         assert!((p[0].end - 0.17).abs() < 1e-9 && (p[1].start - 0.17).abs() < 1e-9);
         assert!((p[1].confidence - 0.9).abs() < 1e-9);
+    }
+
+    #[test]
+    fn pieces_end_in_the_quietest_stretch_before_the_limit() {
+        let mut x = vec![1000i16; 10_000];
+        for s in &mut x[6_920..7_400] {
+            *s = 0;
+        }
+        // Frames of 160 from 5 000: the first silent one starts at 6 920.
+        assert_eq!(quietest_cut(&x, 9_000, 4_000), 6_920);
+        // Nothing to search: the limit itself.
+        assert_eq!(quietest_cut(&x, 9_000, 0), 9_000);
     }
 
     #[test]
