@@ -578,4 +578,18 @@ fn cli_face_diff_across_formats() {
     let out = fbakit(&["face", "diff", a, b, "--tolerance", "0.004"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(text(&out.stdout).starts_with("EQUAL:"));
+
+    // A blendshape rig with its feature points (its FAT built from its shapes) against the
+    // same face as fbakit bundles it, and against that face written as glb and read back.
+    let rig = "samples/faces/ict-head/ict-head.glb";
+    let fp = "samples/faces/ict-head/ict-head-fp.csv";
+    let out = fbakit(&["face", "diff", rig, "--fp-a", fp, "ict", "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["equal"], true);
+    assert!(json["tables"].as_array().unwrap().len() > 20);
+    let ict = fbakit::face::read("ict").unwrap();
+    let (_, written) = through(&ict, "glb", dir.path(), "ict");
+    let out = fbakit(&["face", "diff", rig, "--fp-a", fp, written.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
 }
