@@ -129,6 +129,16 @@ fn vrm_bone(json: &Value, bone: &str) -> Option<usize> {
 
 /// World rotation of every node at rest (parents from `children`).
 fn world_rotations(json: &Value) -> (Vec<Quat>, Vec<Option<usize>>) {
+    let (world, parent) = compose_at_rest(json, local_rotation);
+    (world.into_iter().map(Quat::normalize).collect(), parent)
+}
+
+/// Every node's local value (`local`) composed with its ancestors' (parent first), and each
+/// node's parent. A cycle in a broken `children` graph stops after 256 steps.
+fn compose_at_rest<T: Copy + std::ops::Mul<Output = T>>(
+    json: &Value,
+    local: fn(&Value) -> T,
+) -> (Vec<T>, Vec<Option<usize>>) {
     let nodes = json["nodes"].as_array().cloned().unwrap_or_default();
     let mut parent = vec![None; nodes.len()];
     for (i, n) in nodes.iter().enumerate() {
@@ -138,10 +148,10 @@ fn world_rotations(json: &Value) -> (Vec<Quat>, Vec<Option<usize>>) {
             }
         }
     }
-    let local: Vec<Quat> = nodes.iter().map(local_rotation).collect();
+    let local: Vec<T> = nodes.iter().map(local).collect();
     let world = (0..nodes.len())
         .map(|i| {
-            let mut q = local[i];
+            let mut m = local[i];
             let mut at = parent[i];
             let mut depth = 0;
             while let Some(p) = at {
@@ -149,10 +159,10 @@ fn world_rotations(json: &Value) -> (Vec<Quat>, Vec<Option<usize>>) {
                 if depth > 256 {
                     break;
                 }
-                q = local[p] * q;
+                m = local[p] * m;
                 at = parent[p];
             }
-            q.normalize()
+            m
         })
         .collect();
     (world, parent)
@@ -305,33 +315,7 @@ impl JawNode {
 
 /// World matrix of every node at rest (parents from `children`).
 fn world_matrices(json: &Value) -> (Vec<Mat4>, Vec<Option<usize>>) {
-    let nodes = json["nodes"].as_array().cloned().unwrap_or_default();
-    let mut parent = vec![None; nodes.len()];
-    for (i, n) in nodes.iter().enumerate() {
-        for c in n["children"].as_array().into_iter().flatten() {
-            if let Some(c) = c.as_u64().filter(|&c| (c as usize) < nodes.len()) {
-                parent[c as usize] = Some(i);
-            }
-        }
-    }
-    let local: Vec<Mat4> = nodes.iter().map(local_matrix).collect();
-    let world = (0..nodes.len())
-        .map(|i| {
-            let mut m = local[i];
-            let mut at = parent[i];
-            let mut depth = 0;
-            while let Some(p) = at {
-                depth += 1;
-                if depth > 256 {
-                    break;
-                }
-                m = local[p] * m;
-                at = parent[p];
-            }
-            m
-        })
-        .collect();
-    (world, parent)
+    compose_at_rest(json, local_matrix)
 }
 
 fn vec3_of(v: &Value, default: Vec3) -> Vec3 {
