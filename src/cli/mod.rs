@@ -237,12 +237,14 @@ pub enum Command {
     Grid(show::GridArgs),
     /// Run the end-to-end demo on the bundled samples (clone, play, render, measure).
     #[command(
-        long_about = "Run the end-to-end demo on the bundled samples: clone alma's FAT onto \
-                      bruno (stripped to meshes and feature points), play samples/speech.fap \
-                      on both, and write bruno-cloned.wrl, alma-speech.glb, bruno-speech.glb, \
-                      contact-sheet.png and cloning-grid.png into --out (default \
-                      ./fbakit-demo), then print quality figures (self-clone error, FAP \
-                      compliance, error against bruno's true FAT) and timings. Run it from \
+        long_about = "Run the end-to-end demo on the bundled samples. It clones three ways: \
+                      the real ICT head's FAT (built from its ARKit shapes) onto a second real \
+                      head, alma's FAT onto bruno (stripped to meshes and feature points) and \
+                      alma's onto the ICT head; plays samples/speech.fap on every face; writes \
+                      bruno-cloned.wrl, one animated .glb per face, contact-sheet.png and \
+                      cloning-grid.png into --out (default ./fbakit-demo); then prints one table \
+                      of quality figures (FAP compliance, error against the target's true FAT \
+                      where it is known, self-clone error) and grouped warnings. Run it from \
                       the fbakit checkout (it finds samples/ there, or beside the sources).",
         after_help = "Examples:\n  fbakit demo\n  fbakit demo --out /tmp/demo --method rbf --json"
     )]

@@ -104,7 +104,7 @@ pub struct DemoArgs {
     /// Cloning method for the outputs (the other methods are measured too unless --single).
     #[arg(long, value_enum, default_value_t)]
     pub method: MethodArg,
-    /// Only run the chosen method (skip the comparison with the other one).
+    /// Only run the chosen method (skip the comparison with the other methods).
     #[arg(long)]
     pub single: bool,
     /// Print the report as JSON.
