@@ -70,7 +70,8 @@ impl std::fmt::Debug for AudioReader {
     }
 }
 
-fn bad(path: &Path, detail: impl Into<String>) -> Error {
+/// A recording that cannot be read (one error for WAV and compressed files alike).
+pub(super) fn bad(path: &Path, detail: impl Into<String>) -> Error {
     SpeechError::BadRecording {
         path: path.to_path_buf(),
         detail: detail.into(),

@@ -18,8 +18,8 @@ use symphonia::core::formats::{FormatOptions, FormatReader, TrackType};
 use symphonia::core::io::{MediaSource, MediaSourceStream};
 use symphonia::core::meta::MetadataOptions;
 
-use super::SpeechError;
-use crate::error::{Error, Result};
+use super::audio::bad;
+use crate::error::Result;
 
 /// What a recording's first bytes say it is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -138,14 +138,6 @@ impl std::fmt::Debug for CompressedSource {
             .field("format", &self.format)
             .finish()
     }
-}
-
-fn bad(path: &Path, detail: impl Into<String>) -> Error {
-    SpeechError::BadRecording {
-        path: path.to_path_buf(),
-        detail: detail.into(),
-    }
-    .into()
 }
 
 /// A message for a demuxer or decoder error.
