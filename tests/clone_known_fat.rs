@@ -8,42 +8,20 @@
 #[path = "support/ict_truth.rs"]
 mod ict_truth;
 
-use std::path::Path;
 use std::sync::OnceLock;
 
 use fbakit::clone::eval::{clone_against_truth, GroundTruthReport};
 use fbakit::clone::face::{CloneOptions, Method};
-use fbakit::face::candide::candide_face;
 use fbakit::face::subdivide::subdivide_face;
 use fbakit::face::FaceModel;
 use fbakit::mesh::subdivide::Scheme;
 use glam::Vec3;
 
+#[path = "support/candide.rs"]
+mod candide_data;
+use candide_data::{candide, SHAPE};
+
 const METHODS: [Method; 3] = [Method::Fmc, Method::Rbf, Method::Fit];
-
-/// The shape change: CANDIDE-3's own shape units, mildly.
-const SHAPE: [(&str, f32); 5] = [
-    ("Mouth width", 0.4),
-    ("Nose z-extension", 0.5),
-    ("Head height", 0.3),
-    ("Eyes, width", 0.3),
-    ("Chin width", 0.4),
-];
-
-/// CANDIDE-3 with its FAT, shaped by `shape` units; `None` without the shared data.
-fn candide(shape: &[(&str, f32)]) -> Option<FaceModel> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/candide3");
-    if !dir.join("candide3.wfm").is_file() {
-        eprintln!("note: {} not found; skipping", dir.display());
-        return None;
-    }
-    let model = fbakit::candide::read_wfm_file(&dir.join("candide3.wfm")).unwrap();
-    let fp = fbakit::fdp::csv::read_csv_file(&dir.join("feature-points.csv"))
-        .unwrap()
-        .to_set();
-    let shape: Vec<(String, f32)> = shape.iter().map(|(n, v)| (n.to_string(), *v)).collect();
-    Some(candide_face(&model, &fp, &shape).unwrap())
-}
 
 /// One case: its name and every method's report.
 struct Case {

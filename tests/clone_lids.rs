@@ -9,12 +9,10 @@
 mod ict_truth;
 
 use std::collections::HashSet;
-use std::path::Path;
 use std::sync::OnceLock;
 
 use fbakit::clone::eval::{clone_against_truth, GroundTruthReport};
 use fbakit::clone::face::{CloneOptions, CloneOutcome, Method, Part};
-use fbakit::face::candide::candide_face;
 use fbakit::face::subdivide::subdivide_face;
 use fbakit::face::FaceModel;
 use fbakit::fat::eval::Activation;
@@ -23,35 +21,16 @@ use fbakit::mesh::subdivide::Scheme;
 use fbakit::spec::{FapId, FeaturePointId};
 use glam::Vec3;
 
+#[path = "support/candide.rs"]
+mod candide_data;
+use candide_data::{candide, SHAPE};
+
 const EYELIDS: [&str; 4] = [
     "close_t_l_eyelid",
     "close_t_r_eyelid",
     "close_b_l_eyelid",
     "close_b_r_eyelid",
 ];
-
-/// CANDIDE-3's shape units, mildly (as `clone_known_fat`).
-const SHAPE: [(&str, f32); 5] = [
-    ("Mouth width", 0.4),
-    ("Nose z-extension", 0.5),
-    ("Head height", 0.3),
-    ("Eyes, width", 0.3),
-    ("Chin width", 0.4),
-];
-
-fn candide(shape: &[(&str, f32)]) -> Option<FaceModel> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/candide3");
-    if !dir.join("candide3.wfm").is_file() {
-        eprintln!("note: {} not found; skipping", dir.display());
-        return None;
-    }
-    let model = fbakit::candide::read_wfm_file(&dir.join("candide3.wfm")).unwrap();
-    let fp = fbakit::fdp::csv::read_csv_file(&dir.join("feature-points.csv"))
-        .unwrap()
-        .to_set();
-    let shape: Vec<(String, f32)> = shape.iter().map(|(n, v)| (n.to_string(), *v)).collect();
-    Some(candide_face(&model, &fp, &shape).unwrap())
-}
 
 struct Case {
     name: String,

@@ -6,10 +6,11 @@
 //! the rig head come from `../shared/data`; pairs needing them are skipped with a note when
 //! it is absent.
 
+#[path = "support/candide.rs"]
+mod candide_data;
 #[path = "support/ict_truth.rs"]
 mod ict_truth;
 
-use std::path::Path;
 use std::sync::OnceLock;
 
 use fbakit::clone::eval::{compliance, normal_turns, ComplianceReport, NormalTurnReport};
@@ -22,16 +23,7 @@ fn bundled(name: &str) -> FaceModel {
 }
 
 fn candide() -> Option<FaceModel> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/candide3");
-    if !dir.join("candide3.wfm").is_file() {
-        eprintln!("note: {} not found; skipping", dir.display());
-        return None;
-    }
-    let model = fbakit::candide::read_wfm_file(&dir.join("candide3.wfm")).unwrap();
-    let fp = fbakit::fdp::csv::read_csv_file(&dir.join("feature-points.csv"))
-        .unwrap()
-        .to_set();
-    let mut face = fbakit::face::candide::candide_face(&model, &fp, &[]).unwrap();
+    let mut face = candide_data::candide(&[])?;
     face.name = "candide".into();
     Some(face)
 }
