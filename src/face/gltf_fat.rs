@@ -633,47 +633,15 @@ fn read_structure(rig: &Rig, scene: &Value, scene_at: &str) -> Result<Structure>
             .as_str()
             .filter(|n| !n.is_empty() && !transforms.iter().any(|x| x.name == *n))
             .ok_or_else(|| bad(rig, &format!("{at}.name"), "must be a new transform name"))?;
-        let parent = match &t["parent"] {
-            Value::Null => None,
-            p => Some(
-                p.as_u64()
-                    .map(|p| p as usize)
-                    .filter(|&p| p < i)
-                    .ok_or_else(|| {
-                        bad(
-                            rig,
-                            &format!("{at}.parent"),
-                            "must index an earlier transform or be null",
-                        )
-                    })?,
-            ),
-        };
-        let v3 = |field: &str| {
-            vec3(&t[field]).ok_or_else(|| {
-                bad(
-                    rig,
-                    &format!("{at}.{field}"),
-                    "must be three finite numbers",
-                )
-            })
-        };
-        let q = |field: &str| {
-            quat(&t[field]).ok_or_else(|| {
-                bad(
-                    rig,
-                    &format!("{at}.{field}"),
-                    "must be a unit quaternion [x, y, z, w]",
-                )
-            })
-        };
+        let parent = index_field(rig, t, &at, "parent", i, "an earlier transform")?;
         transforms.push(FaceTransform {
             name: name.to_string(),
             parent,
-            translation: v3("translation")?,
-            rotation: q("rotation")?,
-            scale: v3("scale")?,
-            scale_orientation: q("scaleOrientation")?,
-            center: v3("center")?,
+            translation: vec3_field(rig, t, &at, "translation")?,
+            rotation: quat_field(rig, t, &at, "rotation")?,
+            scale: vec3_field(rig, t, &at, "scale")?,
+            scale_orientation: quat_field(rig, t, &at, "scaleOrientation")?,
+            center: vec3_field(rig, t, &at, "center")?,
         });
     }
     let mut meshes = Vec::new();
@@ -682,21 +650,7 @@ fn read_structure(rig: &Rig, scene: &Value, scene_at: &str) -> Result<Structure>
         let name = m["mesh"]
             .as_str()
             .ok_or_else(|| bad(rig, &format!("{at}.mesh"), "must name a face mesh"))?;
-        let transform = match &m["transform"] {
-            Value::Null => None,
-            t => Some(
-                t.as_u64()
-                    .map(|t| t as usize)
-                    .filter(|&t| t < transforms.len())
-                    .ok_or_else(|| {
-                        bad(
-                            rig,
-                            &format!("{at}.transform"),
-                            "must index `transforms` or be null",
-                        )
-                    })?,
-            ),
-        };
+        let transform = index_field(rig, m, &at, "transform", transforms.len(), "`transforms`")?;
         let polygons = match m.get("polygons") {
             None => None,
             Some(v) => Some(
@@ -756,15 +710,6 @@ fn read_transform_motion(
             ))
         }
     };
-    let v3 = |field: &str| {
-        vec3(&x[field]).ok_or_else(|| {
-            bad(
-                rig,
-                &format!("{at}.{field}"),
-                "must be three finite numbers",
-            )
-        })
-    };
     let angle = x["angle"]
         .as_f64()
         .filter(|a| a.is_finite())
@@ -772,11 +717,59 @@ fn read_transform_motion(
     Ok(FaceDefTransform {
         transform: transform.to_string(),
         field,
-        rotation_axis: v3("axis")?,
+        rotation_axis: vec3_field(rig, x, at, "axis")?,
         rotation_angle: angle as f32,
-        scale: v3("scale")?,
-        translation: v3("translation")?,
+        scale: vec3_field(rig, x, at, "scale")?,
+        translation: vec3_field(rig, x, at, "translation")?,
     })
+}
+
+/// `obj[field]` as three finite numbers, or an error at `{at}.{field}`.
+fn vec3_field(rig: &Rig, obj: &Value, at: &str, field: &str) -> Result<Vec3> {
+    vec3(&obj[field]).ok_or_else(|| {
+        bad(
+            rig,
+            &format!("{at}.{field}"),
+            "must be three finite numbers",
+        )
+    })
+}
+
+/// `obj[field]` as a quaternion, or an error at `{at}.{field}`.
+fn quat_field(rig: &Rig, obj: &Value, at: &str, field: &str) -> Result<Quat> {
+    quat(&obj[field]).ok_or_else(|| {
+        bad(
+            rig,
+            &format!("{at}.{field}"),
+            "must be a unit quaternion [x, y, z, w]",
+        )
+    })
+}
+
+/// `obj[field]`: null, or an index below `below` into `what`.
+fn index_field(
+    rig: &Rig,
+    obj: &Value,
+    at: &str,
+    field: &str,
+    below: usize,
+    what: &str,
+) -> Result<Option<usize>> {
+    match &obj[field] {
+        Value::Null => Ok(None),
+        v => v
+            .as_u64()
+            .map(|i| i as usize)
+            .filter(|&i| i < below)
+            .map(Some)
+            .ok_or_else(|| {
+                bad(
+                    rig,
+                    &format!("{at}.{field}"),
+                    format!("must index {what} or be null"),
+                )
+            }),
+    }
 }
 
 fn quat(v: &Value) -> Option<Quat> {
@@ -961,5 +954,57 @@ mod tests {
         assert_eq!(regroup(&tris, &runs), Some(mesh.polygons.clone()));
         // Counts that do not add up are refused.
         assert_eq!(regroup(&tris, &[[4, 2]]), None);
+    }
+
+    #[test]
+    fn structure_errors_name_their_json_path() {
+        let rig = Rig {
+            name: "r".into(),
+            meshes: Vec::new(),
+            shapes: Vec::new(),
+            warnings: Vec::new(),
+            source: None,
+        };
+        let t = json!({"name": "a", "parent": null, "translation": [0, 0, 0],
+            "rotation": [0, 0, 0, 1], "scale": [1, 1, 1],
+            "scaleOrientation": [0, 0, 0, 1], "center": [0, 0, 0]});
+        let ok = read_structure(&rig, &json!({"transforms": [t]}), "s").expect("one transform");
+        assert_eq!(ok.0.len(), 1);
+        let cases = [
+            (
+                "parent",
+                json!(0),
+                "s.transforms[0].parent",
+                "an earlier transform",
+            ),
+            (
+                "center",
+                json!([0, "x", 0]),
+                "s.transforms[0].center",
+                "three finite",
+            ),
+            (
+                "rotation",
+                json!([0, 0, 1]),
+                "s.transforms[0].rotation",
+                "quaternion",
+            ),
+        ];
+        for (field, value, at, what) in cases {
+            let mut bad_t = t.clone();
+            bad_t[field] = value;
+            let e = read_structure(&rig, &json!({"transforms": [bad_t]}), "s")
+                .expect_err(field)
+                .to_string();
+            assert!(e.contains(at) && e.contains(what), "{e}");
+        }
+        let mesh = json!({"transforms": [t], "meshes": [{"mesh": "m", "transform": 1}]});
+        let e = read_structure(&rig, &mesh, "s")
+            .expect_err("index")
+            .to_string();
+        assert!(
+            e.contains("s.meshes[0].transform") && e.contains("`transforms`"),
+            "{e}"
+        );
     }
 }
