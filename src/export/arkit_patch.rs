@@ -106,7 +106,7 @@ pub fn patch_arkit(face: &FaceModel, source: &GltfSource) -> Result<ArkitPatchEx
         if shapes.is_empty() {
             continue;
         }
-        let existing = target_names(source, m);
+        let existing = source.target_names(m);
         let ours = recorded(source, m);
         let mut names = Vec::with_capacity(shapes.len());
         let mut replaces = Vec::with_capacity(shapes.len());
@@ -209,20 +209,6 @@ pub fn patch_arkit(face: &FaceModel, source: &GltfSource) -> Result<ArkitPatchEx
         morph_targets,
         warnings,
     })
-}
-
-/// Names of mesh `m`'s targets (mesh extras, or its first primitive's, as tools write them).
-fn target_names(source: &GltfSource, m: usize) -> Vec<String> {
-    let mesh = &source.json["meshes"][m];
-    mesh["extras"]["targetNames"]
-        .as_array()
-        .or_else(|| mesh["primitives"][0]["extras"]["targetNames"].as_array())
-        .map(|a| {
-            a.iter()
-                .filter_map(|v| v.as_str().map(str::to_string))
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 /// The ARKit targets fbakit recorded on mesh `m` by an earlier write.

@@ -261,7 +261,7 @@ pub fn patch_face(
             continue;
         }
         morph_targets += t.pieces.len();
-        let existing = existing_names(source, m);
+        let existing = source.target_names(m);
         let recorded = recorded_pieces(source, m, &existing);
         let mut names = piece_names(&t.pieces, &existing);
         let mut replaces = vec![None; t.pieces.len()];
@@ -442,20 +442,6 @@ fn recorded_pieces(source: &GltfSource, m: usize, names: &[String]) -> Vec<(usiz
         }
     }
     out
-}
-
-/// Names of mesh `m`'s own targets.
-fn existing_names(source: &GltfSource, m: usize) -> Vec<String> {
-    let mesh = &source.json["meshes"][m];
-    mesh["extras"]["targetNames"]
-        .as_array()
-        .or_else(|| mesh["primitives"][0]["extras"]["targetNames"].as_array())
-        .map(|a| {
-            a.iter()
-                .filter_map(|v| v.as_str().map(str::to_string))
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 /// Target names: the key's name, `#j` appended when the key has several targets, and
@@ -721,7 +707,7 @@ fn animation(
         let mut key = old.clone();
         key.resize(layout.total, 0.0);
         // fbakit's earlier targets are driven below or stay at zero.
-        for i in recorded_pieces(source, m, &existing_names(source, m))
+        for i in recorded_pieces(source, m, &source.target_names(m))
             .iter()
             .map(|r| r.0)
         {

@@ -338,13 +338,7 @@ fn patch_mesh(
         .and_then(|p| p["targets"].as_array())
         .map_or(0, Vec::len);
     // Names of the user's targets: mesh extras, else primitive 0's (both conventions exist).
-    let mut names: Vec<Value> = mesh["extras"]["targetNames"]
-        .as_array()
-        .or_else(|| {
-            prims
-                .first()
-                .and_then(|p| p["extras"]["targetNames"].as_array())
-        })
+    let mut names: Vec<Value> = super::source::target_names_value(&mesh)
         .cloned()
         .unwrap_or_default();
     if names.len() != old {

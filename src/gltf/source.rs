@@ -43,6 +43,24 @@ impl GltfSource {
     pub fn part(&self, name: &str) -> Option<&SourcePart> {
         self.parts.iter().find(|p| p.face_mesh == name)
     }
+
+    /// Names of mesh `m`'s morph targets as the document gives them (empty when it names
+    /// none); see [`target_names_value`].
+    pub fn target_names(&self, m: usize) -> Vec<String> {
+        target_names_value(&self.json["meshes"][m])
+            .into_iter()
+            .flatten()
+            .filter_map(|v| v.as_str().map(str::to_string))
+            .collect()
+    }
+}
+
+/// The `targetNames` array of a glTF mesh object: in the mesh's extras, else in its first
+/// primitive's (tools write either).
+pub fn target_names_value(mesh: &serde_json::Value) -> Option<&Vec<serde_json::Value>> {
+    mesh["extras"]["targetNames"]
+        .as_array()
+        .or_else(|| mesh["primitives"][0]["extras"]["targetNames"].as_array())
 }
 
 /// Where one face mesh came from in the document.
