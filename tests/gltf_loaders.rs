@@ -14,47 +14,26 @@
 
 mod support;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
 use serde_json::Value;
 use support::avatar;
 use support::loader_outputs::{gltf_outputs, json_of, scene_nodes};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+use support::node_check::run_node_check;
 
 /// three.js's view of each file, or `None` (with a note) when a tool is missing.
 fn load_in_three(files: &[&PathBuf]) -> Option<Vec<Value>> {
-    let required = std::env::var_os("GLTF_LOADERS_REQUIRED").is_some();
-    let skip = |why: String| {
-        assert!(!required, "three.js loader test required but: {why}");
-        eprintln!("note: skipping three.js loader test: {why}");
-        None
-    };
-    let mut cmd = Command::new("node");
-    cmd.arg(root().join("tests/support/gltf-loaders-check.mjs"))
-        .args(files);
-    for (var, local) in [
-        ("THREE_DIR", "target/gltf-loaders"),
-        ("VIEWER_BROWSER_DIR", "target/viewer-browser"),
-    ] {
-        if std::env::var_os(var).is_none() && root().join(local).is_dir() {
-            cmd.env(var, root().join(local));
-        }
-    }
-    let out = match cmd.output() {
-        Ok(o) => o,
-        Err(e) => return skip(format!("cannot run node ({e})")),
-    };
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if out.status.code() == Some(3) {
-        return skip(stderr.trim().to_string());
-    }
-    assert!(out.status.success(), "loader check failed: {stderr}");
-    let reports: Vec<Value> = String::from_utf8(out.stdout)
-        .unwrap()
+    let text = run_node_check(
+        "gltf-loaders-check.mjs",
+        files,
+        &[
+            ("THREE_DIR", "target/gltf-loaders"),
+            ("VIEWER_BROWSER_DIR", "target/viewer-browser"),
+        ],
+        "GLTF_LOADERS_REQUIRED",
+        "three.js loader",
+    )?;
+    let reports: Vec<Value> = text
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();

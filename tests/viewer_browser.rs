@@ -8,6 +8,8 @@
 //! (`$CHROMIUM_PATH` or `/usr/bin/chromium`). Without them the tests print a note and return,
 //! unless `$VIEWER_BROWSER_REQUIRED` is set (as `.ci/run` does once it installed both).
 
+mod support;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -15,6 +17,7 @@ use fbakit::export::viewer::{ViewerAnimation, ViewerPage};
 use fbakit::fap::{read_stream_file, ReadOptions};
 use fbakit::player::{PlayOptions, Player};
 use serde_json::Value;
+use support::node_check::run_node_check;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -22,36 +25,19 @@ fn root() -> &'static Path {
 
 /// The check script's report for `page`, or `None` (with a note) when the browser is missing.
 fn check_page(page: &Path) -> Option<Value> {
-    let required = std::env::var_os("VIEWER_BROWSER_REQUIRED").is_some();
-    let skip = |why: String| {
-        assert!(!required, "viewer browser test required but: {why}");
-        eprintln!("note: skipping viewer browser test: {why}");
-        None
-    };
-    let mut cmd = Command::new("node");
-    cmd.arg(root().join("tests/support/viewer-check.mjs"))
-        .arg(page);
+    let mut args = vec![page.as_os_str().to_owned()];
     // Screenshots for a person to look at: `$VIEWER_SCREENSHOTS=DIR` keeps one per page.
     if let Some(dir) = std::env::var_os("VIEWER_SCREENSHOTS") {
         let name = page.file_stem().unwrap_or_default().to_string_lossy();
-        cmd.arg(Path::new(&dir).join(format!("{name}.png")));
+        args.push(Path::new(&dir).join(format!("{name}.png")).into_os_string());
     }
-    if std::env::var_os("VIEWER_BROWSER_DIR").is_none() {
-        let local = root().join("target/viewer-browser");
-        if local.is_dir() {
-            cmd.env("VIEWER_BROWSER_DIR", local);
-        }
-    }
-    let out = match cmd.output() {
-        Ok(o) => o,
-        Err(e) => return skip(format!("cannot run node ({e})")),
-    };
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if out.status.code() == Some(3) {
-        return skip(stderr.trim().to_string());
-    }
-    assert!(out.status.success(), "viewer check failed: {stderr}");
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = run_node_check(
+        "viewer-check.mjs",
+        args,
+        &[("VIEWER_BROWSER_DIR", "target/viewer-browser")],
+        "VIEWER_BROWSER_REQUIRED",
+        "viewer browser",
+    )?;
     eprintln!("{text}");
     Some(serde_json::from_str(text.trim()).unwrap())
 }

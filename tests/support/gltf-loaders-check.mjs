@@ -10,54 +10,23 @@
 // `.gltf` files load their `.bin` and images by relative URI as on a web server. Exit codes:
 // 0 = reports printed, 3 = a package or the browser missing (callers treat that as "skip"),
 // 1 = a file could not be checked.
-import { createRequire } from "node:module";
 import { existsSync } from "node:fs";
 import path from "node:path";
 
-function resolveIn(envVar, request) {
-  const bases = [];
-  if (process.env[envVar]) {
-    bases.push(path.join(path.resolve(process.env[envVar]), "package.json"));
-  }
-  bases.push(import.meta.url);
-  for (const base of bases) {
-    try {
-      return createRequire(base).resolve(request);
-    } catch {
-      // try the next place
-    }
-  }
-  return null;
-}
+import { launchChromium, resolveIn } from "./headless-chromium.mjs";
 
 const files = process.argv.slice(2).map((f) => path.resolve(f));
 if (files.length === 0) {
   console.error("usage: gltf-loaders-check.mjs FILE...");
   process.exit(1);
 }
-const playwrightMain = resolveIn("VIEWER_BROWSER_DIR", "playwright-core");
-if (!playwrightMain) {
-  console.error("playwright-core not found (set VIEWER_BROWSER_DIR)");
-  process.exit(3);
-}
 // three's package.json exports map hides its folders: find the package root from its main.
 const threeMain = resolveIn("THREE_DIR", "three");
-if (!threeMain) {
-  console.error("three not found (set THREE_DIR)");
-  process.exit(3);
-}
 const threeRoot = path.resolve(path.dirname(threeMain), "..");
 if (!existsSync(path.join(threeRoot, "examples/jsm/loaders/GLTFLoader.js"))) {
   console.error(`no GLTFLoader under ${threeRoot}`);
   process.exit(3);
 }
-const executablePath = process.env.CHROMIUM_PATH || "/usr/bin/chromium";
-if (!existsSync(executablePath)) {
-  console.error(`no Chromium at ${executablePath} (set CHROMIUM_PATH)`);
-  process.exit(3);
-}
-const playwright = createRequire(import.meta.url)(playwrightMain);
-
 const ORIGIN = "http://fbakit.test";
 const PAGE = `<!doctype html><meta charset="utf-8"><title>gltf loaders</title>
 <script type="importmap">{"imports": {"three": "/three/build/three.module.js",
@@ -70,19 +39,7 @@ window.GLTFLoader = GLTFLoader;
 window.loadersReady = true;
 </script>`;
 
-const browser = await playwright.chromium.launch({
-  executablePath,
-  args: [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-  ],
-});
+const browser = await launchChromium();
 
 let failed = false;
 try {

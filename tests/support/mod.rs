@@ -5,4 +5,5 @@ pub mod cli;
 pub mod gltf_scenes;
 pub mod gltf_transform;
 pub mod loader_outputs;
+pub mod node_check;
 pub mod validator;

@@ -7,60 +7,18 @@
 // `npm install --prefix` directory) first, then through ordinary node_modules resolution;
 // Chromium is $CHROMIUM_PATH or /usr/bin/chromium. Exit codes: 0 = report printed, 3 = driver or
 // browser missing (callers treat that as "skip"), 1 = the page could not be checked.
-import { createRequire } from "node:module";
-import { existsSync } from "node:fs";
 import path from "node:path";
 import { pathToFileURL } from "node:url";
 
-function loadPlaywright() {
-  const bases = [];
-  if (process.env.VIEWER_BROWSER_DIR) {
-    bases.push(path.join(path.resolve(process.env.VIEWER_BROWSER_DIR), "package.json"));
-  }
-  bases.push(import.meta.url);
-  for (const base of bases) {
-    try {
-      return createRequire(base)("playwright-core");
-    } catch {
-      // try the next place
-    }
-  }
-  return null;
-}
+import { launchChromium } from "./headless-chromium.mjs";
 
 const [pagePath, screenshot] = process.argv.slice(2);
 if (!pagePath) {
   console.error("usage: viewer-check.mjs PAGE.html [SCREENSHOT.png]");
   process.exit(1);
 }
-const playwright = loadPlaywright();
-if (!playwright) {
-  console.error("playwright-core not found (set VIEWER_BROWSER_DIR)");
-  process.exit(3);
-}
-const executablePath = process.env.CHROMIUM_PATH || "/usr/bin/chromium";
-if (!existsSync(executablePath)) {
-  console.error(`no Chromium at ${executablePath} (set CHROMIUM_PATH)`);
-  process.exit(3);
-}
-
 const pageUrl = pathToFileURL(path.resolve(pagePath)).href;
-const browser = await playwright.chromium.launch({
-  executablePath,
-  args: [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    // WebGL without a GPU: ANGLE on the SwiftShader software rasteriser.
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-  ],
-});
+const browser = await launchChromium({ webgl: true });
 
 const report = { consoleErrors: [], pageErrors: [], foreignRequests: [] };
 try {
