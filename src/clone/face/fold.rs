@@ -158,16 +158,7 @@ pub(super) fn fold_into_target(
                         Some(x) => x,
                         None => motion.insert(TableMotion::new(cloned, table)?),
                     };
-                    // A vertex in no polygon is invisible and never moves (the rest of a
-                    // cut part mesh keeps the unused ones of every part).
-                    let used = used_vertices(&cloned.meshes[m.index].mesh);
-                    let vertices: Vec<u32> = m
-                        .to_target
-                        .iter()
-                        .enumerate()
-                        .filter(|(i, _)| used.get(*i).copied().unwrap_or(false))
-                        .map(|(_, &v)| v)
-                        .collect();
+                    let vertices = m.to_target;
                     let neutral: Vec<Vec3> = vertices
                         .iter()
                         .map(|&v| original.get(v as usize).copied().unwrap_or(Vec3::ZERO))
@@ -177,7 +168,7 @@ pub(super) fn fold_into_target(
                     let b = bake_motion(
                         &BakeRequest {
                             mesh: cut.name,
-                            vertices: &vertices,
+                            vertices,
                             neutral: &neutral,
                             range,
                             borders: &borders,
@@ -216,19 +207,6 @@ pub(super) fn fold_into_target(
     let face = layout_face(cloned, target, &baked, fat);
     correct_report(report, &baked);
     Ok(face)
-}
-
-/// Per vertex of `mesh`, whether a polygon uses it.
-fn used_vertices(mesh: &crate::mesh::Mesh) -> Vec<bool> {
-    let mut used = vec![false; mesh.positions.len()];
-    for poly in mesh.polygons.iter() {
-        for &v in poly {
-            if let Some(u) = used.get_mut(v as usize) {
-                *u = true;
-            }
-        }
-    }
-    used
 }
 
 /// The transform view mesh `mesh`'s vertices are expressed in once the baked transforms are

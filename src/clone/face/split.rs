@@ -424,7 +424,10 @@ fn apply_cut(
     let rest_vertices: Vec<u32> = (0..mesh.positions.len() as u32)
         .filter(|&v| !used_elsewhere[v as usize])
         .collect();
-    let (rest_mesh, rest_map) = sub_mesh(mesh, &rest_polys, Some(&rest_vertices));
+    // A rest that is a part takes only its polygons' vertices: an unused vertex (of any part)
+    // would pull its centre and size; it stays out of the view and never moves.
+    let keep = plan.rest.is_none().then_some(rest_vertices.as_slice());
+    let (rest_mesh, rest_map) = sub_mesh(mesh, &rest_polys, keep);
     let mut report = Vec::new();
     if let Some(p) = plan.rest {
         report.push(SplitPart {
