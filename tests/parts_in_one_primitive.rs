@@ -318,6 +318,37 @@ fn the_patched_glb_keeps_the_primitives_validates_and_plays() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", support::cli::text(&o.stderr));
+    // The avatar has a `Head` node (3): head rotations turn it when played, no morph target
+    // bakes them (the hat, a child of the node, has none).
+    let json_of = |p: &Path| {
+        let bytes = std::fs::read(p).unwrap();
+        let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+        serde_json::from_slice::<serde_json::Value>(chunks.json).unwrap()
+    };
+    let (patched, played_json) = (json_of(&out), json_of(&played));
+    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
+    assert!(
+        names.contains("open_jaw") && !names.contains("head_"),
+        "{names}"
+    );
+    assert!(patched["meshes"][1]["primitives"][0]
+        .get("targets")
+        .is_none());
+    let play = played_json["animations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "play")
+        .unwrap();
+    assert!(
+        play["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c["target"]["node"] == 3 && c["target"]["path"] == "rotation"),
+        "{}",
+        play["channels"]
+    );
     // No new validator issue.
     let Some(reports) = support::validator::validate(&[glb.clone(), out.clone(), played.clone()])
     else {
