@@ -16,7 +16,12 @@
 //!    roughly spherical pieces around the pupils are eyeballs; pieces behind the lips within
 //!    1.5 MNS0 of the lip line are upper or lower teeth by their side of the lip line, and a
 //!    piece reaching well into both jaws (ICT's gums and tongue) is cut along it. The tongue
-//!    is not told apart from the lower gums: it follows the jaw.
+//!    is not told apart from the lower gums: it follows the jaw. Likewise a part mesh (or
+//!    glTF primitive) holding the feature points of several parts — both pupils in one eyes
+//!    mesh, the upper and lower teeth points in one teeth mesh — is cut into one part each:
+//!    by connected pieces, a piece going to the part whose points it holds or lie nearest,
+//!    polygon by polygon when one piece holds several parts' points. Each eye then turns
+//!    about its own centre and the lower row follows the jaw; step 9 folds them back.
 //! 2. **`align`** — a similarity (scale, rotation, translation; Umeyama's SVD solution) that
 //!    puts the target's feature points onto the source's, least squares over every point both
 //!    faces have. The target is cloned in that aligned frame (so a target modelled at another

@@ -1,6 +1,7 @@
 //! One-mesh heads: eyes, teeth and gums that are separate connected pieces of the skin mesh
 //! (the bundled `ict`) are split into part meshes before cloning, so the rigid-part step can
-//! move them (module docs of [`super`], step 1). The split is an internal view: its index maps
+//! move them (module docs of [`super`], step 1); so are part meshes holding several parts
+//! (both eyeballs in one mesh or glTF primitive, both rows of teeth). The split is an internal view: its index maps
 //! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -149,9 +150,11 @@ impl Landmarks {
 /// Splits eyeballs, teeth and gums out of the skin meshes of a face that has no such part
 /// meshes (a one-mesh head), recognised by shape and place: roughly spherical pieces near
 /// the pupils are eyeballs, pieces behind the lips near the lip line are teeth or gums of
-/// the jaw on their side (cut along the lip line when they reach well into both). Only
-/// meshes no FAT table deforms are cut (a FAT would need remapping). Returns the face (unchanged
-/// when nothing was split) and the new part meshes.
+/// the jaw on their side (cut along the lip line when they reach well into both); and cuts
+/// part meshes holding several parts' feature points (both eyeballs, both rows of teeth) into
+/// one part each. Only meshes no FAT table deforms are cut (a FAT would need remapping).
+/// Returns the face (unchanged when nothing was split) and its part meshes taken from cut
+/// meshes (a cut part mesh keeps its name for its first part).
 pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
     match split_view(face) {
         Some(v) => (v.face, v.parts),
