@@ -173,6 +173,9 @@ fn inverse(map: &BTreeMap<u32, u32>) -> Vec<u32> {
     out
 }
 
+/// A mesh of the view by name, and its vertices' numbers there by old vertex.
+type VertexMap = (String, BTreeMap<u32, u32>);
+
 /// Where the polygons of one mesh go, before the cut.
 struct CutPlan {
     /// The mesh (index in the face).
@@ -399,7 +402,7 @@ fn apply_cut(
     out: &mut FaceModel,
     face: &FaceModel,
     plan: &CutPlan,
-) -> (Cut, Vec<SplitPart>, Vec<(String, BTreeMap<u32, u32>)>) {
+) -> (Cut, Vec<SplitPart>, Vec<VertexMap>) {
     let mi = plan.mesh;
     let name = face.meshes[mi].name.clone();
     let mesh = &face.meshes[mi].mesh;
@@ -442,7 +445,7 @@ fn apply_cut(
             source_vertices: inverse(&rest_map),
         });
     }
-    let mut maps: Vec<(String, BTreeMap<u32, u32>)> = vec![(name.clone(), rest_map)];
+    let mut maps: Vec<VertexMap> = vec![(name.clone(), rest_map)];
     out.meshes[mi].mesh = rest_mesh;
     for (p, polys) in &plan.dest {
         let Some(p) = p.filter(|_| *p != plan.rest) else {
@@ -479,11 +482,7 @@ fn apply_cut(
 
 /// Feature points bound to a cut mesh (`cuts`: mesh index, its maps by new mesh name) follow
 /// their vertex into its new mesh; the others name their mesh (the face has more meshes now).
-fn rebind_feature_points(
-    out: &mut FaceModel,
-    face: &FaceModel,
-    cuts: &[(usize, Vec<(String, BTreeMap<u32, u32>)>)],
-) {
+fn rebind_feature_points(out: &mut FaceModel, face: &FaceModel, cuts: &[(usize, Vec<VertexMap>)]) {
     let ids: Vec<FeaturePointId> = face.feature_points.iter().map(|f| f.id).collect();
     for id in ids {
         let Some((m, v)) = face.fp_vertex(id) else {
