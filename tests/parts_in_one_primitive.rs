@@ -1,8 +1,9 @@
 //! Parts that share one primitive (issue 19 §1): the avatar's eyes primitive holds both
 //! eyeballs, its teeth primitive both rows, its lashes primitive the lashes of both eyes. Each
 //! eye turns about its own centre for its own eyeball FAPs only, rigidly within 1 % of its
-//! size at the FAT's interval values; the lower row follows `open_jaw`, the upper stays; the
-//! primitives keep their vertices in order, and the patched glb validates and plays.
+//! size at the FAT's interval values; the lower row follows `open_jaw`, the upper stays; each
+//! eye's lashes follow its own lid; the primitives keep their vertices in order, and the
+//! patched glb validates and plays (head rotations on the `Head` node, not baked).
 
 mod support;
 
@@ -21,6 +22,10 @@ const TEETH: &str = "Body.4";
 /// The eyes primitive: the right eye's sphere (x < 0) first, then the left's.
 const RIGHT_EYE: std::ops::Range<usize> = 0..45;
 const LEFT_EYE: std::ops::Range<usize> = 45..90;
+const LASHES: &str = "Body.3";
+/// The lashes primitive: the right eye's eight vertices, then the left's.
+const RIGHT_LASHES: std::ops::Range<usize> = 0..8;
+const LEFT_LASHES: std::ops::Range<usize> = 8..16;
 /// The teeth primitive: upper row, then lower row.
 const UPPER: std::ops::Range<usize> = 0..14;
 const LOWER: std::ops::Range<usize> = 14..28;
@@ -268,6 +273,38 @@ fn each_part_of_a_shared_primitive_moves_alone() {
     );
     check_eyes(face);
     check_teeth(face);
+}
+
+/// The lids close although the avatar's coarse skin holds each upper lid point on the same
+/// vertex as an eye corner (the guard moves the point itself), and the lashes primitive's
+/// two halves each follow their own lid.
+#[test]
+fn lids_close_and_each_eyes_lashes_follow_their_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, out) = cloned(dir.path());
+    let face = &out.face;
+    let lashes = face.mesh_index(LASHES).unwrap();
+    let neutral = face.neutral_world_positions();
+    let n = &neutral[lashes];
+    for (fap, lid, own, other) in [
+        (19u8, "3.1", LEFT_LASHES, RIGHT_LASHES),
+        (20, "3.2", RIGHT_LASHES, LEFT_LASHES),
+    ] {
+        let (m, v) = face.fp_vertex(lid.parse().unwrap()).unwrap();
+        let p = posed(face, fap, 1024.0);
+        let down = neutral[m][v as usize].y - p[m][v as usize].y;
+        assert!(
+            down > 0.0,
+            "FAP {fap}: the lid point {lid} does not go down ({down})"
+        );
+        let lash = own.clone().map(|v| n[v].y - p[lashes][v].y).sum::<f32>() / 8.0;
+        eprintln!("FAP {fap}: lid {lid} down {down}, its lashes down {lash}");
+        assert!(lash > 0.1 * down, "FAP {fap}: lashes {lash}, lid {down}");
+        assert!(
+            max_move(n, &p[lashes], other.clone()) < 1e-6,
+            "FAP {fap} moves the other eye's lashes"
+        );
+    }
 }
 
 #[test]

@@ -57,7 +57,10 @@
 //!    rescale factor lies outside [min(1, r)/4, 4·max(1, r)] (r = target/source FAPU of its
 //!    unit), has *failed* — a rescale dividing by almost nothing once gave factors of 4.5·10⁵.
 //!    It is repaired by a direct transfer (nearest source vertex in the aligned frame, times
-//!    r) and re-checked; if that fails too the FAP's table is dropped. Either way it is
+//!    r), else by moving its feature point alone (the source's displacement there times r,
+//!    fading out before the nearest other feature point: a coarse target's lid point may share
+//!    its vertex with an eye corner), and re-checked; if that fails too the FAP's table is
+//!    dropped. Either way it is
 //!    listed in [`CloneReport::failed_faps`] and warned about.
 //!    **`smooth`** (every method, `smooth.rs`): a motion must not crease, fold or spike where
 //!    its source does not. Target triangles whose normal turns more than 1.25× the source
@@ -453,7 +456,7 @@ fn clone_skin_motions(
             f.reason,
             f.factor,
             if f.repaired {
-                "repaired by a direct nearest-vertex transfer"
+                "repaired by a direct transfer"
             } else {
                 "its table is dropped"
             }
