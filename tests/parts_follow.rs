@@ -92,9 +92,9 @@ fn lash_primitive_follows_the_eyelid_not_the_jaw() {
                 .unwrap()
         })
         .collect();
-    // The avatar's skin is a coarse sphere (3 cm between vertices): its upper and lower lid
-    // points share vertices, so close_t_l_eyelid fails the guard and is dropped; the brows
-    // move the skin the left lashes sit on.
+    // The avatar's skin is a coarse sphere (3 cm between vertices): its upper lid point
+    // shares its vertex with the inner eye corner, so close_t_l_eyelid is the guard's repair
+    // (the point moved alone); the brows move the skin the left lashes sit on.
     let mut moved = 0;
     for fap in [19u8, 31, 33] {
         let key = TableKey::LowLevel(FapId::new(fap).unwrap());

@@ -24,7 +24,9 @@ use glam::{Affine3A, Quat, Vec3};
 use serde_json::Map;
 
 use super::gltf::FaceMorphs;
-use super::gltf_rotations::{jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes};
+use super::gltf_rotations::{
+    head_node, jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes, HEAD_FAPS,
+};
 use crate::error::{Diagnostic, Result};
 use crate::face::gltf_fat::{self, TargetRecord};
 use crate::face::gltf_fat::{exact_offset, rate_of};
@@ -189,6 +191,17 @@ pub fn patch_face(
         .iter()
         .map(|t| by_name.get(&t.name).copied())
         .collect();
+    // A head node of the user's (named, or found by its usual names) turns the head: the
+    // head rotations (48–50) of transforms the document has no node for are left to it, not
+    // baked into morph targets (never a rotation and a morph for one motion).
+    let trimmed;
+    let face = match head_node(source, nodes) {
+        Some(n) if !transform_nodes.contains(&Some(n)) => {
+            trimmed = without_head_rotations(face, &transform_nodes);
+            &trimmed
+        }
+        _ => face,
+    };
     let world_pieces = face_pieces(face, &transform_nodes)?;
     let mut meshes: BTreeMap<usize, MeshTargets> = BTreeMap::new();
     // A glTF mesh shown by several nodes is patched once: from its first instance.
@@ -403,6 +416,26 @@ pub fn patch_face(
         morph_targets,
         warnings,
     })
+}
+
+/// `face` without the transform entries of its head rotation tables (48–50) on transforms
+/// the document has no node for (`transform_nodes`); a table left empty is dropped.
+fn without_head_rotations(face: &FaceModel, transform_nodes: &[Option<usize>]) -> FaceModel {
+    let mut out = face.clone();
+    for table in &mut out.fat.tables {
+        if !matches!(table.key, TableKey::LowLevel(f) if HEAD_FAPS.contains(&f.number())) {
+            continue;
+        }
+        table.transforms.retain(|x| {
+            face.transform_index(&x.transform)
+                .and_then(|i| transform_nodes.get(i).copied().flatten())
+                .is_some()
+        });
+    }
+    out.fat
+        .tables
+        .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
+    out
 }
 
 /// Where a mesh's pieces land among its targets after the patch.

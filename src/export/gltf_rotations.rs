@@ -127,6 +127,21 @@ fn vrm_bone(json: &Value, bone: &str) -> Option<usize> {
         .map(|n| n as usize)
 }
 
+/// The head node `play` turns for FAPs 48–50: the node named `names.head`, else the first
+/// with a usual head name, else the VRM humanoid `head` bone.
+pub fn head_node(source: &GltfSource, names: &RotationNodes) -> Option<usize> {
+    find(&source.json, names.head.as_deref(), HEAD_NAMES).or_else(|| {
+        names
+            .head
+            .is_none()
+            .then(|| vrm_bone(&source.json, "head"))
+            .flatten()
+    })
+}
+
+/// The head rotation FAPs (pitch, yaw, roll).
+pub const HEAD_FAPS: [u8; 3] = [48, 49, 50];
+
 /// World rotation of every node at rest (parents from `children`).
 fn world_rotations(json: &Value) -> (Vec<Quat>, Vec<Option<usize>>) {
     let (world, parent) = compose_at_rest(json, local_rotation);
@@ -199,16 +214,7 @@ pub fn rotated_nodes(source: &GltfSource, fat: &Fat, names: &RotationNodes) -> V
         None => (None, None),
     };
     let wanted: [(Option<usize>, &[u8]); 3] = [
-        (
-            find(json, names.head.as_deref(), HEAD_NAMES).or_else(|| {
-                names
-                    .head
-                    .is_none()
-                    .then(|| vrm_bone(json, "head"))
-                    .flatten()
-            }),
-            &[49, 48, 50],
-        ),
+        (head_node(source, names), &[49, 48, 50]),
         (
             find(json, eye_l, LEFT_EYE_NAMES)
                 .or_else(|| eye_l.is_none().then(|| vrm_bone(json, "leftEye")).flatten()),

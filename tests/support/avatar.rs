@@ -5,6 +5,10 @@
 //! target of the user's own (`Blink`, animated), a material extension and extras on the
 //! asset, nodes and materials.
 //!
+//! A variant ([`build_with`], [`Options::teeth`]) adds a fifth primitive `teeth`: an upper and a
+//! lower row of teeth in one primitive behind the lips (the upper row on the head joint, the
+//! lower on the jaw), with feature points 9.8–9.11 on them ([`teeth_fp_lines`]).
+//!
 //! The jaw's inverse bind matrix was taken half a centimetre higher than the jaw rests, so the
 //! mouth's vertices (weighted to jaw and head) are placed per vertex at rest; the other joints
 //! agree and place their vertices with the armature's one matrix.
@@ -70,6 +74,99 @@ fn sphere(
         }
     }
     (p, n, uv, t)
+}
+
+/// What the avatar has besides its four primitives.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// A fifth primitive `teeth`: both rows of teeth in one primitive.
+    pub teeth: bool,
+}
+
+/// Lip line height and front of the teeth rows (cm, armature frame): just behind the lips
+/// [`fp_csv`] puts on the head sphere.
+const LIP_Y: f32 = 155.8;
+const TEETH_Z: f32 = 8.2;
+/// Half width and height of a row of teeth (cm).
+const TEETH_HALF_WIDTH: f32 = 1.5;
+const TEETH_HEIGHT: f32 = 0.7;
+/// Gap between the rows and the lip line (cm).
+const TEETH_GAP: f32 = 0.1;
+
+/// One row of teeth: a strip curving back at its ends, from `y0` to `y1`.
+fn teeth_row(y0: f32, y1: f32) -> (Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
+    let (mut p, mut uv, mut t) = (Vec::new(), Vec::new(), Vec::new());
+    let n = 6;
+    for i in 0..=n {
+        let u = i as f32 / n as f32;
+        let x = (2.0 * u - 1.0) * TEETH_HALF_WIDTH;
+        let z = HEAD_CENTRE.z + TEETH_Z - 0.4 * x * x;
+        for (k, y) in [y0, y1].into_iter().enumerate() {
+            p.push(Vec3::new(x, y, z));
+            uv.push(Vec2::new(u, k as f32));
+        }
+    }
+    for i in 0..n as u16 {
+        let (a, b, c, d) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+        t.push([a, c, b]);
+        t.push([b, c, d]);
+    }
+    (p, uv, t)
+}
+
+/// The `teeth` primitive of [`Options::teeth`]: upper row (vertices 0..14, head joint), then
+/// the lower row (14..28, jaw joint).
+pub fn teeth_prim() -> Prim {
+    let (head, jaw) = (2u8, 3u8);
+    let mut prim = Prim {
+        name: "teeth",
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        triangles: vec![],
+        joints: vec![],
+    };
+    let rows = [
+        (LIP_Y + TEETH_GAP, LIP_Y + TEETH_GAP + TEETH_HEIGHT, head),
+        (LIP_Y - TEETH_GAP - TEETH_HEIGHT, LIP_Y - TEETH_GAP, jaw),
+    ];
+    for (y0, y1, joint) in rows {
+        let (p, uv, t) = teeth_row(y0, y1);
+        let base = prim.positions.len() as u16;
+        prim.triangles
+            .extend(t.iter().map(|tr| tr.map(|i| i + base)));
+        prim.joints
+            .extend(std::iter::repeat_n([(joint, 1.0), (0, 0.0)], p.len()));
+        prim.normals.extend(std::iter::repeat_n(Vec3::Z, p.len()));
+        prim.positions.extend(p);
+        prim.uvs.extend(uv);
+    }
+    prim
+}
+
+/// Feature points 9.8–9.11 on the [`teeth_prim`] rows, as `fp,x,y,z` lines in the file's
+/// world frame (metres, at rest): 9.8 and 9.10 on the upper row's lower and upper middle, 9.9 and 9.11
+/// on the lower row's upper and lower middle.
+pub fn teeth_fp_lines() -> String {
+    let z = HEAD_CENTRE.z + TEETH_Z;
+    let at = |id: &str, y: f32| format!("{id},0,{},{}\n", y * 0.01, z * 0.01);
+    [
+        at("9.8", LIP_Y + TEETH_GAP),
+        at("9.10", LIP_Y + TEETH_GAP + TEETH_HEIGHT),
+        // The jaw joint places the lower row JAW_BIND_OFFSET lower than modelled.
+        at("9.9", LIP_Y - TEETH_GAP - JAW_BIND_OFFSET),
+        at("9.11", LIP_Y - TEETH_GAP - TEETH_HEIGHT - JAW_BIND_OFFSET),
+    ]
+    .concat()
+}
+
+/// The primitives of `Body` with `opts`.
+pub fn body_prims_with(opts: &Options) -> Vec<Prim> {
+    let mut prims = body_prims();
+    if opts.teeth {
+        prims.push(teeth_prim());
+    }
+    prims
 }
 
 /// The four primitives of `Body`.
@@ -244,7 +341,12 @@ fn joint_worlds() -> [Mat4; 4] {
 
 /// Builds the avatar.
 pub fn build() -> Avatar {
-    let prims = body_prims();
+    build_with(&Options::default())
+}
+
+/// Builds the avatar with `opts`.
+pub fn build_with(opts: &Options) -> Avatar {
+    let prims = body_prims_with(opts);
     let mut b = Bin {
         bin: Vec::new(),
         views: Vec::new(),
@@ -359,6 +461,15 @@ pub fn build() -> Avatar {
     let mut emissive = mat("eyes", false);
     emissive["emissiveFactor"] = json!([0.1, 0.1, 0.1]);
     emissive["extensions"] = json!({"KHR_materials_emissive_strength": {"emissiveStrength": 2.0}});
+    let mut materials = vec![
+        mat("skin", true),
+        mat("mouth", false),
+        emissive,
+        mat("lashes", false),
+    ];
+    materials.extend(prims[4..].iter().map(|p| mat(p.name, false)));
+    let hat_material = materials.len();
+    materials.push(mat("hat", false));
     let json = json!({
         "asset": {"version": "2.0", "generator": "fbakit test avatar", "extras": {"author": "tests", "licence": "CC0"}},
         "extensionsUsed": ["KHR_materials_emissive_strength"],
@@ -376,10 +487,10 @@ pub fn build() -> Avatar {
         ],
         "meshes": [
             {"name": "Body", "primitives": primitives, "weights": [0.0], "extras": {"targetNames": ["Blink"], "note": "user mesh"}},
-            {"name": "Hat", "primitives": [{"attributes": {"POSITION": hat_pos}, "indices": hat_idx, "material": 4}]}
+            {"name": "Hat", "primitives": [{"attributes": {"POSITION": hat_pos}, "indices": hat_idx, "material": hat_material}]}
         ],
         "skins": [{"name": "Rig", "joints": [1, 2, 3, 4], "skeleton": 1, "inverseBindMatrices": ibm}],
-        "materials": [mat("skin", true), mat("mouth", false), emissive, mat("lashes", false), mat("hat", false)],
+        "materials": materials,
         "textures": [{"source": 0, "sampler": 0}],
         "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 33071, "wrapT": 33071}],
         "images": [{"bufferView": image_view, "mimeType": "image/png", "name": "skin_basecolor"}],

@@ -16,7 +16,7 @@ use super::rigid::hierarchy_ancestors;
 use super::split::SplitView;
 use super::{CloneReport, Part};
 use crate::error::{Diagnostic, Result};
-use crate::face::FaceModel;
+use crate::face::{FaceFrames, FaceModel};
 use crate::fat::bake::{bake_motion, on_borders, part_size, BakeRequest};
 use crate::fat::eval::{Activation, FatEvaluator};
 use crate::fat::morph::MorphTarget;
@@ -32,8 +32,22 @@ struct ViewMesh<'a> {
     index: usize,
     /// View vertex → target vertex.
     to_target: &'a [u32],
-    /// The part it is, `None` for the skin left of the cut mesh.
+    /// The part it is, `None` for the skin left of a cut mesh.
     part: Option<Part>,
+}
+
+/// One cut mesh of the target: its index there and its view meshes.
+struct CutMeshes<'a> {
+    /// Index in the target.
+    target: usize,
+    /// Its name.
+    name: &'a str,
+    /// The view meshes holding its vertices (the rest first).
+    meshes: Vec<ViewMesh<'a>>,
+    /// How many view meshes hold each of its vertices (2 on a cut along the lip line).
+    multiplicity: Vec<u8>,
+    /// The view transform its vertices are expressed in, in the output (see [`home`]).
+    home: Option<usize>,
 }
 
 /// The cloned view `cloned` folded back into `target`'s layout (module docs). `targets` are the
@@ -46,114 +60,140 @@ pub(super) fn fold_into_target(
     targets: &[MorphTarget],
     report: &mut CloneReport,
 ) -> Result<FaceModel> {
-    let Some(target_mesh) = target.mesh_index(&view.mesh) else {
-        return Ok(cloned.clone());
-    };
-    let mut meshes: Vec<ViewMesh> = Vec::new();
-    if let Some(index) = cloned.mesh_index(&view.mesh) {
-        meshes.push(ViewMesh {
-            index,
-            to_target: &view.skin_vertices,
-            part: None,
-        });
-    }
-    for p in &view.parts {
-        if let Some(index) = cloned.mesh_index(&p.mesh) {
-            meshes.push(ViewMesh {
-                index,
-                to_target: &p.source_vertices,
-                part: Some(p.part),
-            });
-        }
-    }
-    // How many view meshes hold each target vertex (2 on a cut along the lip line).
-    let mut multiplicity = vec![0u8; target.meshes[target_mesh].mesh.positions.len()];
-    for m in &meshes {
-        for &v in m.to_target {
-            if let Some(k) = multiplicity.get_mut(v as usize) {
-                *k = k.saturating_add(1);
-            }
-        }
-    }
     let part_names: BTreeSet<&str> = view.parts.iter().map(|p| p.mesh.as_str()).collect();
     let baked = baked_transforms(cloned, &part_names, &report.rigid.created_transforms);
+    let mut cuts: Vec<CutMeshes> = Vec::new();
+    for cut in &view.cuts {
+        let (Some(target_mesh), Some(rest)) =
+            (target.mesh_index(&cut.mesh), cloned.mesh_index(&cut.mesh))
+        else {
+            continue;
+        };
+        let mut meshes = vec![ViewMesh {
+            index: rest,
+            to_target: &cut.rest_vertices,
+            part: cut.rest,
+        }];
+        for p in view
+            .parts
+            .iter()
+            .filter(|p| p.from == cut.mesh && p.mesh != cut.mesh)
+        {
+            if let Some(index) = cloned.mesh_index(&p.mesh) {
+                meshes.push(ViewMesh {
+                    index,
+                    to_target: &p.source_vertices,
+                    part: Some(p.part),
+                });
+            }
+        }
+        let mut multiplicity = vec![0u8; target.meshes[target_mesh].mesh.positions.len()];
+        for m in &meshes {
+            for &v in m.to_target {
+                if let Some(k) = multiplicity.get_mut(v as usize) {
+                    *k = k.saturating_add(1);
+                }
+            }
+        }
+        cuts.push(CutMeshes {
+            target: target_mesh,
+            name: &cut.mesh,
+            meshes,
+            multiplicity,
+            home: home(cloned, rest, &baked),
+        });
+    }
     let ranges = covered_ranges(targets);
-    let original = &target.meshes[target_mesh].mesh.positions;
     let mut fat = Fat::default();
     for table in &cloned.fat.tables {
-        let mut entries: Vec<FaceDefMesh> = Vec::new();
         let mut out = FaceDefTable::new(table.key);
-        for e in &table.meshes {
-            match meshes
-                .iter()
-                .find(|m| cloned.meshes[m.index].name == e.mesh)
-            {
-                Some(m) => entries.push(FaceDefMesh {
-                    mesh: view.mesh.clone(),
-                    coord_index: e
-                        .coord_index
-                        .iter()
-                        .map(|&v| m.to_target.get(v as usize).copied().unwrap_or(v))
-                        .collect(),
-                    ..e.clone()
-                }),
-                None => out.meshes.push(e.clone()),
-            }
-        }
-        if table
+        let mut merged = Vec::new();
+        let mut motion: Option<TableMotion> = None;
+        let moves_baked = table
             .transforms
             .iter()
-            .any(|t| baked.contains(&t.transform))
-        {
-            let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
-            let borders: Vec<f64> = entries
-                .iter()
-                .flat_map(|e| e.interval_borders.iter().copied())
-                .collect();
-            let mut motion = TableMotion::new(cloned, table)?;
-            for m in meshes.iter().filter(|m| m.part.is_some()) {
-                let Some(t) = cloned.meshes[m.index].transform else {
-                    continue;
-                };
-                if !hierarchy_ancestors(cloned, Some(t))
+            .any(|t| baked.contains(&t.transform));
+        let mut rest: Vec<FaceDefMesh> = table.meshes.clone();
+        for cut in &cuts {
+            let mut entries: Vec<FaceDefMesh> = Vec::new();
+            rest.retain(|e| {
+                match cut
+                    .meshes
                     .iter()
-                    .any(|&a| baked.contains(&cloned.transforms[a].name))
+                    .find(|m| cloned.meshes[m.index].name == e.mesh)
                 {
-                    continue;
+                    Some(m) => {
+                        entries.push(FaceDefMesh {
+                            mesh: cut.name.to_string(),
+                            coord_index: e
+                                .coord_index
+                                .iter()
+                                .map(|&v| m.to_target.get(v as usize).copied().unwrap_or(v))
+                                .collect(),
+                            ..e.clone()
+                        });
+                        false
+                    }
+                    None => true,
                 }
-                let skin = meshes.first().map_or(m.index, |s| s.index);
-                let neutral: Vec<Vec3> = m
-                    .to_target
+            });
+            if moves_baked {
+                let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
+                let borders: Vec<f64> = entries
                     .iter()
-                    .map(|&v| original.get(v as usize).copied().unwrap_or(Vec3::ZERO))
+                    .flat_map(|e| e.interval_borders.iter().copied())
                     .collect();
-                let size = part_size(&neutral);
-                let tolerance = BAKE_TOLERANCE * size;
-                let b = bake_motion(
-                    &BakeRequest {
-                        mesh: &view.mesh,
-                        vertices: m.to_target,
-                        neutral: &neutral,
-                        range,
-                        borders: &borders,
-                        tolerance,
-                    },
-                    |p| motion.in_mesh_frame(skin, m.index, table.key, p),
-                );
-                if b.max_error > tolerance {
-                    report.warnings.push(Diagnostic::warning(format!(
-                        "{}: the baked motion of {} is off by {:.3} % of its size",
-                        table.key,
-                        cloned.meshes[m.index].name,
-                        100.0 * b.max_error / size.max(f32::MIN_POSITIVE)
-                    )));
+                let original = &target.meshes[cut.target].mesh.positions;
+                for m in cut.meshes.iter().filter(|m| m.part.is_some()) {
+                    let Some(t) = cloned.meshes[m.index].transform else {
+                        continue;
+                    };
+                    if !hierarchy_ancestors(cloned, Some(t))
+                        .iter()
+                        .any(|&a| baked.contains(&cloned.transforms[a].name))
+                    {
+                        continue;
+                    }
+                    let motion = match &mut motion {
+                        Some(x) => x,
+                        None => motion.insert(TableMotion::new(cloned, table)?),
+                    };
+                    let vertices = m.to_target;
+                    let neutral: Vec<Vec3> = vertices
+                        .iter()
+                        .map(|&v| original.get(v as usize).copied().unwrap_or(Vec3::ZERO))
+                        .collect();
+                    let size = part_size(&neutral);
+                    let tolerance = BAKE_TOLERANCE * size;
+                    let b = bake_motion(
+                        &BakeRequest {
+                            mesh: cut.name,
+                            vertices,
+                            neutral: &neutral,
+                            range,
+                            borders: &borders,
+                            tolerance,
+                        },
+                        |p| motion.in_mesh_frame(cut.home, m.index, table.key, p),
+                    );
+                    if b.max_error > tolerance {
+                        report.warnings.push(Diagnostic::warning(format!(
+                            "{}: the baked motion of {} is off by {:.3} % of its size",
+                            table.key,
+                            cloned.meshes[m.index].name,
+                            100.0 * b.max_error / size.max(f32::MIN_POSITIVE)
+                        )));
+                    }
+                    // A part this table does not move adds no entry.
+                    if b.entry.displacements.iter().any(|d| *d != Vec3::ZERO) {
+                        entries.push(b.entry);
+                    }
                 }
-                entries.push(b.entry);
             }
+            merged.extend(merge_entries(&entries, &cut.multiplicity));
         }
-        if let Some(merged) = merge_entries(&entries, &multiplicity) {
-            out.meshes.insert(0, merged);
-        }
+        out.meshes = merged;
+        out.meshes.append(&mut rest);
         out.transforms = table
             .transforms
             .iter()
@@ -167,6 +207,22 @@ pub(super) fn fold_into_target(
     let face = layout_face(cloned, target, &baked, fat);
     correct_report(report, &baked);
     Ok(face)
+}
+
+/// The transform view mesh `mesh`'s vertices are expressed in once the baked transforms are
+/// gone: its own, or its nearest ancestor not baked (the rest of a cut part mesh sat under a
+/// created part transform).
+fn home(cloned: &FaceModel, mesh: usize, baked: &BTreeSet<String>) -> Option<usize> {
+    let mut at = cloned.meshes.get(mesh)?.transform;
+    let mut steps = 0;
+    while let Some(t) = at {
+        if !baked.contains(&cloned.transforms[t].name) || steps > cloned.transforms.len() {
+            return Some(t);
+        }
+        at = cloned.transforms[t].parent;
+        steps += 1;
+    }
+    None
 }
 
 /// Created transforms that hold only cut part meshes: their motion becomes displacements.
@@ -217,7 +273,7 @@ fn covered_ranges(targets: &[MorphTarget]) -> HashMap<TableKey, (f64, f64)> {
 struct TableMotion<'a> {
     face: &'a FaceModel,
     evaluator: FatEvaluator,
-    neutral: Vec<Affine3A>,
+    neutral: FaceFrames,
 }
 
 impl<'a> TableMotion<'a> {
@@ -233,14 +289,20 @@ impl<'a> TableMotion<'a> {
         Ok(TableMotion {
             face,
             evaluator,
-            neutral: face.frames().meshes,
+            neutral: face.frames(),
         })
     }
 
-    /// The map, in the frame of view mesh `skin` (the target mesh's frame), that takes a
-    /// vertex of view mesh `part` at neutral to where the table at `p` puts it:
-    /// `W_skin(p)⁻¹ · W_part(p) · W_part(0)⁻¹ · W_skin(0)`.
-    fn in_mesh_frame(&mut self, skin: usize, part: usize, key: TableKey, p: f64) -> Affine3A {
+    /// The map, in the frame of view transform `home` (the frame the target mesh's vertices
+    /// are in; `None` the face frame), that takes a vertex of view mesh `part` at neutral to
+    /// where the table at `p` puts it: `W_home(p)⁻¹ · W_part(p) · W_part(0)⁻¹ · W_home(0)`.
+    fn in_mesh_frame(
+        &mut self,
+        home: Option<usize>,
+        part: usize,
+        key: TableKey,
+        p: f64,
+    ) -> Affine3A {
         let mut out = self.evaluator.output();
         self.evaluator
             .evaluate(&[Activation { key, value: p }], &mut out);
@@ -252,10 +314,11 @@ impl<'a> TableMotion<'a> {
             .map(|(t, d)| t.animated_matrix(d))
             .collect();
         let posed = self.face.frames_with(&locals);
-        posed.meshes[skin].inverse()
+        let frame = |f: &FaceFrames| home.map_or(Affine3A::IDENTITY, |t| f.transforms[t]);
+        frame(&posed).inverse()
             * posed.meshes[part]
-            * self.neutral[part].inverse()
-            * self.neutral[skin]
+            * self.neutral.meshes[part].inverse()
+            * frame(&self.neutral)
     }
 }
 
@@ -336,9 +399,7 @@ fn layout_face(
         .map(|m| {
             let mut out = m.clone();
             if let Some(c) = cloned.mesh_index(&m.name) {
-                out.transform = cloned.meshes[c]
-                    .transform
-                    .and_then(|t| new_index.get(&t).copied());
+                out.transform = home(cloned, c, baked).and_then(|t| new_index.get(&t).copied());
                 if cloned.meshes[c].mesh.positions.len() == m.mesh.positions.len() {
                     // Same mesh (not cut): positions as the clone left them (a part moved
                     // under a new transform is re-expressed in its frame).

@@ -16,7 +16,12 @@
 //!    roughly spherical pieces around the pupils are eyeballs; pieces behind the lips within
 //!    1.5 MNS0 of the lip line are upper or lower teeth by their side of the lip line, and a
 //!    piece reaching well into both jaws (ICT's gums and tongue) is cut along it. The tongue
-//!    is not told apart from the lower gums: it follows the jaw.
+//!    is not told apart from the lower gums: it follows the jaw. Likewise a part mesh (or
+//!    glTF primitive) holding the feature points of several parts — both pupils in one eyes
+//!    mesh, the upper and lower teeth points in one teeth mesh — is cut into one part each:
+//!    by connected pieces, a piece going to the part whose points it holds or lie nearest,
+//!    polygon by polygon when one piece holds several parts' points. Each eye then turns
+//!    about its own centre and the lower row follows the jaw; step 9 folds them back.
 //! 2. **`align`** — a similarity (scale, rotation, translation; Umeyama's SVD solution) that
 //!    puts the target's feature points onto the source's, least squares over every point both
 //!    faces have. The target is cloned in that aligned frame (so a target modelled at another
@@ -52,7 +57,10 @@
 //!    rescale factor lies outside [min(1, r)/4, 4·max(1, r)] (r = target/source FAPU of its
 //!    unit), has *failed* — a rescale dividing by almost nothing once gave factors of 4.5·10⁵.
 //!    It is repaired by a direct transfer (nearest source vertex in the aligned frame, times
-//!    r) and re-checked; if that fails too the FAP's table is dropped. Either way it is
+//!    r), else by moving its feature point alone (the source's displacement there times r,
+//!    fading out before the nearest other feature point: a coarse target's lid point may share
+//!    its vertex with an eye corner), and re-checked; if that fails too the FAP's table is
+//!    dropped. Either way it is
 //!    listed in [`CloneReport::failed_faps`] and warned about.
 //!    **`smooth`** (every method, `smooth.rs`): a motion must not crease, fold or spike where
 //!    its source does not. Target triangles whose normal turns more than 1.25× the source
@@ -448,7 +456,7 @@ fn clone_skin_motions(
             f.reason,
             f.factor,
             if f.repaired {
-                "repaired by a direct nearest-vertex transfer"
+                "repaired by a direct transfer"
             } else {
                 "its table is dropped"
             }

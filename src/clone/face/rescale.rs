@@ -1,7 +1,8 @@
 //! The RBF method's FAPU rescale (module docs of [`super`], step 6) and the guard every
 //! method's cloned motions pass afterwards: a FAP whose own feature point barely moves, or
 //! whose rescale factor is far outside the faces' FAPU ratio, is repaired by a direct
-//! nearest-vertex transfer or dropped, and reported ([`FapFailure`]).
+//! nearest-vertex transfer (or, failing that, a local move of its feature point) or dropped,
+//! and reported ([`FapFailure`]).
 
 use std::collections::BTreeMap;
 
@@ -31,8 +32,8 @@ pub struct FapFailure {
     /// The rescale factor it would have needed (expected / cloned feature-point motion;
     /// infinite, `null` in JSON, when the feature point did not move at all).
     pub factor: f64,
-    /// `true`: replaced by a direct nearest-vertex transfer that passed the check; `false`:
-    /// the FAP's table was dropped.
+    /// `true`: replaced by a direct transfer (nearest vertex, else the feature point's own
+    /// move) that passed the check; `false`: the FAP's table was dropped.
     pub repaired: bool,
 }
 
@@ -217,9 +218,9 @@ fn check(ds: f64, dt: f64, r: f64, k: Option<f64>) -> Option<String> {
 /// The guard (module docs of [`super`], step 6): checks every cloned low-level translation
 /// motion against its source; a failing one is replaced by a direct transfer (each target
 /// vertex takes the source displacement of its nearest source vertex in the aligned frame,
-/// times the FAPU ratio) and re-checked; if that fails too, every motion of that FAP is
-/// emptied and the key returned among the dropped ones. `rescaled` says whether step 6 ran
-/// (its factor is then part of the check).
+/// times the FAPU ratio), else by [`feature_point_transfer`], and re-checked; if that fails
+/// too, every motion of that FAP is emptied and the key returned among the dropped ones.
+/// `rescaled` says whether step 6 ran (its factor is then part of the check).
 pub(super) fn guard_motions(
     source: &CloneSurface,
     motions: &[SurfaceMotion],
@@ -238,9 +239,17 @@ pub(super) fn guard_motions(
             continue;
         };
         let map = nearest.get_or_insert_with(|| nearest_source_vertices(source, target));
-        let repaired = direct_transfer(src, map, r as f32);
-        let ok = measure(source, src, target, &repaired)
-            .is_some_and(|(ds2, dt2, r2)| check(ds2, dt2, r2, None).is_none());
+        let passes = |m: &SurfaceMotion| {
+            measure(source, src, target, m)
+                .is_some_and(|(ds2, dt2, r2)| check(ds2, dt2, r2, None).is_none())
+        };
+        let mut repaired = direct_transfer(src, map, r as f32);
+        if !passes(&repaired) {
+            if let Some(m) = feature_point_transfer(source, src, target) {
+                repaired = m;
+            }
+        }
+        let ok = passes(&repaired);
         *dst = if ok {
             repaired
         } else {
@@ -264,6 +273,60 @@ pub(super) fn guard_motions(
         }
     }
     failures
+}
+
+/// The last repair, for a feature point that shares its target vertex with another one: a
+/// coarse target can hold a lid point and an eye corner on one vertex (a sphere's few
+/// vertices around the eye), which the method and the direct transfer keep still. The FAP's
+/// feature point moves by the source's displacement there times the FAPU ratio, the target
+/// vertices around it with it by [`bump`] out to half the distance to the nearest other vertex
+/// holding a feature point (at most [`GAIN_REACH_ES0`] ES0): the lid still closes where its
+/// point is. `None` for a point alone on its vertex or still in the source.
+fn feature_point_transfer(
+    source: &CloneSurface,
+    src: &SurfaceMotion,
+    target: &CloneSurface,
+) -> Option<SurfaceMotion> {
+    let (fp, kind) = fap_fp(src.key, source, target)?;
+    let (sv, tv) = (source.fp_vertices[&fp], target.fp_vertices[&fp]);
+    let want = offset_at(src, sv) * fapu_ratio(source, target, kind) as f32;
+    let centre = *target.positions.get(tv as usize)?;
+    let shared = target
+        .fp_vertices
+        .iter()
+        .any(|(&id, &v)| v == tv && id != fp);
+    if !shared || want == Vec3::ZERO || !want.is_finite() {
+        return None;
+    }
+    let reach = target
+        .fp_vertices
+        .values()
+        .filter(|&&v| v != tv)
+        .filter_map(|&v| target.positions.get(v as usize))
+        .map(|p| p.distance(centre))
+        .filter(|&d| d > 0.0)
+        .fold(
+            2.0 * GAIN_REACH_ES0 * target.fapu.distances.es0 as f32,
+            f32::min,
+        )
+        / 2.0;
+    if !(reach > 0.0 && reach.is_finite()) {
+        return None;
+    }
+    let offsets = target
+        .positions
+        .iter()
+        .enumerate()
+        .filter_map(|(v, p)| {
+            let w = bump(p.distance(centre) / reach);
+            (w > 0.0).then_some((v as u32, want * w))
+        })
+        .collect();
+    Some(SurfaceMotion {
+        key: src.key,
+        value: src.value,
+        offsets,
+    })
 }
 
 /// The nearest source surface vertex of every target surface vertex (both in the aligned
@@ -356,6 +419,22 @@ mod tests {
         assert_eq!(f.len(), 1);
         assert!(!f[0].repaired);
         assert!(out[0].offsets.is_empty());
+    }
+
+    #[test]
+    fn a_feature_point_sharing_its_vertex_is_moved_alone() {
+        let s = surface(vec![Vec3::ZERO, Vec3::X, Vec3::Y], 1.0);
+        // The target's 2.5 sits on the source's still vertex 1 and shares its vertex with
+        // 2.3: the method and the direct transfer leave it still.
+        let mut t = surface(vec![Vec3::X, Vec3::ZERO, Vec3::Y], 1.0);
+        t.fp_vertices.insert(FeaturePointId::new(2, 3).unwrap(), 0);
+        let src = vec![motion(vec![(0, Vec3::new(0.0, 0.1, 0.0))])];
+        let mut out = vec![motion(vec![(1, Vec3::new(0.0, 0.1, 0.0))])];
+        let f = guard_motions(&s, &src, &t, &mut out, false);
+        assert!(f.len() == 1 && f[0].repaired, "{f:?}");
+        // 2.5 takes its source motion; the others, a unit away (beyond half an ES0), stay.
+        assert_eq!(offset_at(&out[0], 0), Vec3::new(0.0, 0.1, 0.0));
+        assert_eq!(out[0].offsets.len(), 1);
     }
 
     #[test]

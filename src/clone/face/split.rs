@@ -1,16 +1,17 @@
 //! One-mesh heads: eyes, teeth and gums that are separate connected pieces of the skin mesh
 //! (the bundled `ict`) are split into part meshes before cloning, so the rigid-part step can
-//! move them (module docs of [`super`], step 1). The split is an internal view: its index maps
+//! move them (module docs of [`super`], step 1); so are part meshes holding several parts
+//! (both eyeballs in one mesh or glTF primitive, both rows of teeth). The split is an internal view: its index maps
 //! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use glam::Vec3;
 use serde::Serialize;
 
 use super::parts::{face_diagonal, fp_mesh_vertex};
 use super::Part;
-use crate::face::{FaceMesh, FaceModel};
+use crate::face::{FaceFrames, FaceMesh, FaceModel};
 use crate::fdp::VertexBinding;
 use crate::mesh::{find_coincident_vertices, Mesh, Polygons};
 use crate::spec::FeaturePointId;
@@ -35,17 +36,30 @@ pub struct SplitPart {
     pub source_vertices: Vec<u32>,
 }
 
-/// The internal view of a one-mesh head cut into parts, with the index maps back to it.
+/// One mesh of the target cut into parts: the part meshes appended to the view, and the
+/// rest, which keeps the mesh's name.
+#[derive(Clone, Debug)]
+pub(super) struct Cut {
+    /// Name of the mesh that was cut (its rest keeps the name).
+    pub mesh: String,
+    /// What the rest is: `None` the skin of a one-mesh head, `Some(part)` the first part of a
+    /// part mesh holding several (both eyeballs, both rows of teeth).
+    pub rest: Option<Part>,
+    /// For each vertex of the rest, its vertex in the original mesh.
+    pub rest_vertices: Vec<u32>,
+}
+
+/// The internal view of a face whose meshes were cut into parts, with the index maps back to
+/// it.
 #[derive(Clone, Debug)]
 pub(super) struct SplitView {
-    /// The face with the cut mesh replaced by its skin and the part meshes appended.
+    /// The face with each cut mesh replaced by its rest and the part meshes appended.
     pub face: FaceModel,
-    /// The parts cut out (their `source_vertices` map their vertices back).
+    /// Every part of the view taken from a cut mesh (their `source_vertices` map their
+    /// vertices back), a rest that is a part included.
     pub parts: Vec<SplitPart>,
-    /// Name of the mesh that was cut (its skin keeps the name).
-    pub mesh: String,
-    /// For each vertex of the skin left in the view, its vertex in the original mesh.
-    pub skin_vertices: Vec<u32>,
+    /// The meshes cut.
+    pub cuts: Vec<Cut>,
 }
 
 /// Connected pieces of a mesh (polygon connectivity, coincident vertices joined): the piece
@@ -136,9 +150,11 @@ impl Landmarks {
 /// Splits eyeballs, teeth and gums out of the skin meshes of a face that has no such part
 /// meshes (a one-mesh head), recognised by shape and place: roughly spherical pieces near
 /// the pupils are eyeballs, pieces behind the lips near the lip line are teeth or gums of
-/// the jaw on their side (cut along the lip line when they reach well into both). Only
-/// meshes no FAT table deforms are cut (a FAT would need remapping). Returns the face (unchanged
-/// when nothing was split) and the new part meshes.
+/// the jaw on their side (cut along the lip line when they reach well into both); and cuts
+/// part meshes holding several parts' feature points (both eyeballs, both rows of teeth) into
+/// one part each. Only meshes no FAT table deforms are cut (a FAT would need remapping).
+/// Returns the face (unchanged when nothing was split) and its part meshes taken from cut
+/// meshes (a cut part mesh keeps its name for its first part).
 pub fn split_embedded_parts(face: &FaceModel) -> (FaceModel, Vec<SplitPart>) {
     match split_view(face) {
         Some(v) => (v.face, v.parts),
@@ -157,23 +173,65 @@ fn inverse(map: &BTreeMap<u32, u32>) -> Vec<u32> {
     out
 }
 
-/// [`split_embedded_parts`] with the index maps, `None` when nothing is cut.
+/// A mesh of the view by name, and its vertices' numbers there by old vertex.
+type VertexMap = (String, BTreeMap<u32, u32>);
+
+/// Where the polygons of one mesh go, before the cut.
+struct CutPlan {
+    /// The mesh (index in the face).
+    mesh: usize,
+    /// Polygons per destination (`None`: the skin).
+    dest: BTreeMap<Option<Part>, Vec<usize>>,
+    /// The destination that stays in the mesh under its name.
+    rest: Option<Part>,
+    /// Connected pieces each part gathers.
+    pieces: BTreeMap<Part, BTreeSet<usize>>,
+}
+
+/// [`split_embedded_parts`] with the index maps, `None` when nothing is cut: the skin mesh of
+/// a one-mesh head ([`chin_plan`]) and every part mesh holding several parts
+/// ([`shared_part_plans`]) are cut, unless a FAT table deforms them.
 pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
-    let lm = Landmarks::of(face)?;
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
-    // Meshes holding a skin feature point (2.1: the chin) are the candidates.
-    let chin = FeaturePointId::FP_2_1;
-    let (mi, _) = fp_mesh_vertex(face, &frames, chin, diag * 1e-4)?;
-    let name = face.meshes[mi].name.clone();
-    if face
+    let deformed: BTreeSet<&str> = face
         .fat
         .tables
         .iter()
-        .any(|t| t.meshes.iter().any(|m| m.mesh == name))
-    {
+        .flat_map(|t| t.meshes.iter().map(|m| m.mesh.as_str()))
+        .collect();
+    let chin = chin_plan(face, &frames, diag);
+    let chin_mesh = chin.as_ref().map(|p| p.mesh);
+    let mut plans: Vec<CutPlan> = chin.into_iter().collect();
+    plans.extend(shared_part_plans(face, &frames, diag, chin_mesh));
+    plans.retain(|p| !deformed.contains(face.meshes[p.mesh].name.as_str()));
+    if plans.is_empty() {
         return None;
     }
+    let mut out = face.clone();
+    let mut parts = Vec::new();
+    let mut cuts = Vec::new();
+    let mut maps = Vec::new();
+    for plan in &plans {
+        let (cut, mut cut_parts, cut_maps) = apply_cut(&mut out, face, plan);
+        cuts.push(cut);
+        parts.append(&mut cut_parts);
+        maps.push((plan.mesh, cut_maps));
+    }
+    rebind_feature_points(&mut out, face, &maps);
+    Some(SplitView {
+        face: out,
+        parts,
+        cuts,
+    })
+}
+
+/// The skin mesh of a one-mesh head (the mesh holding the chin, 2.1) with its eyes, teeth
+/// and gums as separate connected pieces: where each polygon goes.
+fn chin_plan(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Option<CutPlan> {
+    let lm = Landmarks::of(face)?;
+    let chin = FeaturePointId::FP_2_1;
+    let (mi, _) = fp_mesh_vertex(face, frames, chin, diag * 1e-4)?;
     let mesh = &face.meshes[mi].mesh;
     let world: Vec<Vec3> = mesh
         .positions
@@ -199,9 +257,8 @@ pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
             }
         })
         .collect();
-    // Polygons by destination.
     let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
-    let mut pieces: BTreeMap<Part, std::collections::BTreeSet<usize>> = BTreeMap::new();
+    let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
     for (pi, poly) in mesh.polygons.iter().enumerate() {
         let Some(&v0) = poly.first() else { continue };
         let k = piece.get(v0 as usize).copied().unwrap_or(core);
@@ -230,45 +287,178 @@ pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
     if dest.keys().all(|p| p.is_none()) {
         return None;
     }
-    let mut out = face.clone();
-    // Skin keeps its polygons and every vertex no part polygon uses (isolated ones too).
-    let mut used_by_part = vec![false; mesh.positions.len()];
-    for (p, polys) in &dest {
-        if p.is_some() {
+    Some(CutPlan {
+        mesh: mi,
+        dest,
+        rest: None,
+        pieces,
+    })
+}
+
+/// Part meshes (no skin feature point) holding the feature points of several parts — both
+/// pupils in one eyes mesh or primitive, the upper and lower teeth points in one teeth mesh —
+/// and where each of their polygons goes: a connected piece holding one part's points, or
+/// none, goes to that part (to the part of the nearest point held); a piece holding several
+/// parts' points (two eyeballs joined, teeth and gums in one piece) is cut polygon by polygon,
+/// each to the part of its nearest point. The first part stays in the mesh.
+fn shared_part_plans(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    diag: f32,
+    skip: Option<usize>,
+) -> Vec<CutPlan> {
+    // Per mesh, the part points it holds: (part, world position).
+    let mut held: BTreeMap<usize, Vec<(Part, Vec3)>> = BTreeMap::new();
+    let mut has_skin: BTreeSet<usize> = BTreeSet::new();
+    for fp in face.feature_points.iter() {
+        let Some((mi, v)) = fp_mesh_vertex(face, frames, fp.id, diag * 1e-4) else {
+            continue;
+        };
+        let Some(&q) = face.meshes[mi].mesh.positions.get(v as usize) else {
+            continue;
+        };
+        match Part::of_feature_point(fp.id) {
+            Some(p) => held
+                .entry(mi)
+                .or_default()
+                .push((p, frames.meshes[mi].transform_point3(q))),
+            None => {
+                has_skin.insert(mi);
+            }
+        }
+    }
+    let mut plans = Vec::new();
+    for (mi, points) in held {
+        let kinds: BTreeSet<Part> = points.iter().map(|p| p.0).collect();
+        if Some(mi) == skip || has_skin.contains(&mi) || kinds.len() < 2 {
+            continue;
+        }
+        let mesh = &face.meshes[mi].mesh;
+        let world: Vec<Vec3> = mesh
+            .positions
+            .iter()
+            .map(|&p| frames.meshes[mi].transform_point3(p))
+            .collect();
+        let nearest_part = |q: Vec3| {
+            points
+                .iter()
+                .min_by(|a, b| a.1.distance(q).total_cmp(&b.1.distance(q)))
+                .map(|p| p.0)
+        };
+        let (piece, count) = mesh_pieces(mesh, diag * 1e-6);
+        // Per piece: the parts of the points on it, else the part of the point nearest it.
+        let mut on_piece: Vec<BTreeSet<Part>> = vec![BTreeSet::new(); count];
+        let mut nearest: Vec<Option<(f32, Part)>> = vec![None; count];
+        for (v, &k) in piece.iter().enumerate() {
+            for &(p, q) in &points {
+                let d = world[v].distance(q);
+                if d <= diag * 1e-6 {
+                    on_piece[k].insert(p);
+                }
+                if nearest[k].is_none_or(|n| d < n.0) {
+                    nearest[k] = Some((d, p));
+                }
+            }
+        }
+        let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
+        let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
+        for (pi, poly) in mesh.polygons.iter().enumerate() {
+            let Some(&v0) = poly.first() else { continue };
+            let Some(&k) = piece.get(v0 as usize) else {
+                continue;
+            };
+            let part = if on_piece[k].len() > 1 {
+                let c = poly
+                    .iter()
+                    .filter_map(|&v| world.get(v as usize))
+                    .sum::<Vec3>()
+                    / poly.len() as f32;
+                nearest_part(c)
+            } else {
+                on_piece[k].first().copied().or(nearest[k].map(|n| n.1))
+            };
+            let Some(part) = part else { continue };
+            pieces.entry(part).or_default().insert(k);
+            dest.entry(Some(part)).or_default().push(pi);
+        }
+        if dest.len() < 2 {
+            continue;
+        }
+        let rest = dest.keys().next().copied().flatten();
+        plans.push(CutPlan {
+            mesh: mi,
+            dest,
+            rest,
+            pieces,
+        });
+    }
+    plans
+}
+
+/// Cuts `plan`'s mesh in `out` (a copy of `face`): the rest keeps the mesh's place and name,
+/// the other destinations are appended as part meshes. Returns the cut, its parts (the rest
+/// among them when it is a part) and the old → new vertex maps by mesh name, the rest first.
+fn apply_cut(
+    out: &mut FaceModel,
+    face: &FaceModel,
+    plan: &CutPlan,
+) -> (Cut, Vec<SplitPart>, Vec<VertexMap>) {
+    let mi = plan.mesh;
+    let name = face.meshes[mi].name.clone();
+    let mesh = &face.meshes[mi].mesh;
+    // The rest keeps its polygons and every vertex no other polygon uses (isolated ones too).
+    let mut used_elsewhere = vec![false; mesh.positions.len()];
+    for (p, polys) in &plan.dest {
+        if *p != plan.rest {
             for &pi in polys {
                 for &v in mesh.polygons.get(pi).unwrap_or(&[]) {
-                    if let Some(u) = used_by_part.get_mut(v as usize) {
+                    if let Some(u) = used_elsewhere.get_mut(v as usize) {
                         *u = true;
                     }
                 }
             }
         }
     }
-    let skin_polys = dest.get(&None).cloned().unwrap_or_default();
-    for &pi in &skin_polys {
+    let rest_polys = plan.dest.get(&plan.rest).cloned().unwrap_or_default();
+    for &pi in &rest_polys {
         for &v in mesh.polygons.get(pi).unwrap_or(&[]) {
-            if let Some(u) = used_by_part.get_mut(v as usize) {
+            if let Some(u) = used_elsewhere.get_mut(v as usize) {
                 *u = false;
             }
         }
     }
-    let skin_vertices: Vec<u32> = (0..mesh.positions.len() as u32)
-        .filter(|&v| !used_by_part[v as usize])
+    let rest_vertices: Vec<u32> = (0..mesh.positions.len() as u32)
+        .filter(|&v| !used_elsewhere[v as usize])
         .collect();
-    let (skin_mesh, skin_map) = sub_mesh(mesh, &skin_polys, Some(&skin_vertices));
-    let mut maps: Vec<(String, BTreeMap<u32, u32>)> = vec![(name.clone(), skin_map)];
-    out.meshes[mi].mesh = skin_mesh;
+    // A rest that is a part takes only its polygons' vertices: an unused vertex (of any part)
+    // would pull its centre and size; it stays out of the view and never moves.
+    let keep = plan.rest.is_none().then_some(rest_vertices.as_slice());
+    let (rest_mesh, rest_map) = sub_mesh(mesh, &rest_polys, keep);
     let mut report = Vec::new();
-    for (p, polys) in &dest {
-        let Some(p) = p else { continue };
-        let (m, map) = sub_mesh(mesh, polys, None);
-        let new_name = unique_mesh_name(&out, &format!("{name}_{}", p.name()));
+    if let Some(p) = plan.rest {
         report.push(SplitPart {
-            part: *p,
+            part: p,
+            from: name.clone(),
+            mesh: name.clone(),
+            vertices: rest_mesh.positions.len(),
+            pieces: plan.pieces.get(&p).map_or(0, |s| s.len()),
+            source_vertices: inverse(&rest_map),
+        });
+    }
+    let mut maps: Vec<VertexMap> = vec![(name.clone(), rest_map)];
+    out.meshes[mi].mesh = rest_mesh;
+    for (p, polys) in &plan.dest {
+        let Some(p) = p.filter(|_| *p != plan.rest) else {
+            continue;
+        };
+        let (m, map) = sub_mesh(mesh, polys, None);
+        let new_name = unique_mesh_name(out, &format!("{name}_{}", p.name()));
+        report.push(SplitPart {
+            part: p,
             from: name.clone(),
             mesh: new_name.clone(),
             vertices: m.positions.len(),
-            pieces: pieces.get(p).map_or(0, |s| s.len()),
+            pieces: plan.pieces.get(&p).map_or(0, |s| s.len()),
             source_vertices: inverse(&map),
         });
         out.meshes.push(FaceMesh {
@@ -282,49 +472,42 @@ pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
         });
         maps.push((new_name, map));
     }
-    rebind_feature_points(&mut out, face, mi, &maps);
-    Some(SplitView {
-        face: out,
-        parts: report,
-        skin_vertices: inverse(&maps[0].1),
+    let cut = Cut {
         mesh: name,
-    })
+        rest: plan.rest,
+        rest_vertices: inverse(&maps[0].1),
+    };
+    (cut, report, maps)
 }
 
-/// Feature points bound to the cut mesh follow their vertex into its new mesh.
-fn rebind_feature_points(
-    out: &mut FaceModel,
-    face: &FaceModel,
-    mi: usize,
-    maps: &[(String, BTreeMap<u32, u32>)],
-) {
+/// Feature points bound to a cut mesh (`cuts`: mesh index, its maps by new mesh name) follow
+/// their vertex into its new mesh; the others name their mesh (the face has more meshes now).
+fn rebind_feature_points(out: &mut FaceModel, face: &FaceModel, cuts: &[(usize, Vec<VertexMap>)]) {
     let ids: Vec<FeaturePointId> = face.feature_points.iter().map(|f| f.id).collect();
     for id in ids {
         let Some((m, v)) = face.fp_vertex(id) else {
             continue;
         };
-        if m != mi {
-            // Bound elsewhere: make the mesh explicit (the face has several meshes now).
-            if let Some(fp) = out.feature_points.get(id).cloned() {
-                if let Some(mut b) = fp.binding.clone() {
-                    b.mesh = Some(face.meshes[m].name.clone());
-                    let mut fp = fp;
-                    fp.binding = Some(b);
-                    out.feature_points.insert(fp);
-                }
-            }
-            continue;
-        }
-        let Some(fp) = out.feature_points.get(id).cloned() else {
+        let Some(mut fp) = out.feature_points.get(id).cloned() else {
             continue;
         };
-        let mut fp = fp;
-        fp.binding = maps.iter().find_map(|(name, map)| {
-            map.get(&v).map(|&nv| VertexBinding {
-                mesh: Some(name.clone()),
-                vertices: vec![nv],
-            })
-        });
+        match cuts.iter().find(|c| c.0 == m) {
+            Some((_, maps)) => {
+                fp.binding = maps.iter().find_map(|(name, map)| {
+                    map.get(&v).map(|&nv| VertexBinding {
+                        mesh: Some(name.clone()),
+                        vertices: vec![nv],
+                    })
+                });
+            }
+            None => {
+                let Some(mut b) = fp.binding.clone() else {
+                    continue;
+                };
+                b.mesh = Some(face.meshes[m].name.clone());
+                fp.binding = Some(b);
+            }
+        }
         out.feature_points.insert(fp);
     }
 }
