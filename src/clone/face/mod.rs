@@ -72,7 +72,7 @@
 //!    changed. Smoothed motions are listed in [`CloneReport::smoothed`].
 //!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
 //!    the FAPU-scaled source motion by a smooth gain field around it (Wendland C² bump over
-//!    half an ES0, gain 1/4–4; [`CloneReport::fapu_gain`]): a registration that put the
+//!    half an ES0, gain 1/10–10; [`CloneReport::fapu_gain`]): a registration that put the
 //!    target's feature point off the source's peak (a stylised brow onto a real one) no
 //!    longer leaves the FAP half as strong. Not with FAPU scaling off
 //!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).

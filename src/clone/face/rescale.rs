@@ -119,6 +119,11 @@ pub(super) fn rescale_to_fapu(
 const GAIN_REACH_ES0: f32 = 0.5;
 /// Compliance errors under this share of the expected motion are left alone.
 const GAIN_TOLERANCE: f64 = 0.01;
+/// Largest gain (either way). Wider than the guard's [`MAX_FACTOR_RATIO`]: a cartoon's lip
+/// corner or brow registered beside a real head's moving peak leaves the feature point
+/// 1/4–1/7 of its motion (bruno ↔ `ict`), which the smooth gain field repairs without a
+/// crease (the normal-turn ratios did not change); the guard's bound is for whole motions.
+const MAX_GAIN: f64 = 10.0;
 
 /// Wendland's C² bump `(1 − x)⁴ (4x + 1)` on `[0, 1]`, 0 beyond: 1 at the centre, flat at
 /// both ends.
@@ -142,7 +147,7 @@ fn bump(x: f32) -> f32 {
 /// still vertices stay still. A cloned motion whose registration put the feature point off
 /// the source's peak (a cartoon's brow onto a real one) so moves its feature point by the
 /// FAPU without a uniform rescale of the whole motion. Motions within 1 % of the wanted
-/// displacement, and those the guard would reject (a gain outside `[1/4, 4]`, a feature point
+/// displacement, and those beyond repair (a gain outside `[1/10, 10]`, a feature point
 /// that barely moves), are left alone. Returns the gains by FAP name and value.
 pub(super) fn gain_to_fapu(
     source: &CloneSurface,
@@ -171,7 +176,7 @@ pub(super) fn gain_to_fapu(
             continue;
         }
         let k = want.dot(got) / got.length_squared();
-        if !(k.is_finite() && (1.0 / MAX_FACTOR_RATIO..=MAX_FACTOR_RATIO).contains(&k)) {
+        if !(k.is_finite() && (1.0 / MAX_GAIN..=MAX_GAIN).contains(&k)) {
             continue;
         }
         let centre = target.positions[tv as usize];
