@@ -29,7 +29,9 @@
 //! the reach counts as an infinite gap in the median; when this step's median or cut turns
 //! out beyond the reach, the vertices without a match are searched again up to the limit.
 //! Without the bounds, the searches of the vertices with no compatible point nearby (a fifth
-//! of dense CANDIDE's on the bundled head) scanned much of the target.
+//! of dense CANDIDE's on the bundled head) scanned much of the target. Within the bounds, the
+//! search skips whole subtrees of the target's BVH whose triangles all face away or lie on
+//! the other side of a slit ([`super::filter_tree`]), which changes no match either.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
