@@ -14,7 +14,9 @@
 //! frequencies go first) while a motion's broad peak, which has no rough triangle, keeps its
 //! height; every vertex away from the defects keeps its motion exactly, and so does every
 //! low-level FAP's own feature point (its motion is what the FAP defines). A smooth clone (no
-//! triangle above `τ`, the usual case between faces of one style) is not changed at all. The fill follows mesh edges, so the open lips and lids of the target (not
+//! triangle above `τ`, the usual case between faces of one style) is not changed at all. Only a
+//! triangle with a moved corner can turn, so only those are measured, on the source and on the
+//! target. The fill follows mesh edges, so the open lips and lids of the target (not
 //! joined by edges across the slit) do not mix.
 
 use std::collections::BTreeMap;
@@ -74,6 +76,33 @@ fn rough(positions: &[Vec3], d: &[Vec3], t: &[u32; 3], n0: Vec3, cos_tau: f32) -
     n0.dot(n1) / l < cos_tau
 }
 
+/// The triangles using each of `n` vertices.
+fn incident_triangles(n: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (i, t) in triangles.iter().enumerate() {
+        for &v in t {
+            if let Some(l) = incident.get_mut(v as usize) {
+                l.push(i as u32);
+            }
+        }
+    }
+    incident
+}
+
+/// The triangles (each once, ascending) with a corner among the `offsets`' vertices: the
+/// only ones a motion can turn, so the only ones its checks need to look at.
+fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u32> {
+    let mut tris: Vec<u32> = offsets
+        .iter()
+        .filter_map(|&(v, _)| incident.get(v as usize))
+        .flatten()
+        .copied()
+        .collect();
+    tris.sort_unstable();
+    tris.dedup();
+    tris
+}
+
 /// The smoothing of every cloned motion (module docs). Returns, per smoothed motion
 /// (`name@value`), how many target vertices were re-solved.
 pub(super) fn smooth_motions(
@@ -84,14 +113,8 @@ pub(super) fn smooth_motions(
 ) -> BTreeMap<String, usize> {
     let n = target.positions.len();
     let adj = adjacency(n, &target.triangles);
-    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for (i, t) in target.triangles.iter().enumerate() {
-        for &v in t {
-            if let Some(l) = incident.get_mut(v as usize) {
-                l.push(i as u32);
-            }
-        }
-    }
+    let incident = incident_triangles(n, &target.triangles);
+    let source_incident = incident_triangles(source.positions.len(), &source.triangles);
     let tn = normals(&target.positions, &target.triangles);
     let results: Vec<Option<(String, usize)>> = motions
         .par_iter()
@@ -106,7 +129,12 @@ pub(super) fn smooth_motions(
                     *p += o;
                 }
             }
-            let theta = max_normal_turn(&source.positions, &sd, &source.triangles).angle;
+            // Only a triangle with a moved corner turns.
+            let moved: Vec<[u32; 3]> = touching(&source_incident, &src.offsets)
+                .into_iter()
+                .map(|i| source.triangles[i as usize])
+                .collect();
+            let theta = max_normal_turn(&source.positions, &sd, &moved).angle;
             let tau = SLACK * theta.max(NORMAL_TURN_FLOOR);
             if tau >= std::f64::consts::PI {
                 return None;
@@ -120,7 +148,8 @@ pub(super) fn smooth_motions(
             }
             let pos = &target.positions;
             let tris = &target.triangles;
-            let mut bad: Vec<u32> = (0..tris.len() as u32)
+            let mut bad: Vec<u32> = touching(&incident, &dst.offsets)
+                .into_iter()
                 .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
                 .collect();
             if bad.is_empty() {

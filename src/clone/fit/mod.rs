@@ -50,6 +50,7 @@
 //! pipeline's guard checks the result like every method's.
 
 mod correspond;
+mod filter_tree;
 mod regions;
 mod register;
 mod surface;

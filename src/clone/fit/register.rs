@@ -29,7 +29,9 @@
 //! the reach counts as an infinite gap in the median; when this step's median or cut turns
 //! out beyond the reach, the vertices without a match are searched again up to the limit.
 //! Without the bounds, the searches of the vertices with no compatible point nearby (a fifth
-//! of dense CANDIDE's on the bundled head) scanned much of the target.
+//! of dense CANDIDE's on the bundled head) scanned much of the target. Within the bounds, the
+//! search skips whole subtrees of the target's BVH whose triangles all face away or lie on
+//! the other side of a slit ([`super::filter_tree`]), which changes no match either.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -82,7 +84,7 @@ pub(crate) struct Registered {
 pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> Result<Registered> {
     let n = m.positions.len();
     let p: Vec<DVec3> = m.positions.iter().map(|v| v.as_dvec3()).collect();
-    let system = SmoothSystem::new(m.adjacency, opts.membrane)?;
+    let mut system = SmoothSystem::new(m.adjacency, opts.membrane)?;
     let beta = opts.landmark_weight;
     let mut lm_diag = vec![0.0; n];
     let mut lm_rhs = vec![DVec3::ZERO; n];
@@ -94,7 +96,7 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
     }
     let mut u = vec![DVec3::ZERO; n];
     let mut solves = 0;
-    let solve = |alpha: f64, w: &[f64], c: &[DVec3], u: &mut Vec<DVec3>| -> Result<()> {
+    let mut solve = |alpha: f64, w: &[f64], c: &[DVec3], u: &mut Vec<DVec3>| -> Result<()> {
         let diag: Vec<f64> = (0..n).map(|i| w[i] + lm_diag[i] + DAMPING).collect();
         let rhs: Vec<[f64; 3]> = (0..n)
             .map(|i| (w[i] * (c[i] - p[i]) + lm_rhs[i]).to_array())

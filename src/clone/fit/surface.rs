@@ -1,14 +1,14 @@
 //! Closest-point queries on a triangle surface (one parry3d BVH) filtered by slit side
 //! ([`super::regions`]) and, optionally, by normal compatibility; plus the surface's
-//! boundary, so hits on a border can be rejected.
-
-use std::collections::HashMap;
+//! boundary, so hits on a border can be rejected. Searches skip whole subtrees the filter
+//! rejects ([`super::filter_tree`]), with the same results as a filter applied per triangle.
 
 use glam::Vec3;
 use parry3d::math::Vector as PVec;
 use parry3d::query::PointQuery;
 use parry3d::shape::{CompositeShapeRef, TriMesh};
 
+use super::filter_tree::{FilterTree, NormalTest};
 use super::regions::TriMask;
 use crate::clone::tri_filter::FilteredTriMesh;
 pub(crate) use crate::mesh::geometry::{adjacency, barycentric, triangle_normals};
@@ -27,6 +27,8 @@ pub(crate) struct Hit {
 /// A surface ready for filtered closest-point queries.
 pub(crate) struct QuerySurface {
     mesh: Option<TriMesh>,
+    /// The mesh's BVH with per-node masks and normal cones (`None`: one triangle).
+    tree: Option<FilterTree>,
     positions: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
     masks: Vec<TriMask>,
@@ -67,19 +69,28 @@ impl QuerySurface {
 
 /// Per triangle, which corners face a border edge (an edge of one triangle only).
 fn border_edges(triangles: &[[u32; 3]]) -> Vec<[bool; 3]> {
-    let key = |a: u32, b: u32| (a.min(b), a.max(b));
-    let mut count: HashMap<(u32, u32), u32> = HashMap::with_capacity(triangles.len() * 2);
-    for t in triangles {
-        for k in 0..3 {
-            *count
-                .entry(key(t[(k + 1) % 3], t[(k + 2) % 3]))
-                .or_default() += 1;
+    // Every (edge, triangle, corner), sorted by edge: an edge alone in its run is a border.
+    let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+    let mut edges: Vec<(u64, u32, u8)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| {
+            (0..3u8).map(move |k| {
+                let k = k as usize;
+                (key(t[(k + 1) % 3], t[(k + 2) % 3]), i as u32, k as u8)
+            })
+        })
+        .collect();
+    edges.sort_unstable_by_key(|e| e.0);
+    let mut border = vec![[false; 3]; triangles.len()];
+    for (j, e) in edges.iter().enumerate() {
+        let alone =
+            (j == 0 || edges[j - 1].0 != e.0) && edges.get(j + 1).is_none_or(|next| next.0 != e.0);
+        if alone {
+            border[e.1 as usize][e.2 as usize] = true;
         }
     }
-    triangles
-        .iter()
-        .map(|t| std::array::from_fn(|k| count[&key(t[(k + 1) % 3], t[(k + 2) % 3])] == 1))
-        .collect()
+    border
 }
 
 impl QuerySurface {
@@ -92,12 +103,17 @@ impl QuerySurface {
         } else {
             TriMesh::new(verts, triangles.to_vec()).ok()
         };
+        let normals = triangle_normals(positions, triangles);
+        let tree = mesh
+            .as_ref()
+            .and_then(|m| FilterTree::new(m, &masks, &normals));
         QuerySurface {
             mesh,
+            tree,
             positions: positions.to_vec(),
             triangles: triangles.to_vec(),
             masks,
-            normals: triangle_normals(positions, triangles),
+            normals,
             border: border_edges(triangles),
         }
     }
@@ -115,15 +131,18 @@ impl QuerySurface {
         if !p.is_finite() {
             return None;
         }
-        let view = FilteredTriMesh {
-            mesh,
-            allowed: |i| self.allowed(filter, i),
+        let allowed = |i| self.allowed(filter, i);
+        let q = PVec::new(p.x, p.y, p.z);
+        let (tri, proj, _) = match &self.tree {
+            Some(tree) => {
+                let normal = filter
+                    .normal
+                    .map(|(n, c)| NormalTest::new(n, filter.crease, c));
+                tree.closest(mesh, q, max_dist, filter.bit, normal.as_ref(), allowed)?
+            }
+            None => CompositeShapeRef(&FilteredTriMesh { mesh, allowed })
+                .project_local_point_and_get_location(q, max_dist, false)?,
         };
-        let (tri, proj, _) = CompositeShapeRef(&view).project_local_point_and_get_location(
-            PVec::new(p.x, p.y, p.z),
-            max_dist,
-            false,
-        )?;
         let point = Vec3::new(proj.point.x, proj.point.y, proj.point.z);
         let t = self.triangles.get(tri as usize)?;
         let [a, b, c] = t.map(|v| self.positions[v as usize]);
@@ -161,10 +180,19 @@ impl QuerySurface {
         )
     }
 
-    /// Whether any triangle of the surface passes `filter`, wherever it lies (a linear scan
-    /// that stops at the first one; the BVH cannot prune a search that finds nothing).
+    /// Whether any triangle of the surface passes `filter`, wherever it lies (a walk of the
+    /// tree that skips the subtrees the filter rejects and stops at the first triangle).
     pub fn any_allowed(&self, filter: Filter) -> bool {
-        self.mesh.is_some() && (0..self.triangles.len() as u32).any(|i| self.allowed(filter, i))
+        let allowed = |i| self.allowed(filter, i);
+        match &self.tree {
+            Some(tree) => {
+                let normal = filter
+                    .normal
+                    .map(|(n, c)| NormalTest::new(n, filter.crease, c));
+                tree.any(filter.bit, normal.as_ref(), allowed)
+            }
+            None => self.mesh.is_some() && (0..self.triangles.len() as u32).any(allowed),
+        }
     }
 
     /// Whether a hit lies on the surface's border (on a border edge of its triangle).
@@ -172,5 +200,17 @@ impl QuerySurface {
         self.border
             .get(hit.triangle as usize)
             .is_some_and(|b| (0..3).any(|k| b[k] && hit.weights[k] < 1e-4))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn border_edges_are_the_edges_of_one_triangle() {
+        // Two triangles sharing edge 1-2, and a third sharing nothing.
+        let b = border_edges(&[[0, 1, 2], [2, 1, 3], [4, 5, 6]]);
+        assert_eq!(b, vec![[false, true, true], [true, true, false], [true; 3]]);
     }
 }

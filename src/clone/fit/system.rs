@@ -2,7 +2,7 @@
 //! `A_reg` the fixed smoothness matrix of the surface and `D` a diagonal of data, landmark
 //! and damping weights that changes every step. The sparsity pattern and the symbolic
 //! Cholesky factorisation are built once; each step only refactors numerically, in one
-//! thread ([`PAR`]).
+//! thread ([`PAR`]), into storage kept from step to step.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
@@ -20,6 +20,10 @@ pub(crate) struct SmoothSystem {
     /// `LᵀL + μ·Lg` values, aligned with `row_idx`.
     smooth: Vec<f64>,
     symbolic: SymbolicCholesky<u32>,
+    /// The numeric factor and the solver's scratch, reused by every solve (allocating and
+    /// touching them afresh cost about as much as a small factorisation).
+    factor: Vec<f64>,
+    scratch: Option<MemBuffer>,
 }
 
 /// Parallelism of the factorisation and solves: none. On a surface of a few thousand
@@ -128,11 +132,13 @@ impl SmoothSystem {
             row_idx,
             smooth,
             symbolic,
+            factor: Vec::new(),
+            scratch: None,
         })
     }
 
     /// Solves `(α·A_reg + diag(d)) u = b` for the three columns of `b` (row per vertex).
-    pub fn solve(&self, alpha: f64, diag: &[f64], rhs: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
+    pub fn solve(&mut self, alpha: f64, diag: &[f64], rhs: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
         let n = self.n;
         if diag.len() != n || rhs.len() != n {
             return Err(fail(FitSystemError::SizeMismatch));
@@ -145,17 +151,24 @@ impl SmoothSystem {
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         let mat = SparseColMatRef::new(sym, &vals);
         let par = PAR;
-        let mut factor = vec![0.0; self.symbolic.len_val()];
-        let scratch = self
-            .symbolic
-            .factorize_numeric_llt_scratch::<f64>(par, Default::default())
-            .or(self.symbolic.solve_in_place_scratch::<f64>(3, par));
-        let mut buffer = MemBuffer::try_new(scratch).map_err(|e| faer_error("allocation", e))?;
-        let stack = MemStack::new(&mut buffer);
+        self.factor.clear();
+        self.factor.resize(self.symbolic.len_val(), 0.0);
+        let buffer = match &mut self.scratch {
+            Some(b) => b,
+            None => {
+                let scratch = self
+                    .symbolic
+                    .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+                    .or(self.symbolic.solve_in_place_scratch::<f64>(3, par));
+                self.scratch
+                    .insert(MemBuffer::try_new(scratch).map_err(|e| faer_error("allocation", e))?)
+            }
+        };
+        let stack = MemStack::new(buffer);
         let llt = self
             .symbolic
             .factorize_numeric_llt(
-                &mut factor,
+                &mut self.factor,
                 mat,
                 Side::Lower,
                 Default::default(),
@@ -183,7 +196,7 @@ mod tests {
         // Path 0-1-2-3-4, ends held at 0 and 4 by strong diagonal weights: the middle
         // follows smoothly and symmetrically.
         let adj: Vec<Vec<u32>> = vec![vec![1], vec![0, 2], vec![1, 3], vec![2, 4], vec![3]];
-        let s = SmoothSystem::new(&adj, 0.0).unwrap();
+        let mut s = SmoothSystem::new(&adj, 0.0).unwrap();
         let w = 1e6;
         let diag = [w, 1e-9, 1e-9, 1e-9, w];
         let mut rhs = vec![[0.0; 3]; 5];
