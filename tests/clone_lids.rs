@@ -319,10 +319,12 @@ fn gaps(posed: &[Vec<Vec3>], m: &[Band]) -> Vec<f32> {
         .collect()
 }
 
-/// Vertices of the face's eyeballs (cut parts of a one-mesh head).
+/// Vertices of the face's eyeballs (cut parts of a one-mesh head: the output cut again, as
+/// `fit` keeps a head of the source's mesh whole).
 fn eyeball_vertices(out: &CloneOutcome, part: Part) -> HashSet<(usize, u32)> {
-    out.report
-        .split_parts
+    let bare = fbakit::export::picture::strip_fat(&out.face);
+    fbakit::clone::face::split_embedded_parts(&bare)
+        .1
         .iter()
         .filter(|s| s.part == part)
         .flat_map(|s| s.source_vertices.iter().map(|&v| (0usize, v)))

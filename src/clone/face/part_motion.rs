@@ -72,7 +72,10 @@ pub(super) fn part_motions(
     }
     let mut around: Vec<Vec<u32>> = vec![Vec::new(); inner.len()];
     for (t, tri) in src.triangles.iter().enumerate() {
-        if tri.iter().all(|&v| slot.get(v as usize).is_some_and(|&k| k != u32::MAX)) {
+        if tri
+            .iter()
+            .all(|&v| slot.get(v as usize).is_some_and(|&k| k != u32::MAX))
+        {
             for &v in tri {
                 around[slot[v as usize] as usize].push(t as u32);
             }
@@ -87,10 +90,7 @@ pub(super) fn part_motions(
             .iter()
             .map(|&p| frame.point(world.transform_point3(p)))
             .collect();
-        let near: Vec<(u32, f32)> = q
-            .iter()
-            .filter_map(|&p| index.nearest_vertex(p))
-            .collect();
+        let near: Vec<(u32, f32)> = q.iter().filter_map(|&p| index.nearest_vertex(p)).collect();
         if near.len() != q.len() || q.len() < 3 {
             continue;
         }
@@ -147,7 +147,10 @@ fn place(p: Vec3, v: u32, tris: &[u32], src: &crate::clone::CloneSurface) -> Pla
         vertices: [v; 3],
         weights: [1.0, 0.0, 0.0],
     };
-    let mut best_d = src.positions.get(v as usize).map_or(f32::INFINITY, |q| q.distance(p));
+    let mut best_d = src
+        .positions
+        .get(v as usize)
+        .map_or(f32::INFINITY, |q| q.distance(p));
     for &t in tris {
         let Some(tri) = src.triangles.get(t as usize) else {
             continue;
