@@ -90,9 +90,11 @@ pub(super) fn same_polygons(a: &crate::mesh::Polygons, b: &crate::mesh::Polygons
 }
 
 /// [`build_skin_surface`], welded and triangulated exactly as `like` when both skins are
-/// one mesh (the same vertex count and polygons, [`same_polygons`]): a face and its reshaped or rescaled copy may have seams that
-/// coincide on one and not on the other, and the same welding keeps their surfaces one mesh
-/// (so [`fit`](crate::clone::fit) matches them vertex to vertex).
+/// one mesh (the same vertex count and polygons, but for one in a thousand polygons: a rig's
+/// identities exported apart may split a few quads along the other diagonal): a face and its
+/// reshaped or rescaled copy may have seams that coincide on one and not on the other, or
+/// quads convex on one and not on the other, and the same welding and triangles keep their
+/// surfaces one mesh (so [`fit`](crate::clone::fit) matches them vertex to vertex).
 pub fn build_skin_surface_like(
     face: &FaceModel,
     skin: &[usize],
