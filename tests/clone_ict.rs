@@ -104,17 +104,18 @@ fn both_cloners_against_the_real_head_truth() {
                 eprintln!("    {:<22} {:6.1} %", k.key, k.all);
             }
             // The targets are median ≤ 10 % and no FAP above 100 % (fit: ≤ 4 %).
-            // Measured on B and B×10: fmc median 7.4 %, worst thrust_jaw 15.9 %; rbf median
-            // 5.5 %, worst thrust_jaw 14.1 % (without refinement rounds, its default); fit
-            // median 2.2 %, worst thrust_jaw 13.8 % (the jaw error is the rigid teeth and
-            // gums: on the skin alone open_jaw is 1.7 %). The subdivided target scores a little
-            // higher (rbf median 9.0 %, fit 2.3 %; fit gave 2.6 % and 3.3 % before its lid
-            // and lip slit handling). The limits are those figures with a small margin, to
-            // catch regressions.
+            // Measured (since the split teeth and gums take the source's motion vertex by
+            // vertex, not one rigid motion; thrust_jaw was the worst FAP of every method at
+            // 13.8–15.9 % before): fmc median 3.2–3.3 %, worst stretch_r_cornerlip 6.5 %; rbf
+            // 2.2–2.3 %, worst open_jaw 5.9 %. fit matches B and B×10, one mesh with A,
+            // vertex to vertex (0.0 %); on the subdivided B it registers: median 2.3 %, worst
+            // open_jaw 5.7 % (2.3 % and 13.8 % before). The limits are those figures with a
+            // small margin, to catch regressions.
             let (med_max, worst_max) = match m {
-                Method::Fmc => (9.0, 18.0),
-                Method::Rbf => (9.5, 18.0),
-                Method::Fit => (3.0, 15.0),
+                Method::Fmc => (4.0, 8.0),
+                Method::Rbf => (3.0, 7.0),
+                Method::Fit if ci < 2 => (0.1, 0.1),
+                Method::Fit => (2.6, 7.0),
             };
             assert!(med <= med_max, "{m:?} case {ci}: median {med}");
             assert!(worst.all < worst_max, "{m:?} case {ci}: {worst:?}");
@@ -128,15 +129,15 @@ fn eyeballs_stay_still() {
     for case in cases.iter() {
         for (m, out, _) in &case.clones {
             let face = &out.face;
-            // The cut parts are an internal view: the eyeballs are vertices of the head's
-            // one mesh, found through the cut's index maps.
-            let eye_parts: Vec<&fbakit::clone::face::SplitPart> = out
-                .report
-                .split_parts
+            // The eyeballs are vertices of the head's one mesh (the clone's cut, if it made
+            // one, is an internal view; `fit` keeps a head of the source's mesh whole): found
+            // by cutting the output the same way.
+            let (_, split) = fbakit::clone::face::split_embedded_parts(&strip_fat(face));
+            let eye_parts: Vec<&fbakit::clone::face::SplitPart> = split
                 .iter()
                 .filter(|s| matches!(s.part, Part::LeftEye | Part::RightEye))
                 .collect();
-            assert_eq!(eye_parts.len(), 2, "{:?}", out.report.split_parts);
+            assert_eq!(eye_parts.len(), 2, "{split:?}");
             assert_eq!(face.meshes.len(), 1);
             let eyes: Vec<(usize, usize)> = eye_parts
                 .iter()

@@ -183,19 +183,31 @@ fn every_mode_on_identity_heads() {
         }
     }
     // Issue 21's targets for the default modes: median ≤ 8 % on every real-head case
-    // (measured 5.7–6.9 % fmc, 4.4–5.0 % rbf). The papers' modes stay as printed: far
-    // behind (29–34 %).
+    // (measured 4.6–4.8 % fmc, worst FAP 5.9 %; 3.2–3.4 % rbf, worst 4.3 %, since the split
+    // teeth and gums take the source's motion vertex by vertex: 5.2–5.4 % and 3.5–3.6 %,
+    // worst thrust_jaw 11.5 %, before). fit: the identities of the source's own mesh are
+    // matched vertex to vertex (0.0 %); the 4× denser head goes through the registration:
+    // median 3.4 %, worst stretch_r_cornerlip 4.2 % (3.6 % and thrust_jaw 11.2 % before).
+    // The issue asks median ≤ 3 % and no FAP over 15 %. The papers' modes stay as printed:
+    // far behind (28–34 %).
     for c in cases {
         for r in &c.rows {
             assert!(r.median.is_finite() && r.worst.1.is_finite());
             match r.mode {
-                Mode::Fmc | Mode::Rbf => {
+                Mode::Fmc | Mode::Rbf | Mode::Fit => {
+                    let (med, worst) = match r.mode {
+                        Mode::Fmc => (5.5, 7.0),
+                        Mode::Rbf => (4.0, 5.0),
+                        _ if c.name.contains("dense") => (3.6, 5.0),
+                        _ => (0.1, 0.1),
+                    };
                     assert!(
-                        r.median <= 8.0,
-                        "{} {:?}: median {}",
+                        r.median <= med && r.worst.1 <= worst,
+                        "{} {:?}: median {}, worst {:?}",
                         c.name,
                         r.mode,
-                        r.median
+                        r.median,
+                        r.worst
                     )
                 }
                 Mode::FmcPaper | Mode::RbfPaper => {

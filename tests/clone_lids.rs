@@ -319,10 +319,12 @@ fn gaps(posed: &[Vec<Vec3>], m: &[Band]) -> Vec<f32> {
         .collect()
 }
 
-/// Vertices of the face's eyeballs (cut parts of a one-mesh head).
+/// Vertices of the face's eyeballs (cut parts of a one-mesh head: the output cut again, as
+/// `fit` keeps a head of the source's mesh whole).
 fn eyeball_vertices(out: &CloneOutcome, part: Part) -> HashSet<(usize, u32)> {
-    out.report
-        .split_parts
+    let bare = fbakit::export::picture::strip_fat(&out.face);
+    fbakit::clone::face::split_embedded_parts(&bare)
+        .1
         .iter()
         .filter(|s| s.part == part)
         .flat_map(|s| s.source_vertices.iter().map(|&v| (0usize, v)))
@@ -465,24 +467,27 @@ fn candide_known_fat_cases() {
     }
 }
 
-/// Issue 21's real-head targets for `fit`, as far as they are met: no FAP over 15 %, the
-/// eyelids under 6 % (measured 3.2–4.4 %), median ≤ 4.5 % (measured 3.5–4.3 %; the issue
-/// asks 3 %: the jaw FAPs, 7–11 %, are the rigid teeth and gums), no FAP repaired or
-/// dropped by the guard, eyeballs still under every FAP, the target's own layout; the lids
-/// meet and the lips open as the truth's.
+/// Issue 21's real-head targets for `fit`, as far as they are met: no FAP over 6 % (the
+/// issue: 15 %; measured worst 4.8 %), the eyelids under 5 % (measured 0.0 % on the
+/// identities of the source's own mesh, matched vertex to vertex, 3.4–4.4 % on the denser
+/// ones), median ≤ 3.8 % (measured 0.0 % and 3.4–3.6 %; the issue asks 3 %: the denser
+/// heads go through the registration; before the split teeth and gums took the source's
+/// motion vertex by vertex the jaw FAPs were 7–11 %), no FAP repaired or dropped by the
+/// guard, eyeballs still under every FAP, the target's own layout; the lids meet and the
+/// lips open as the truth's.
 #[test]
 fn ict_identity_cases() {
     let cases = ict_cases();
     for c in cases {
         let r = &c.report;
-        assert!(r.median_all <= 4.5, "{}: median {}", c.name, r.median_all);
+        assert!(r.median_all <= 3.8, "{}: median {}", c.name, r.median_all);
         for k in &r.keys {
-            assert!(k.all <= 15.0, "{}: {} {:.1} %", c.name, k.key, k.all);
+            assert!(k.all <= 6.0, "{}: {} {:.1} %", c.name, k.key, k.all);
         }
         let lids = eyelid_errors(c);
         assert_eq!(lids.len(), 2, "{}", c.name);
         for (k, e) in lids {
-            assert!(e <= 6.0, "{}: {k} {e:.1} %", c.name);
+            assert!(e <= 5.0, "{}: {k} {e:.1} %", c.name);
         }
         assert!(
             c.outcome.report.failed_faps.is_empty(),

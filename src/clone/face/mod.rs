@@ -22,6 +22,11 @@
 //!    by connected pieces, a piece going to the part whose points it holds or lie nearest,
 //!    polygon by polygon when one piece holds several parts' points. Each eye then turns
 //!    about its own centre and the lower row follows the jaw; step 9 folds them back.
+//!    With `fit`, a target that is one mesh with the source's only skin mesh (the same
+//!    vertex count and polygons, but for a few quads split along the other diagonal: another
+//!    identity of a rig's model) is not cut: the source moves its eyes, teeth and gums through its skin FAT, and `fit` carries
+//!    that vertex to vertex ([`super::fit`], "One topology") — eyeballs keep the source's
+//!    motion (none under a lid FAP), the gums stretch as the source's do.
 //! 2. **`align`** — a similarity (scale, rotation, translation; Umeyama's SVD solution) that
 //!    puts the target's feature points onto the source's, least squares over every point both
 //!    faces have. The target is cloned in that aligned frame (so a target modelled at another
@@ -98,9 +103,10 @@
 //!    motion has no rigid equivalent (tongue roll) and deformations of other non-skin meshes
 //!    (pupil dilation) are dropped with a warning. Parts cut out of a one-mesh target that
 //!    the source has no part mesh for (a one-mesh source moves its teeth through the skin
-//!    FAT) take the source displacements at their nearest source skin vertices (when the
-//!    source has geometry there: median gap under 0.5 % of its size), times the FAPU ratio,
-//!    reduced to their best rigid motion.
+//!    FAT) take, vertex by vertex, the source displacement where they lie on its inner
+//!    pieces (closest point around the nearest inner vertex, barycentric; when the source has
+//!    geometry there: median gap under 0.5 % of its size), times the FAPU ratio — not one
+//!    rigid motion per part: a rig's gums and tongue stretch with the jaw (`part_motion`).
 //! 8. **`fat`** — per target skin mesh the face-frame displacements go back to the mesh frame
 //!    (inverse world 3×3) and [`fat_from_morph_targets`] rebuilds the tables (multi-interval
 //!    tables keep their borders); transform entries are appended. Every output number must be
@@ -236,13 +242,21 @@ pub fn clone_face(
     // The target's own FAT is replaced anyway; without it its skin mesh can be cut.
     let mut bare = target.clone();
     bare.fat = Fat::default();
-    let view = split::split_view(&bare);
+    let sparts = identify_parts(source);
+    // `fit` onto one mesh with the source's skin needs no cut (module docs, step 1).
+    let whole = opts.method == Method::Fit
+        && opts.fit.shared_topology
+        && one_mesh_with(source, &sparts, &bare);
+    let view = if whole {
+        None
+    } else {
+        split::split_view(&bare)
+    };
     let (split_target, split) = match &view {
         Some(v) => (v.face.clone(), v.parts.clone()),
         None => (bare.clone(), Vec::new()),
     };
     let target = &split_target;
-    let sparts = identify_parts(source);
     let mut tparts = identify_parts(target);
     for s in &split {
         if let Some(mi) = target.mesh_index(&s.mesh) {
@@ -481,6 +495,21 @@ fn clone_skin_motions(
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
     Ok(result.motions)
+}
+
+/// Whether `target` is one mesh with the source's only skin mesh: the same vertex count and
+/// polygons ([`skin_surface::same_polygons`]: a rig head and another identity of its model,
+/// or its reshaped copy).
+fn one_mesh_with(source: &FaceModel, sparts: &FaceParts, target: &FaceModel) -> bool {
+    let [s] = sparts.skin.as_slice() else {
+        return false;
+    };
+    let [t] = target.meshes.as_slice() else {
+        return false;
+    };
+    let s = &source.meshes[*s].mesh;
+    s.positions.len() == t.mesh.positions.len()
+        && skin_surface::same_polygons(&s.polygons, &t.mesh.polygons)
 }
 
 /// A face (`side` = "source" or "target") needs a skin mesh.

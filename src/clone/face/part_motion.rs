@@ -1,13 +1,22 @@
-//! Rigid motion for target parts the source moves by deformation: a one-mesh source (a rig
-//! face such as ICT's, its eyes and teeth inside the skin mesh) moves its teeth with the jaw
-//! through the skin FAT, so no source transform drives the target's split-out teeth. Each
-//! such target part (teeth and gums; eyeballs move by eye rotations only) takes the source displacements at its nearest source skin vertices
-//! (aligned frame, times the FAPU ratio) and keeps only their best rigid motion (module docs
-//! of [`super`], step 7).
+//! Motion for target parts the source moves by deformation: a one-mesh source (a rig face
+//! such as ICT's, its eyes, teeth, gums and tongue inside the skin mesh) moves its teeth with
+//! the jaw through the skin FAT, so no source transform drives the target's split-out teeth.
+//! Each such target part (teeth, gums and tongue; eyeballs move by eye rotations only) takes,
+//! vertex by vertex, the source displacement where it lies on the source's inner pieces
+//! (closest point among the triangles around its nearest inner vertex, barycentric weights;
+//! aligned frame, times the FAPU ratio) — module docs of [`super`], step 7.
+//!
+//! Not reduced to one rigid motion per part: a rig's gums and tongue stretch where the jaw
+//! opens (ICT blends them across the lip line), and the part's best rigid motion put
+//! open_jaw 7.6 % and thrust_jaw 11.4 % off the ICT identities' true FATs (per vertex: 2.6
+//! and 3.1 %). A source part that moves rigidly hands on a motion that is rigid up to its
+//! interpolation.
 
 use std::collections::HashMap;
 
 use glam::{DMat3, DVec3, Vec3};
+
+use crate::mesh::geometry::barycentric;
 
 use super::{FaceParts, Part, Similarity, SkinSurface, SplitPart};
 use crate::clone::SurfaceMotion;
@@ -22,8 +31,8 @@ use crate::spec::FapuKind;
 /// size (median): the source has the part's geometry in its skin, not just skin nearby.
 const MAX_MEDIAN_GAP: f32 = 0.005;
 
-/// Per source motion (key, value bits), the rigid displacements of the target's split parts
-/// the source has no part mesh for.
+/// Per source motion (key, value bits), the displacements of the target's split parts the
+/// source has no part mesh for.
 pub(super) fn part_motions(
     sparts: &FaceParts,
     split: &[SplitPart],
@@ -56,6 +65,22 @@ pub(super) fn part_motions(
             .map(|&v| src.positions[v as usize])
             .collect::<Vec<_>>(),
     );
+    // Inner triangles around each inner vertex (by its index in `inner`).
+    let mut slot = vec![u32::MAX; src.positions.len()];
+    for (k, &v) in inner.iter().enumerate() {
+        slot[v as usize] = k as u32;
+    }
+    let mut around: Vec<Vec<u32>> = vec![Vec::new(); inner.len()];
+    for (t, tri) in src.triangles.iter().enumerate() {
+        if tri
+            .iter()
+            .all(|&v| slot.get(v as usize).is_some_and(|&k| k != u32::MAX))
+        {
+            for &v in tri {
+                around[slot[v as usize] as usize].push(t as u32);
+            }
+        }
+    }
     let frames = face.frames();
     for mi in todo {
         let world = frames.meshes[mi];
@@ -65,11 +90,7 @@ pub(super) fn part_motions(
             .iter()
             .map(|&p| frame.point(world.transform_point3(p)))
             .collect();
-        let near: Vec<(u32, f32)> = q
-            .iter()
-            .filter_map(|&p| index.nearest_vertex(p))
-            .map(|(k, d)| (inner[k as usize], d))
-            .collect();
+        let near: Vec<(u32, f32)> = q.iter().filter_map(|&p| index.nearest_vertex(p)).collect();
         if near.len() != q.len() || q.len() < 3 {
             continue;
         }
@@ -78,25 +99,29 @@ pub(super) fn part_motions(
         if gaps[gaps.len() / 2] > MAX_MEDIAN_GAP * size {
             continue;
         }
+        let places: Vec<Place> = q
+            .iter()
+            .zip(&near)
+            .map(|(&p, &(k, _))| place(p, inner[k as usize], &around[k as usize], src))
+            .collect();
         let inv: DMat3 = world.matrix3.as_dmat3().inverse();
-        let from: Vec<DVec3> = q.iter().map(|p| p.as_dvec3()).collect();
         for m in motions {
             let ratio = fapu_ratio(m.key, ssurf, tsurf);
-            let to: Vec<DVec3> = from
+            let offsets: Vec<DVec3> = places
                 .iter()
-                .zip(&near)
-                .map(|(p, n)| *p + offset_at(m, n.0).as_dvec3() * ratio)
+                .map(|pl| {
+                    let d: DVec3 = pl
+                        .vertices
+                        .iter()
+                        .zip(&pl.weights)
+                        .map(|(&v, &w)| offset_at(m, v).as_dvec3() * f64::from(w))
+                        .sum();
+                    inv * frame.inverse_vector(d * ratio)
+                })
                 .collect();
-            if from.iter().zip(&to).all(|(a, b)| a == b) {
+            if offsets.iter().all(|d| *d == DVec3::ZERO) {
                 continue;
             }
-            let Some(rigid) = rigid_fit(&from, &to) else {
-                continue;
-            };
-            let offsets: Vec<DVec3> = from
-                .iter()
-                .map(|&p| inv * frame.inverse_vector(rigid_point(&rigid, p) - p))
-                .collect();
             out.entry((m.key, m.value.to_bits()))
                 .or_default()
                 .push(MorphMesh {
@@ -109,20 +134,39 @@ pub(super) fn part_motions(
     out
 }
 
-/// Best rotation and translation taking `from` onto `to` (the similarity fit with its scale
-/// set to 1: a part does not grow).
-fn rigid_fit(from: &[DVec3], to: &[DVec3]) -> Option<Similarity> {
-    let mut s = Similarity::fit(from, to).ok()?;
-    let n = from.len() as f64;
-    let mf = from.iter().sum::<DVec3>() / n;
-    let mt = to.iter().sum::<DVec3>() / n;
-    s.scale = 1.0;
-    s.translation = mt - s.rotation * mf;
-    s.translation.is_finite().then_some(s)
+/// Where a target vertex lies on the source: up to three source vertices and their weights.
+struct Place {
+    vertices: [u32; 3],
+    weights: [f32; 3],
 }
 
-fn rigid_point(s: &Similarity, p: DVec3) -> DVec3 {
-    s.rotation * p * s.scale + s.translation
+/// `p`'s closest point among the source triangles `tris` around its nearest source vertex
+/// `v` (barycentric, clamped to each triangle); `v` itself without such triangles.
+fn place(p: Vec3, v: u32, tris: &[u32], src: &crate::clone::CloneSurface) -> Place {
+    let mut best = Place {
+        vertices: [v; 3],
+        weights: [1.0, 0.0, 0.0],
+    };
+    let mut best_d = src
+        .positions
+        .get(v as usize)
+        .map_or(f32::INFINITY, |q| q.distance(p));
+    for &t in tris {
+        let Some(tri) = src.triangles.get(t as usize) else {
+            continue;
+        };
+        let [a, b, c] = tri.map(|k| src.positions[k as usize]);
+        let w = barycentric(p, a, b, c);
+        let d = (a * w[0] + b * w[1] + c * w[2]).distance(p);
+        if d < best_d {
+            best_d = d;
+            best = Place {
+                vertices: *tri,
+                weights: w,
+            };
+        }
+    }
+    best
 }
 
 fn offset_at(m: &SurfaceMotion, v: u32) -> Vec3 {

@@ -33,6 +33,8 @@ pub struct SkinSurface {
     pub referenced: Vec<bool>,
     /// The concatenated meshes' triangles (before welding).
     concat_triangles: Vec<[u32; 3]>,
+    /// The skin meshes' polygons, in concatenation order.
+    polygons: Vec<crate::mesh::Polygons>,
     /// Concatenated vertices of each surface vertex (CSR: `members[member_start[w]..[w+1]]`).
     member_start: Vec<u32>,
     members: Vec<u32>,
@@ -63,10 +65,36 @@ pub fn build_skin_surface(
     build_skin_surface_like(face, skin, frame, None)
 }
 
-/// [`build_skin_surface`], welded exactly as `like` when both skins are one mesh (the same
-/// vertex count and polygons): a face and its reshaped or rescaled copy may have seams that
-/// coincide on one and not on the other, and the same welding keeps their surfaces one mesh
-/// (so [`fit`](crate::clone::fit) matches them vertex to vertex).
+/// Share of polygons that may differ between two meshes that are still one mesh (a rig's
+/// identities exported apart: ICT's identity sample splits 4 of its 24 418 quads along the
+/// other diagonal).
+const DIFFERENT_POLYGONS: f64 = 0.001;
+
+/// Whether two polygon lists are one mesh's: as many polygons, each with the same corners in
+/// the same place of the list (in any order), but for [`DIFFERENT_POLYGONS`] of them.
+pub(super) fn same_polygons(a: &crate::mesh::Polygons, b: &crate::mesh::Polygons) -> bool {
+    if a.len() != b.len() {
+        return false;
+    }
+    let sorted = |p: &[u32]| {
+        let mut v = p.to_vec();
+        v.sort_unstable();
+        v
+    };
+    let differ = a
+        .iter()
+        .zip(b.iter())
+        .filter(|(p, q)| p.len() != q.len() || sorted(p) != sorted(q))
+        .count();
+    differ as f64 <= DIFFERENT_POLYGONS * a.len() as f64
+}
+
+/// [`build_skin_surface`], welded and triangulated exactly as `like` when both skins are
+/// one mesh (the same vertex count and polygons, but for one in a thousand polygons: a rig's
+/// identities exported apart may split a few quads along the other diagonal): a face and its
+/// reshaped or rescaled copy may have seams that coincide on one and not on the other, or
+/// quads convex on one and not on the other, and the same welding and triangles keep their
+/// surfaces one mesh (so [`fit`](crate::clone::fit) matches them vertex to vertex).
 pub fn build_skin_surface_like(
     face: &FaceModel,
     skin: &[usize],
@@ -75,7 +103,23 @@ pub fn build_skin_surface_like(
 ) -> Result<SkinSurface> {
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
-    let (positions, triangles, starts) = concatenate_skin(face, &frames, skin, frame);
+    let (positions, mut triangles, starts) = concatenate_skin(face, &frames, skin, frame);
+    let polygons: Vec<crate::mesh::Polygons> = skin
+        .iter()
+        .map(|&mi| face.meshes[mi].mesh.polygons.clone())
+        .collect();
+    // One mesh with `like`: its triangulation too (a quad convex on one face and not on the
+    // other would be split along another diagonal, and the two would no longer be one mesh).
+    if let Some(l) = like {
+        let same = l.polygons.len() == polygons.len()
+            && l.polygons
+                .iter()
+                .zip(&polygons)
+                .all(|(a, b)| same_polygons(a, b));
+        if l.welded.len() == positions.len() && same {
+            triangles.clone_from(&l.concat_triangles);
+        }
+    }
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
         return Err(CloneError::NonFiniteSkin {
             face: face.name.clone(),
@@ -140,6 +184,7 @@ pub fn build_skin_surface_like(
         welded,
         referenced,
         concat_triangles: triangles,
+        polygons,
         member_start,
         members,
     })

@@ -38,7 +38,11 @@
 //! template — vertex `i` of the target *is* vertex `i` of the source, so steps 1–3 are
 //! skipped and each target vertex takes its own vertex's motion (times the FAPU ratio). A
 //! registration could only approximate that correspondence
-//! ([`FitOptions::shared_topology`] turns it off).
+//! ([`FitOptions::shared_topology`] turns it off). Whole faces keep a one-mesh target that
+//! is one mesh with the source whole for this ([`crate::clone::face`], step 1): cut into
+//! eyes, teeth and skin, its skin would no longer match the source's, and a registration
+//! put the ICT identities' lids 3–4 % and their jaws 3 % off their true FATs (vertex to
+//! vertex: 0.0 %).
 //!
 //! The source is registered onto the target, not the other way: the source's motion field
 //! is what must be sampled, and the target vertices then sample it where the registered
