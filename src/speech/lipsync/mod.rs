@@ -24,6 +24,7 @@
 
 pub mod activity;
 pub mod alignment;
+pub mod closures;
 pub mod coarticulation;
 pub mod evaluation;
 pub mod features;
@@ -296,7 +297,9 @@ pub fn lipsync_transcript_at(
     ))
 }
 
-/// Phones recognised in the recording (ARPAbet, [`recognition`]) to a lip sync at `fps`.
+/// Phones recognised in the recording (ARPAbet, [`recognition`]) to a lip sync at `fps`;
+/// lip closures the recogniser missed are found in the sound ([`closures`]) and added as
+/// short `B` phones.
 pub fn lipsync_recognised(
     rec: &RecordingAnalysis,
     phones: Vec<AlignedPhone>,
@@ -322,6 +325,8 @@ pub fn lipsync_recognised(
         .into());
     }
     let confidence = spoken.iter().map(|p| p.confidence).sum::<f64>() / spoken.len() as f64;
+    let found = closures::acoustic_closures(&rec.frames, &phones);
+    let phones = closures::with_closures(phones, &found);
     Ok(finish(
         rec,
         phones,
