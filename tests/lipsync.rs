@@ -227,13 +227,17 @@ fn without_a_transcript_english_phones_are_recognised() {
 
 /// The figures without a transcript on part of the evaluation (`examples/lipsync_eval.rs`
 /// has them all), pinned as regression bounds a little below what was measured: PocketSphinx
-/// phones plus the closures found in the sound (`speech::lipsync::closures`). They are below
-/// the targets (80 % closures, 70 % agreement, 3 % false closures) on these espeak-ng
-/// voices; see the module's notes.
-const BOUND_CLOSURES: f64 = 0.0;
-const BOUND_AGREEMENT: f64 = 0.0;
-const BOUND_FALSE: f64 = 1.0;
-const BOUND_CONSONANT: f64 = 1.0;
+/// phones plus the closures found in the sound (`speech::lipsync::closures`). The closures and
+/// the agreement are below the targets (80 %, 70 %) on these espeak-ng voices.
+// Measured on this subset (3 conditions × 4 sentences): closures 0.410 (32/78), agreement
+// 0.600, false closures 0.027, PP on other consonants 0.091 when the test runs alone; 0.359,
+// 0.580, 0.027, 0.092 beside the other tests of this file (espeak-ng's renditions then
+// differ a little: its engine is shared). On the whole evaluation the closures shown went
+// from 26 % with PocketSphinx's phones alone to 53 %.
+const BOUND_CLOSURES: f64 = 0.33;
+const BOUND_AGREEMENT: f64 = 0.55;
+const BOUND_FALSE: f64 = 0.035;
+const BOUND_CONSONANT: f64 = 0.11;
 
 #[test]
 fn without_a_transcript_the_figures_hold() {

@@ -9,6 +9,10 @@
 //! viseme keys. (Moving m/b/p closures onto the recording's energy dips was tried and
 //! measured: it showed fewer closures on the evaluation set, so it is not done.)
 //!
+//! Without a transcript (English only), PocketSphinx recognises the phones
+//! ([`recognition`]) and [`closures`] adds the lip closures the sound shows that the phones
+//! miss ([`lipsync_recognised`]).
+//!
 //! The recording is read a chunk at a time ([`analyse_chunks`]): only its features (about
 //! 60 bytes per 10 ms) are kept, and the warp's memory grows linearly with the length. The
 //! transcript's rendition is spoken a few sentences at a time and kept as features too
