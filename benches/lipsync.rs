@@ -1,6 +1,7 @@
 //! Lip sync's own work on 10 s of audio (espeak-ng's synthesis left out, so the bench runs
-//! without it): MFCC features of a 16 kHz recording, and the coarse-to-fine warp between
-//! two 10 s feature sequences that differ in speed. Real-time factor = 10 s / the sum.
+//! without it): MFCC features of a 16 kHz recording, the coarse-to-fine warp between
+//! two 10 s feature sequences that differ in speed, and the search for lip closures in the
+//! sound (lip sync without a transcript). Real-time factor = 10 s / the sum.
 //!
 //! Run: `cargo bench --bench lipsync`
 
@@ -46,4 +47,11 @@ fn warp_10s(bencher: divan::Bencher) {
     let a = normalise(&features(&signal(1.0)));
     let b = normalise(&features(&signal(1.2)));
     bencher.bench(|| warp(divan::black_box(&a), divan::black_box(&b), 12, 1.0));
+}
+
+#[divan::bench]
+fn acoustic_closures_10s(bencher: divan::Bencher) {
+    let f = features(&signal(1.0));
+    bencher
+        .bench(|| fbakit::speech::lipsync::closures::acoustic_closures(divan::black_box(&f), &[]));
 }

@@ -115,6 +115,8 @@ pub struct CaseResult {
     pub confidence: f64,
     /// Without the transcript (PocketSphinx), when asked for and installed.
     pub recognised: Option<LipsyncScore>,
+    /// Time to analyse and recognise without the transcript (no video), wall clock.
+    pub recognised_seconds: f64,
 }
 
 fn frames_of(keys: &[fbakit::speech::VisemeKey], duration: f64, fps: f64) -> Vec<VisemeParams> {
@@ -137,13 +139,12 @@ pub fn run_case(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<Ca
     run_case_with(text, c, fps, false)
 }
 
-/// Runs one sentence under one condition; also without the transcript when `recognise`.
-pub fn run_case_with(
+/// A recording of `text` under condition `c` in a temporary directory: the directory (kept
+/// while the file is used), the file, and its phones with their times.
+pub fn make_recording(
     text: &str,
     c: &Condition,
-    fps: f64,
-    recognise: bool,
-) -> fbakit::error::Result<CaseResult> {
+) -> fbakit::error::Result<(tempfile::TempDir, std::path::PathBuf, Vec<TimedPhoneme>)> {
     let recording = speak_at(text, c.voice, c.rate)?;
     let (wav, truth) = degrade(&recording, &c.degradation)?;
     let dir = tempfile::tempdir().map_err(|e| fbakit::error::Error::io("tempdir", e))?;
@@ -165,17 +166,41 @@ pub fn run_case_with(
         }
         path = mp3;
     }
+    Ok((dir, path, truth))
+}
+
+/// The score of one sentence under one condition without its transcript (PocketSphinx must
+/// be installed).
+pub fn run_recognised(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<LipsyncScore> {
+    let (_dir, path, truth) = make_recording(text, c)?;
+    let rec = analyse_file(&path, &mut |_| {})?;
+    let phones = recognise_file(&path, &mut |_| {})?;
+    let sync = lipsync_recognised(&rec, phones, fps)?;
+    Ok(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
+}
+
+/// Runs one sentence under one condition; also without the transcript when `recognise`.
+pub fn run_case_with(
+    text: &str,
+    c: &Condition,
+    fps: f64,
+    recognise: bool,
+) -> fbakit::error::Result<CaseResult> {
+    let (_dir, path, truth) = make_recording(text, c)?;
     let started = Instant::now();
     let rec = analyse_file(&path, &mut |_| {})?;
     let sync = lipsync_transcript_at(&rec, text, &LipsyncOptions::default(), fps)?;
     let work_seconds = started.elapsed().as_secs_f64();
+    let started = Instant::now();
     let recognised = if recognise && recognition_available() {
+        let rec = analyse_file(&path, &mut |_| {})?;
         let phones = recognise_file(&path, &mut |_| {})?;
         let sync = lipsync_recognised(&rec, phones, fps)?;
         Some(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
     } else {
         None
     };
+    let recognised_seconds = started.elapsed().as_secs_f64();
     let aligned = score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps);
     // Baseline: the rendition's phones stretched linearly over the recording's speech.
     let rendition = render_transcript(text, "en")?;
@@ -208,18 +233,20 @@ pub fn run_case_with(
         work_seconds,
         confidence: sync.confidence,
         recognised,
+        recognised_seconds,
     })
 }
 
 fn line(name: &str, s: &LipsyncScore) {
     println!(
-        "  {name:<10} closures {:>5.1} % ({}/{})  agreement {:>5.1} %  false closures {:>4.1} %  ({} speech frames)",
+        "  {name:<10} closures {:>5.1} % ({}/{})  agreement {:>5.1} %  false closures {:>4.1} %  ({} speech frames; PP on other consonants {:>4.1} %)",
         100.0 * s.closure_rate(),
         s.closures_shown,
         s.closures,
         100.0 * s.agreement(),
         100.0 * s.false_closure_rate(),
-        s.speech_frames
+        s.speech_frames,
+        100.0 * s.consonant_closure_rate()
     );
 }
 
@@ -228,7 +255,7 @@ fn main() {
         eprintln!("espeak-ng is not installed (apt-get install espeak-ng)");
         std::process::exit(1);
     }
-    let (mut audio, mut work) = (0.0, 0.0);
+    let (mut audio, mut work, mut work_recognised) = (0.0, 0.0, 0.0);
     let mut all = (LipsyncScore::default(), LipsyncScore::default());
     let mut all_recognised = LipsyncScore::default();
     let recognise = recognition_available();
@@ -254,6 +281,7 @@ fn main() {
                     }
                     audio += r.audio_seconds;
                     work += r.work_seconds;
+                    work_recognised += r.recognised_seconds;
                     conf.push(r.confidence);
                     if std::env::var_os("VERBOSE").is_some() {
                         println!("    {text}: conf {:.2}", r.confidence);
@@ -288,4 +316,10 @@ fn main() {
         "{audio:.1} s of audio analysed and aligned in {work:.2} s: {:.0}x real time",
         audio / work.max(1e-9)
     );
+    if recognise {
+        println!(
+            "without a transcript: {audio:.1} s of audio analysed and recognised in {work_recognised:.2} s: {:.0}x real time",
+            audio / work_recognised.max(1e-9)
+        );
+    }
 }

@@ -225,6 +225,57 @@ fn without_a_transcript_english_phones_are_recognised() {
         .any(|v| v["viseme"] != "sil"));
 }
 
+/// The figures without a transcript on part of the evaluation (`examples/lipsync_eval.rs`
+/// has them all), pinned as regression bounds a little below what was measured: PocketSphinx
+/// phones plus the closures found in the sound (`speech::lipsync::closures`). The closures and
+/// the agreement are below the issue's targets (80 %, 70 %) on these espeak-ng voices.
+// Measured on this subset (3 conditions × 4 sentences): closures 0.410 (32/78), agreement
+// 0.600, false closures 0.027, PP on other consonants 0.091 when the test runs alone; 0.359,
+// 0.580, 0.027, 0.092 beside the other tests of this file (espeak-ng's renditions then
+// differ a little: its engine is shared). On the whole evaluation the closures shown went
+// from 26 % with PocketSphinx's phones alone to 53 %.
+const BOUND_CLOSURES: f64 = 0.33;
+const BOUND_AGREEMENT: f64 = 0.55;
+const BOUND_FALSE: f64 = 0.035;
+const BOUND_CONSONANT: f64 = 0.11;
+
+#[test]
+fn without_a_transcript_the_figures_hold() {
+    if skip("without_a_transcript_the_figures_hold") {
+        return;
+    }
+    if !recognition_available() {
+        eprintln!(
+            "skip without_a_transcript_the_figures_hold: PocketSphinx is not installed \
+             (apt-get install pocketsphinx pocketsphinx-en-us)"
+        );
+        return;
+    }
+    let mut total = LipsyncScore::default();
+    for c in lipsync_eval::conditions().iter().filter(|c| !c.mp3) {
+        for text in &lipsync_eval::SENTENCES[..4] {
+            total.add(&lipsync_eval::run_recognised(text, c, 25.0).unwrap());
+        }
+    }
+    eprintln!(
+        "recognised: closures {:.3} ({}/{}), agreement {:.3}, false closures {:.3}, PP on other consonants {:.3}",
+        total.closure_rate(),
+        total.closures_shown,
+        total.closures,
+        total.agreement(),
+        total.false_closure_rate(),
+        total.consonant_closure_rate()
+    );
+    assert!(total.closures >= 60, "{total:?}");
+    assert!(total.closure_rate() >= BOUND_CLOSURES, "{total:?}");
+    assert!(total.agreement() >= BOUND_AGREEMENT, "{total:?}");
+    assert!(total.false_closure_rate() <= BOUND_FALSE, "{total:?}");
+    assert!(
+        total.consonant_closure_rate() <= BOUND_CONSONANT,
+        "{total:?}"
+    );
+}
+
 fn ffmpeg_available() -> bool {
     std::process::Command::new("ffmpeg")
         .arg("-version")

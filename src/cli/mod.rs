@@ -309,15 +309,16 @@ pub enum Command {
                       transcript is spoken by espeak-ng (library libespeak-ng, Debian package \
                       espeak-ng), which gives its phonemes in 100+ languages (--lang); the \
                       rendition is aligned to the recording by dynamic time warping of their \
-                      MFCCs, m/b/p closures are placed on the recording's energy dips, \
-                      silences relax the mouth, and the phones become FAP 1 visemes with \
+                      MFCCs, silences relax the mouth, and the phones become FAP 1 visemes with \
                       blends (never skipping a lip closure, no shape shorter than a frame). \
                       The recording is read a chunk at a time. A transcript that fits poorly \
                       gives a warning with its confidence; one that does not fit at all is \
-                      refused. Phone recognition without a transcript is not available yet. \
+                      refused. Without a transcript (English only) the phones are recognised with \
+                      PocketSphinx (Debian packages pocketsphinx pocketsphinx-en-us) and lip \
+                      closures are found in the sound; rougher than with one. \
                       Exit codes: 0 ok, 2 bad usage or input (unreadable recording, silence, \
-                      a transcript that cannot be aligned, espeak-ng not installed), 1 other \
-                      failures.",
+                      a transcript that cannot be aligned, espeak-ng or PocketSphinx not \
+                      installed), 1 other failures.",
         after_help = "Examples:\n  fbakit lipsync voice.wav --text \"Hello world\" -o hello.mp4       the face says it, with the recording as sound\n  \
                       fbakit lipsync voice.wav --text-file voice.txt -o voice.fap --json\n  \
                       fbakit lipsync rede.wav --text \"Guten Tag\" --lang de -o rede.html --face alma\n  \

@@ -113,6 +113,7 @@ mod tests {
                     FeatureFrame {
                         mfcc: [0.0; 13],
                         energy_db: db,
+                        high_db: db,
                     },
                     n,
                 )

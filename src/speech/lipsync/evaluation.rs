@@ -7,6 +7,10 @@
 //!   frame;
 //! - false closures: the share of speech frames showing PP where the phone is an open or
 //!   rounded vowel.
+//!
+//! Beside them, not an issue target: closures on other consonants, the share of frames of
+//! consonants that are not m/b/p (f, t, s, n, l, …) showing PP, which the false closures
+//! do not count but a viewer sees.
 
 use serde::Serialize;
 
@@ -31,6 +35,10 @@ pub struct LipsyncScore {
     pub agreeing_frames: usize,
     /// Of them, PP on an open or rounded vowel.
     pub false_closures: usize,
+    /// Speech frames of consonants other than m/b/p.
+    pub consonant_frames: usize,
+    /// Of them, PP.
+    pub consonant_closures: usize,
 }
 
 impl LipsyncScore {
@@ -46,8 +54,14 @@ impl LipsyncScore {
     pub fn false_closure_rate(&self) -> f64 {
         ratio(self.false_closures, self.speech_frames, 0.0)
     }
+    /// Share of frames of other consonants showing PP.
+    pub fn consonant_closure_rate(&self) -> f64 {
+        ratio(self.consonant_closures, self.consonant_frames, 0.0)
+    }
     /// Adds another case's counts.
     pub fn add(&mut self, o: &LipsyncScore) {
+        self.consonant_frames += o.consonant_frames;
+        self.consonant_closures += o.consonant_closures;
         self.closures += o.closures;
         self.closures_shown += o.closures_shown;
         self.speech_frames += o.speech_frames;
@@ -119,6 +133,12 @@ pub fn score(truth: &[TimedPhoneme], frames: &[VisemeParams], fps: f64) -> Lipsy
         if here == MouthClass::Closed && matches!(want, MouthClass::Open | MouthClass::Rounded) {
             s.false_closures += 1;
         }
+        if matches!(want, MouthClass::Labiodental | MouthClass::Other) {
+            s.consonant_frames += 1;
+            if here == MouthClass::Closed {
+                s.consonant_closures += 1;
+            }
+        }
     }
     s
 }
@@ -171,6 +191,19 @@ mod tests {
         assert!((s.false_closure_rate() - 0.7).abs() < 1e-9);
         let none: Vec<VisemeParams> = (0..10).map(|_| held(10)).collect();
         assert_eq!(score(&truth, &none, 25.0).closure_rate(), 0.0);
+    }
+
+    #[test]
+    fn closures_on_other_consonants_are_counted_apart() {
+        // "ta": t for 0.0-0.12 s (3 frames), a after; PP shown on the first two t frames.
+        let truth = vec![p("t", 0.0, 0.12), p("a", 0.12, 0.4)];
+        let frames: Vec<VisemeParams> = (0..10)
+            .map(|n| if n < 2 { held(1) } else { held(10) })
+            .collect();
+        let s = score(&truth, &frames, 25.0);
+        assert_eq!((s.consonant_frames, s.consonant_closures), (3, 2));
+        assert_eq!(s.false_closures, 0);
+        assert!((s.consonant_closure_rate() - 2.0 / 3.0).abs() < 1e-9);
     }
 }
 

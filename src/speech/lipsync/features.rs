@@ -29,6 +29,10 @@ pub struct FeatureFrame {
     pub mfcc: [f32; CEPS],
     /// Frame energy in dB relative to full scale (≥ −120).
     pub energy_db: f32,
+    /// Energy of the sample-to-sample differences, dB (≥ −120): the high frequencies
+    /// weighted up, so `high_db − energy_db` is low for a dark, low-frequency sound (a nasal
+    /// murmur or a voice bar behind closed lips) and high for a hiss or a burst.
+    pub high_db: f32,
 }
 
 /// The time (seconds) at the middle of frame `k`.
@@ -135,6 +139,7 @@ impl FeatureExtractor {
         let mut re = [0f32; FFT];
         let mut im = [0f32; FFT];
         let mut energy = 0f64;
+        let mut high = 0f64;
         for (n, (out, w)) in re.iter_mut().zip(&self.window).enumerate() {
             let x = self.pending[start + n];
             let before = if start + n == 0 {
@@ -143,6 +148,7 @@ impl FeatureExtractor {
                 self.pending[start + n - 1]
             };
             energy += f64::from(x) * f64::from(x);
+            high += f64::from(x - before) * f64::from(x - before);
             *out = (x - 0.97 * before) * w;
         }
         self.fft.run(&mut re, &mut im);
@@ -159,8 +165,12 @@ impl FeatureExtractor {
         for (c, row) in self.dct.iter().enumerate() {
             mfcc[c] = row.iter().zip(&logmel).map(|(a, b)| a * b).sum();
         }
-        let energy_db = (10.0 * (energy / WINDOW as f64 + 1e-12).log10()).max(-120.0) as f32;
-        self.frames.push(FeatureFrame { mfcc, energy_db });
+        let db = |e: f64| (10.0 * (e / WINDOW as f64 + 1e-12).log10()).max(-120.0) as f32;
+        self.frames.push(FeatureFrame {
+            mfcc,
+            energy_db: db(energy),
+            high_db: db(high),
+        });
     }
 }
 

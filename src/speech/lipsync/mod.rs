@@ -9,6 +9,10 @@
 //! viseme keys. (Moving m/b/p closures onto the recording's energy dips was tried and
 //! measured: it showed fewer closures on the evaluation set, so it is not done.)
 //!
+//! Without a transcript (English only), PocketSphinx recognises the phones
+//! ([`recognition`]) and [`closures`] adds the lip closures the sound shows that the phones
+//! miss ([`lipsync_recognised`]).
+//!
 //! The recording is read a chunk at a time ([`analyse_chunks`]): only its features (about
 //! 60 bytes per 10 ms) are kept, and the warp's memory grows linearly with the length. The
 //! transcript's rendition is spoken a few sentences at a time and kept as features too
@@ -24,6 +28,7 @@
 
 pub mod activity;
 pub mod alignment;
+pub mod closures;
 pub mod coarticulation;
 pub mod evaluation;
 pub mod features;
@@ -296,7 +301,9 @@ pub fn lipsync_transcript_at(
     ))
 }
 
-/// Phones recognised in the recording (ARPAbet, [`recognition`]) to a lip sync at `fps`.
+/// Phones recognised in the recording (ARPAbet, [`recognition`]) to a lip sync at `fps`;
+/// lip closures the recogniser missed are found in the sound ([`closures`]) and added as
+/// short `B` phones.
 pub fn lipsync_recognised(
     rec: &RecordingAnalysis,
     phones: Vec<AlignedPhone>,
@@ -322,6 +329,8 @@ pub fn lipsync_recognised(
         .into());
     }
     let confidence = spoken.iter().map(|p| p.confidence).sum::<f64>() / spoken.len() as f64;
+    let found = closures::acoustic_closures(&rec.frames, &phones);
+    let phones = closures::with_closures(phones, &found);
     Ok(finish(
         rec,
         phones,
