@@ -154,18 +154,20 @@ fn print(p: &Pair) {
 }
 
 /// Per pair: the largest compliance error (fraction) and normal-turn ratio measured (debug
-/// build, 2026-11-26, after the `lids` slit handling joined the smooth and gain steps) with a
-/// small margin, so a regression fails. The targets (compliance ≤ 5 %, ratio ≤ 1.5)
+/// build, 2026-11-26, after the `lids` slit handling joined the smooth and gain steps, and
+/// after the gain's limit went from 4 to 10: bruno ↔ ict compliance 76 / 86 % → 10.3 /
+/// 7.6 %) with a small margin, so a regression fails. CANDIDE's own `depress_chin` is 200 %
+/// off compliance: its clones inherit it. The targets (compliance ≤ 5 %, ratio ≤ 1.5)
 /// are met on compliance by alma onto both ICT heads only, and on the turn ratio by the ICT
 /// heads onto alma (1.47, 1.34); the other turn ratios are far from 1.5 still (see `print`
 /// for where: the mouth interior of the ICT head under the visemes, CANDIDE's chin under
 /// `open_jaw`, lid and lip corners, CANDIDE's coarse brows).
 const BOUNDS: [(&str, &str, f64, f64); 10] = [
     ("alma", "ict", 0.05, 27.0),
-    ("bruno", "ict", 0.80, 29.0),
+    ("bruno", "ict", 0.11, 27.0),
     ("candide", "ict", 2.05, 12.5),
     ("ict", "alma", 0.08, 1.6),
-    ("ict", "bruno", 0.90, 2.0),
+    ("ict", "bruno", 0.08, 1.8),
     ("ict", "candide", 1.40, 11.0),
     ("alma", "ict-rig", 0.05, 16.5),
     ("candide", "ict-rig", 2.05, 12.5),
