@@ -286,6 +286,20 @@ impl FaceModel {
         frames
     }
 
+    /// Face-frame positions of every vertex of mesh `mesh` at neutral (empty for an unknown
+    /// mesh).
+    pub fn mesh_world(&self, frames: &FaceFrames, mesh: usize) -> Vec<Vec3> {
+        let Some(m) = self.meshes.get(mesh) else {
+            return Vec::new();
+        };
+        let w = frames.meshes[mesh];
+        m.mesh
+            .positions
+            .iter()
+            .map(|&p| w.transform_point3(p))
+            .collect()
+    }
+
     /// Face-frame position of vertex `vertex` of mesh `mesh` at neutral.
     pub fn vertex_world(&self, frames: &FaceFrames, mesh: usize, vertex: u32) -> Option<Vec3> {
         let p = *self.meshes.get(mesh)?.mesh.positions.get(vertex as usize)?;

@@ -69,15 +69,8 @@ pub(super) fn attach_to_skin(
     let gap = MAX_GAP * diag * frame.scale as f32;
     let mut out = Vec::new();
     for &mi in &parts.other {
-        let Some(m) = face.meshes.get(mi) else {
-            continue;
-        };
-        let world: Vec<Vec3> = m
-            .mesh
-            .positions
-            .iter()
-            .map(|&p| frames.meshes[mi].transform_point3(p))
-            .collect();
+        // Empty for an unknown mesh: skipped below.
+        let world = face.mesh_world(frames, mi);
         if world.is_empty() || bounds_diagonal(&world) > MAX_SIZE * diag {
             continue;
         }

@@ -233,11 +233,7 @@ fn chin_plan(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Option<CutPlan
     let chin = FeaturePointId::FP_2_1;
     let (mi, _) = fp_mesh_vertex(face, frames, chin, diag * 1e-4)?;
     let mesh = &face.meshes[mi].mesh;
-    let world: Vec<Vec3> = mesh
-        .positions
-        .iter()
-        .map(|&p| frames.meshes[mi].transform_point3(p))
-        .collect();
+    let world = face.mesh_world(frames, mi);
     let (piece, count) = mesh_pieces(mesh, diag * 1e-6);
     if count < 2 {
         return None;
@@ -334,11 +330,7 @@ fn shared_part_plans(
             continue;
         }
         let mesh = &face.meshes[mi].mesh;
-        let world: Vec<Vec3> = mesh
-            .positions
-            .iter()
-            .map(|&p| frames.meshes[mi].transform_point3(p))
-            .collect();
+        let world = face.mesh_world(frames, mi);
         let nearest_part = |q: Vec3| {
             points
                 .iter()
