@@ -140,6 +140,21 @@ fn subdivide(
     }
 }
 
+/// Triangles of a `k × k` vertex grid numbered row by row, two per cell (unit-test
+/// surfaces).
+#[cfg(test)]
+pub(crate) fn grid_triangles(k: u32) -> Vec<[u32; 3]> {
+    let mut triangles = Vec::new();
+    for j in 0..k.saturating_sub(1) {
+        for i in 0..k - 1 {
+            let v = j * k + i;
+            triangles.push([v, v + 1, v + k + 1]);
+            triangles.push([v, v + k + 1, v + k]);
+        }
+    }
+    triangles
+}
+
 #[cfg(test)]
 #[test]
 fn candide_fixture_is_consistent() {

@@ -236,14 +236,7 @@ mod tests {
                 positions.push(Vec3::new(i as f32, j as f32, 0.0));
             }
         }
-        let mut triangles = Vec::new();
-        for j in 0..k - 1 {
-            for i in 0..k - 1 {
-                let v = j * k + i;
-                triangles.push([v, v + 1, v + k + 1]);
-                triangles.push([v, v + k + 1, v + k]);
-            }
-        }
+        let triangles = crate::clone::fixtures::grid_triangles(k);
         let d = FapuDistances {
             irisd0: 1.0,
             es0: 1.0,

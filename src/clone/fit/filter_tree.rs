@@ -356,14 +356,7 @@ mod tests {
                 positions.push(Vec3::new(a.cos(), v * 2.0, a.sin() + 0.1 * (9.0 * v).sin()));
             }
         }
-        let mut triangles = Vec::new();
-        for j in 0..k - 1 {
-            for i in 0..k - 1 {
-                let v = j * k + i;
-                triangles.push([v, v + 1, v + k + 1]);
-                triangles.push([v, v + k + 1, v + k]);
-            }
-        }
+        let triangles = crate::clone::fixtures::grid_triangles(k);
         let masks = (0..triangles.len())
             .map(|t| [0b001, 0b010, 0b100 | FACE_PIECE, 0b111 | FACE_PIECE][t % 7 % 4])
             .collect();
