@@ -42,6 +42,26 @@ fn check_page(page: &Path) -> Option<Value> {
     Some(serde_json::from_str(text.trim()).unwrap())
 }
 
+/// The check script's report for a page of `face` playing `samples/speech.fap`.
+fn speech_page_report(face: &fbakit::face::FaceModel, name: &str) -> Option<Value> {
+    let (stream, _) =
+        read_stream_file(root().join("samples/speech.fap"), &ReadOptions::lenient()).unwrap();
+    let player = Player::new(face, &stream, &PlayOptions::default()).unwrap();
+    let frames = player.animation().unwrap();
+    let anim = ViewerAnimation {
+        frames: &frames,
+        fps: player.fps(),
+        name: "speech.fap",
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let page: PathBuf = dir.path().join(format!("{name}-speech.html"));
+    ViewerPage::new(face, Some(&anim))
+        .unwrap()
+        .write(&page)
+        .unwrap();
+    check_page(&page)
+}
+
 fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
@@ -79,23 +99,9 @@ fn assert_slider_moves_the_mouth(r: &Value) {
 #[test]
 fn speech_page_plays_and_poses_in_chromium() {
     let face = fbakit::synth::alma().to_face_model();
-    let (stream, _) =
-        read_stream_file(root().join("samples/speech.fap"), &ReadOptions::lenient()).unwrap();
-    let player = Player::new(&face, &stream, &PlayOptions::default()).unwrap();
-    let frames = player.animation().unwrap();
-    let anim = ViewerAnimation {
-        frames: &frames,
-        fps: player.fps(),
-        name: "speech.fap",
+    let Some(r) = speech_page_report(&face, "alma") else {
+        return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let page: PathBuf = dir.path().join("alma-speech.html");
-    ViewerPage::new(&face, Some(&anim))
-        .unwrap()
-        .write(&page)
-        .unwrap();
-
-    let Some(r) = check_page(&page) else { return };
     assert_clean(&r);
     assert_eq!(r["ready"]["frames"], 75);
     // 75 frames at 25 fps last 3 s (the closing key holds the last frame).
@@ -190,23 +196,9 @@ fn assert_eyes_and_framing(r: &Value) {
 #[test]
 fn real_head_page_shows_pupils_above_the_controls_in_chromium() {
     let (face, _) = fbakit::face::BundledFace::Ict.read().unwrap();
-    let (stream, _) =
-        read_stream_file(root().join("samples/speech.fap"), &ReadOptions::lenient()).unwrap();
-    let player = Player::new(&face, &stream, &PlayOptions::default()).unwrap();
-    let frames = player.animation().unwrap();
-    let anim = ViewerAnimation {
-        frames: &frames,
-        fps: player.fps(),
-        name: "speech.fap",
+    let Some(r) = speech_page_report(&face, "ict") else {
+        return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let page: PathBuf = dir.path().join("ict-speech.html");
-    ViewerPage::new(&face, Some(&anim))
-        .unwrap()
-        .write(&page)
-        .unwrap();
-
-    let Some(r) = check_page(&page) else { return };
     assert_clean(&r);
     assert_eq!(r["ready"]["frames"], 75);
     assert_eq!(r["stateOnLoad"]["playing"], true);
