@@ -15,93 +15,10 @@ mod support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use serde_json::Value;
+use support::blender::{import_in_blender, summary};
 use support::loader_outputs::{gltf_outputs, json_of, obj_outputs};
-
-/// Blender's report per file, or `None` (with a note) when Blender is missing.
-fn import_in_blender(files: &[&PathBuf]) -> Option<Vec<Value>> {
-    let required = std::env::var_os("BLENDER_REQUIRED").is_some();
-    let blender = std::env::var_os("BLENDER").unwrap_or_else(|| "blender".into());
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/support/blender_import.py");
-    let out = Command::new(&blender)
-        .args([
-            "-b",
-            "--factory-startup",
-            "--python-exit-code",
-            "1",
-            "--python",
-        ])
-        .arg(script)
-        .arg("--")
-        .args(files)
-        .output();
-    let out = match out {
-        Ok(o) => o,
-        Err(e) => {
-            assert!(
-                !required,
-                "Blender test required but cannot run Blender ({e})"
-            );
-            eprintln!("note: skipping Blender import test: cannot run {blender:?} ({e})");
-            return None;
-        }
-    };
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    if out.status.code() == Some(3) {
-        let why = String::from_utf8_lossy(&out.stderr);
-        assert!(!required, "Blender test required but: {why}");
-        eprintln!("note: skipping Blender import test: {}", why.trim());
-        return None;
-    }
-    assert!(
-        out.status.success(),
-        "Blender failed: {stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let reports: Vec<Value> = stdout
-        .lines()
-        .filter_map(|l| l.strip_prefix("FBAKIT_JSON "))
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(reports.len(), files.len(), "{stdout}");
-    for r in &reports {
-        assert!(r.get("error").is_none(), "{}: {}", r["file"], r["error"]);
-        eprintln!("{}", summary(r));
-    }
-    Some(reports)
-}
-
-/// One line per file (shown with `--nocapture` or on failure).
-fn summary(r: &Value) -> String {
-    let objects: Vec<String> = r["objects"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|o| match o["type"].as_str().unwrap() {
-            "MESH" => format!(
-                "{} {} v/{} keys",
-                o["name"],
-                o["vertices"],
-                o["shapeKeys"].as_array().map_or(0, Vec::len)
-            ),
-            "ARMATURE" => format!("{} ({} bones)", o["name"], o["bones"]),
-            t => format!("{} {t}", o["name"]),
-        })
-        .collect();
-    let actions: Vec<&str> = r["actions"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|a| a["name"].as_str().unwrap())
-        .collect();
-    format!(
-        "{}: [{}]; actions {actions:?}",
-        r["file"],
-        objects.join(", ")
-    )
-}
 
 fn objects(r: &Value) -> BTreeMap<String, &Value> {
     r["objects"]

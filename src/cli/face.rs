@@ -17,7 +17,9 @@ use super::{print_json, print_warnings, EXIT_FAILURE, EXIT_OK};
 pub enum FaceCommand {
     /// Summarise a face: meshes, feature points, FAPU, FAT coverage.
     #[command(after_help = "Examples:\n  fbakit face info face.wrl\n  \
-                            fbakit face info head.obj --fp head.fdp --json")]
+                            fbakit face info head.obj --fp head.fdp --json\n  \
+                            fbakit face info head.obj --fp head.fdp --points   \
+                            # fp,x,y,z lines for another file of this head")]
     Info(InfoArgs),
     /// Check a face file and list every problem with its scene path and line.
     /// Exit code 0 when valid, 1 when problems were found, 2 when unreadable.
@@ -139,7 +141,7 @@ pub enum FaceCommand {
 /// Arguments of `face info`.
 #[derive(Debug, clap::Args)]
 pub struct InfoArgs {
-    /// Face file (.wrl, .wrl.gz, .wrz, .obj).
+    /// Face file (.wrl, .wrl.gz, .wrz, .obj, .wfm, .glb, .gltf).
     pub file: PathBuf,
     /// Feature-point file (.xml, .fdp, .csv) whose points replace the face's.
     #[arg(long, value_name = "FILE")]
@@ -148,6 +150,11 @@ pub struct InfoArgs {
     /// height).
     #[arg(long, value_name = "mm|cm|m")]
     pub units: Option<fbakit::face::units::LengthUnit>,
+    /// Also list each feature point's position as `fp,x,y,z` lines (the file's world frame and
+    /// units): a feature-point CSV another file of the same face can take (`--json` always
+    /// has them).
+    #[arg(long)]
+    pub points: bool,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -253,7 +260,11 @@ fn info(a: InfoArgs) -> Result<u8> {
     if a.json {
         print_json(&summary)?;
     } else {
-        super::print_text(&summary.to_text());
+        let mut text = summary.to_text();
+        if a.points {
+            text.push_str(&summary.feature_points.positions_csv());
+        }
+        super::print_text(&text);
     }
     Ok(EXIT_OK)
 }

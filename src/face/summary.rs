@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::vrml::{FaceFileKind, FaceReadReport, FeaturePointMatch};
 use super::FaceModel;
 use crate::fat::{TableKey, TransformField};
-use crate::spec::{FapId, FapuKind};
+use crate::spec::{FapId, FapuKind, FeaturePointId};
 
 /// One mesh.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -40,6 +40,24 @@ pub struct FeaturePointSummary {
     /// Each present point's position in the face frame (the file's world frame and units),
     /// by label: what a feature-point CSV's `fp,x,y,z` rows take.
     pub positions: BTreeMap<String, [f32; 3]>,
+}
+
+impl FeaturePointSummary {
+    /// The positions as a feature-point CSV (`fp,x,y,z` header, one line per point in the
+    /// standard's order), preceded by a blank line.
+    pub fn positions_csv(&self) -> String {
+        let mut s = String::from("\nfp,x,y,z\n");
+        let mut points: Vec<(FeaturePointId, &[f32; 3])> = self
+            .positions
+            .iter()
+            .filter_map(|(k, p)| Some((k.parse::<FeaturePointId>().ok()?, p)))
+            .collect();
+        points.sort_by_key(|(id, _)| *id);
+        for (id, [x, y, z]) in points {
+            let _ = writeln!(s, "{id},{x},{y},{z}");
+        }
+        s
+    }
 }
 
 /// The FAP units, or why they cannot be measured.

@@ -206,7 +206,9 @@ pub fn component_count(kind: &str) -> usize {
         "SCALAR" => 1,
         "VEC2" => 2,
         "VEC3" => 3,
-        "VEC4" => 4,
+        "VEC4" | "MAT2" => 4,
+        "MAT3" => 9,
+        "MAT4" => 16,
         t => panic!("unexpected type {t}"),
     }
 }

@@ -1,6 +1,7 @@
 //! Helpers shared by integration tests (each test binary uses some of them).
 #![allow(dead_code)]
 pub mod avatar;
+pub mod blender;
 pub mod cli;
 pub mod gltf_scenes;
 pub mod gltf_transform;
