@@ -619,7 +619,7 @@ fn the_jaw_joint_takes_the_jaw_faps_over_from_the_morphs() {
         cmd.args(extra);
         let o = cmd.output().unwrap();
         assert!(o.status.success(), "{}", text(&o.stderr));
-        json_of(out)
+        (json_of(out), text(&o.stderr))
     };
     let (stream, _) =
         fbakit::fap::read_stream_file(&sample, &fbakit::fap::ReadOptions::lenient()).unwrap();
@@ -629,9 +629,34 @@ fn the_jaw_joint_takes_the_jaw_faps_over_from_the_morphs() {
             .unwrap_or(0.0)
     };
     let opened = (0..stream.frames.len()).find(|&i| open(i) > 50.0).unwrap();
-    for (name, extra) in [("named", &["--jaw-node", "Jaw"][..]), ("found", &[][..])] {
+    // The avatar's `Jaw` carries its mouth primitive but not the chin (2.1, on the skin,
+    // weighted to `Head` alone): found by its name it is not used (the chin would stay still);
+    // named, it is, with a warning.
+    let out = dir.path().join("found.glb");
+    let (y, stderr) = play(&out, &[]);
+    assert!(
+        stderr.contains("carries the chin (2.1) by 0 % only") && stderr.contains("stay morph"),
+        "{stderr}"
+    );
+    let jaw = y["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|n| n["name"] == "Jaw")
+        .unwrap();
+    assert!(
+        !y["animations"][1]["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c["target"]["node"] == jaw),
+        "found: the jaw is animated"
+    );
+    {
+        let (name, extra) = ("named", &["--jaw-node", "Jaw"][..]);
         let out = dir.path().join(format!("{name}.glb"));
-        let y = play(&out, extra);
+        let (y, stderr) = play(&out, extra);
+        assert!(stderr.contains("as --jaw-node asks"), "{stderr}");
         let jaw = y["nodes"]
             .as_array()
             .unwrap()

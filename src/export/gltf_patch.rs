@@ -24,6 +24,7 @@ use glam::{Affine3A, Quat, Vec3};
 use serde_json::Map;
 
 use super::gltf::FaceMorphs;
+use super::gltf_carried::carried_share;
 use super::gltf_rotations::{
     head_node, jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes, HEAD_FAPS,
 };
@@ -37,6 +38,7 @@ use crate::fat::{interval_weights, Fat, TableKey, TransformField};
 use crate::gltf::patch::{GltfPatch, MeshPatch, PatchAnimation, PatchedGltf, SparseOffsets};
 use crate::gltf::source::{GltfSource, RestPose};
 use crate::player::AnimationFrame;
+use crate::spec::FeaturePointId;
 
 /// Rotation bake: intervals over `±ROTATION_REACH × V`.
 const ROTATION_INTERVALS: usize = 8;
@@ -352,7 +354,28 @@ pub fn patch_face(
         // from the targets (never a joint and a morph for one motion).
         let driven: Vec<usize> = transform_nodes.iter().flatten().copied().collect();
         let jaw = match jaw_node(source, face, nodes.jaw.as_deref(), unit, &driven) {
-            Ok(jaw) => jaw,
+            // A node found by its name must carry the chin; one the user names is taken at
+            // their word, with a warning when it does not.
+            Ok(Some(jaw)) => match carries_chin(source, face, &jaw) {
+                Ok(()) => Some(jaw),
+                Err(why) if nodes.jaw.is_some() => {
+                    warnings.push(Diagnostic::warning(format!(
+                        "{}: {why}; it takes open_jaw, thrust_jaw and shift_jaw as --jaw-node \
+                         asks",
+                        source.path.display()
+                    )));
+                    Some(jaw)
+                }
+                Err(why) => {
+                    warnings.push(Diagnostic::warning(format!(
+                        "{}: {why}; open_jaw, thrust_jaw and shift_jaw stay morph targets \
+                         (--jaw-node NAME hands them to a node anyway)",
+                        source.path.display()
+                    )));
+                    None
+                }
+            },
+            Ok(None) => None,
             Err(why) => {
                 warnings.push(Diagnostic::warning(format!(
                     "{}: {why}; open_jaw, thrust_jaw and shift_jaw stay morph targets",
@@ -758,6 +781,55 @@ fn animation(
         anim.weights.push((node, values));
     }
     (!anim.weights.is_empty()).then_some(anim)
+}
+
+/// Whether `jaw` carries the chin's vertex (feature point 2.1) at least half (skin weights on
+/// the joint and below it, or the chin's mesh under the node), else why not: a jaw bone no
+/// chin vertex is weighted to would take the jaw FAPs from the morph targets and move nothing.
+fn carries_chin(source: &GltfSource, face: &FaceModel, jaw: &JawNode) -> Result<(), String> {
+    let name = source.json["nodes"][jaw.node]["name"]
+        .as_str()
+        .unwrap_or("")
+        .to_string();
+    let Some((mesh, vertex)) = face.fp_vertex(FeaturePointId::FP_2_1).or_else(|| {
+        // A point given by position: the face's nearest vertex.
+        let chin = face.feature_points.position(FeaturePointId::FP_2_1)?;
+        let world = face.neutral_world_positions();
+        world
+            .iter()
+            .enumerate()
+            .flat_map(|(m, ps)| ps.iter().enumerate().map(move |(v, p)| (m, v, p)))
+            .min_by(|a, b| a.2.distance(chin).total_cmp(&b.2.distance(chin)))
+            .map(|(m, v, _)| (m, v as u32))
+    }) else {
+        return Err(format!(
+            "jaw node `{name}`: the face has no chin (feature point 2.1)"
+        ));
+    };
+    let Some(part) = source.part(&face.meshes[mesh].name) else {
+        return Err(format!(
+            "jaw node `{name}`: the chin's mesh `{}` is not in the document",
+            face.meshes[mesh].name
+        ));
+    };
+    let share = carried_share(
+        source,
+        part.node,
+        part.mesh,
+        part.primitive,
+        vertex as usize,
+        jaw.node,
+    );
+    match share {
+        Some(s) if s >= 0.5 => Ok(()),
+        Some(s) => Err(format!(
+            "jaw node `{name}` carries the chin (2.1) by {:.0} % only",
+            s * 100.0
+        )),
+        None => Err(format!(
+            "jaw node `{name}`: the chin's skin weights cannot be read"
+        )),
+    }
 }
 
 #[cfg(test)]

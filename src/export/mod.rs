@@ -22,6 +22,7 @@ pub mod arkit_patch;
 pub mod budget;
 mod error;
 pub mod gltf;
+pub mod gltf_carried;
 pub mod gltf_patch;
 pub mod gltf_rotations;
 pub mod movie;

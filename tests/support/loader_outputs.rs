@@ -17,12 +17,12 @@ pub struct GltfOutputs {
     pub input_gltf: PathBuf,
     /// `clone alma avatar.glb -o clone.glb`.
     pub clone_glb: PathBuf,
-    /// `play clone.glb lowlevel.fap -o play.glb`.
+    /// `play clone.glb lowlevel.fap --jaw-node Jaw -o play.glb`.
     pub play_glb: PathBuf,
     /// `clone alma in/avatar.gltf -o out/clone.gltf` (another folder: `.bin` and image
     /// written beside it).
     pub clone_gltf: PathBuf,
-    /// `play out/clone.gltf lowlevel.fap -o out/play.gltf`.
+    /// `play out/clone.gltf lowlevel.fap --jaw-node Jaw -o out/play.gltf`.
     pub play_gltf: PathBuf,
     /// `face export clone.glb --names arkit -o arkit.glb`.
     pub arkit_glb: PathBuf,
@@ -86,10 +86,14 @@ pub fn gltf_outputs(dir: &Path) -> GltfOutputs {
             "-o".as_ref(),
             cloned.as_os_str(),
         ]);
+        // The avatar's `Jaw` carries the mouth, not the chin: named, it still takes the jaw
+        // FAPs (found by its name alone it would not).
         run(&[
             "play".as_ref(),
             cloned.as_os_str(),
             lowlevel.as_os_str(),
+            "--jaw-node".as_ref(),
+            "Jaw".as_ref(),
             "-o".as_ref(),
             played.as_os_str(),
         ]);

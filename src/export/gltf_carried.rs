@@ -1,0 +1,182 @@
+//! How much of a face vertex a node of the user's document carries: for a skinned primitive,
+//! the vertex's skin weight on that joint and the joints below it; for a plain one, all of it
+//! when the node is the primitive's node or one of its ancestors, else nothing.
+//!
+//! `play` hands the jaw FAPs to a jaw node only when it carries the chin: a `Jaw` bone that
+//! no vertex of the chin is weighted to (an unused bone of a generic rig, a helper empty)
+//! would take `open_jaw` from the morph targets and move nothing.
+
+use std::collections::BTreeSet;
+
+use serde_json::Value;
+
+use crate::gltf::source::GltfSource;
+
+/// The share (0–1) of vertex `vertex` of the document's `mesh`/`primitive`, instanced by
+/// `mesh_node`, that `node` moves; `None` when the document cannot say (unreadable weights).
+pub fn carried_share(
+    source: &GltfSource,
+    mesh_node: Option<usize>,
+    mesh: usize,
+    primitive: usize,
+    vertex: usize,
+    node: usize,
+) -> Option<f32> {
+    let json = &source.json;
+    let below = subtree(json, node);
+    let Some(mesh_node) = mesh_node else {
+        return Some(0.0);
+    };
+    let Some(skin) = json["nodes"][mesh_node]["skin"].as_u64() else {
+        let carried = ancestors(json, mesh_node).contains(&node);
+        return Some(if carried { 1.0 } else { 0.0 });
+    };
+    let joints: Vec<usize> = json["skins"][skin as usize]["joints"]
+        .as_array()?
+        .iter()
+        .filter_map(|j| j.as_u64().map(|j| j as usize))
+        .collect();
+    let root: gltf::json::Root = serde_json::from_value(json.clone()).ok()?;
+    let doc = gltf::Document::from_json_without_validation(root);
+    let prim = doc.meshes().nth(mesh)?.primitives().nth(primitive)?;
+    let reader = prim.reader(|b| source.buffers.get(b.index()).map(Vec::as_slice));
+    let js = reader.read_joints(0)?.into_u16().nth(vertex)?;
+    let ws = reader.read_weights(0)?.into_f32().nth(vertex)?;
+    // fold from +0: an empty f32 `sum` is −0, which prints as "-0 %".
+    let total = ws
+        .iter()
+        .filter(|w| w.is_finite())
+        .fold(0.0f32, |a, w| a + w);
+    if total <= 0.0 {
+        return Some(0.0);
+    }
+    let on: f32 = js
+        .iter()
+        .zip(ws)
+        .filter(|(j, w)| {
+            w.is_finite() && joints.get(**j as usize).is_some_and(|n| below.contains(n))
+        })
+        .fold(0.0f32, |a, (_, w)| a + w);
+    Some(on / total)
+}
+
+/// `node` and every node below it.
+fn subtree(json: &Value, node: usize) -> BTreeSet<usize> {
+    let mut out = BTreeSet::new();
+    let mut todo = vec![node];
+    while let Some(n) = todo.pop() {
+        // A cycle (an invalid document) visits each node once.
+        if !out.insert(n) {
+            continue;
+        }
+        if let Some(children) = json["nodes"][n]["children"].as_array() {
+            todo.extend(
+                children
+                    .iter()
+                    .filter_map(|c| c.as_u64().map(|c| c as usize)),
+            );
+        }
+    }
+    out
+}
+
+/// `node` and its ancestors.
+fn ancestors(json: &Value, node: usize) -> BTreeSet<usize> {
+    let nodes = json["nodes"].as_array().map_or(&[][..], Vec::as_slice);
+    let mut parent = vec![None; nodes.len()];
+    for (p, n) in nodes.iter().enumerate() {
+        for c in n["children"].as_array().into_iter().flatten() {
+            if let Some(c) = c.as_u64().and_then(|c| parent.get_mut(c as usize)) {
+                *c = Some(p);
+            }
+        }
+    }
+    let mut out = BTreeSet::new();
+    let mut at = Some(node);
+    while let Some(n) = at {
+        if !out.insert(n) {
+            break;
+        }
+        at = parent.get(n).copied().flatten();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn source(json: Value, buffers: Vec<Vec<u8>>) -> GltfSource {
+        GltfSource {
+            path: "a.glb".into(),
+            json,
+            buffers,
+            parts: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn plain_meshes_are_carried_by_their_ancestors_only() {
+        let s = source(
+            serde_json::json!({"nodes": [
+                {"name": "Head", "children": [1, 2]},
+                {"name": "Jaw", "children": [3]},
+                {"name": "Face", "mesh": 0},
+                {"name": "Teeth", "mesh": 1}
+            ]}),
+            Vec::new(),
+        );
+        assert_eq!(carried_share(&s, Some(2), 0, 0, 0, 1), Some(0.0));
+        assert_eq!(carried_share(&s, Some(3), 1, 0, 0, 1), Some(1.0));
+        assert_eq!(carried_share(&s, Some(2), 0, 0, 0, 0), Some(1.0));
+    }
+
+    #[test]
+    fn skinned_vertices_are_carried_by_their_weights_below_the_node() {
+        // Two vertices; joints [Head, Jaw, JawTip]: vertex 0 all Head, vertex 1 a quarter
+        // Jaw and half JawTip (below Jaw), a quarter Head.
+        let mut bin = Vec::new();
+        for p in [[0.0f32, 0.0, 0.0], [0.0, -1.0, 0.0]] {
+            for c in p {
+                bin.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        let joints_at = bin.len();
+        bin.extend_from_slice(&[0, 0, 0, 0, 1, 2, 0, 0]);
+        let weights_at = bin.len();
+        for w in [[1.0f32, 0.0, 0.0, 0.0], [0.25, 0.5, 0.25, 0.0]] {
+            for c in w {
+                bin.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        let json = serde_json::json!({
+            "asset": {"version": "2.0"},
+            "buffers": [{"byteLength": bin.len()}],
+            "bufferViews": [
+                {"buffer": 0, "byteOffset": 0, "byteLength": 24},
+                {"buffer": 0, "byteOffset": joints_at, "byteLength": 8},
+                {"buffer": 0, "byteOffset": weights_at, "byteLength": 32}
+            ],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 2, "type": "VEC3",
+                 "min": [0, -1, 0], "max": [0, 0, 0]},
+                {"bufferView": 1, "componentType": 5121, "count": 2, "type": "VEC4"},
+                {"bufferView": 2, "componentType": 5126, "count": 2, "type": "VEC4"}
+            ],
+            "meshes": [{"primitives": [{"attributes":
+                {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}]}],
+            "skins": [{"joints": [0, 1, 2]}],
+            "nodes": [
+                {"name": "Head", "children": [1, 3]},
+                {"name": "Jaw", "children": [2]},
+                {"name": "JawTip"},
+                {"name": "Face", "mesh": 0, "skin": 0}
+            ]
+        });
+        let s = source(json, vec![bin]);
+        assert_eq!(carried_share(&s, Some(3), 0, 0, 0, 1), Some(0.0));
+        assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 1), Some(0.75));
+        assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 0), Some(1.0));
+        assert_eq!(carried_share(&s, Some(3), 0, 0, 9, 1), None);
+    }
+}
