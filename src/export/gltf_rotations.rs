@@ -139,6 +139,23 @@ pub fn head_node(source: &GltfSource, names: &RotationNodes) -> Option<usize> {
     })
 }
 
+/// The left and right eye nodes (FAPs 23/25 and 24/26): the nodes named `names.eyes`, else
+/// the first with a usual eye name, else the VRM humanoid `leftEye`/`rightEye` bones.
+pub fn eye_nodes(source: &GltfSource, names: &RotationNodes) -> (Option<usize>, Option<usize>) {
+    let json = &source.json;
+    let (l, r) = match &names.eyes {
+        Some((l, r)) => (Some(l.as_str()), Some(r.as_str())),
+        None => (None, None),
+    };
+    let one = |name: Option<&str>, usual: &[&str], bone: &str| {
+        find(json, name, usual).or_else(|| name.is_none().then(|| vrm_bone(json, bone)).flatten())
+    };
+    (
+        one(l, LEFT_EYE_NAMES, "leftEye"),
+        one(r, RIGHT_EYE_NAMES, "rightEye"),
+    )
+}
+
 /// The head rotation FAPs (pitch, yaw, roll).
 pub const HEAD_FAPS: [u8; 3] = [48, 49, 50];
 
@@ -209,26 +226,11 @@ pub fn rotated_nodes(source: &GltfSource, fat: &Fat, names: &RotationNodes) -> V
             .iter()
             .any(|t| t.key == TableKey::LowLevel(FapId::new(f).expect("a FAP number")))
     };
-    let (eye_l, eye_r) = match &names.eyes {
-        Some((l, r)) => (Some(l.as_str()), Some(r.as_str())),
-        None => (None, None),
-    };
+    let (eye_l, eye_r) = eye_nodes(source, names);
     let wanted: [(Option<usize>, &[u8]); 3] = [
         (head_node(source, names), &[49, 48, 50]),
-        (
-            find(json, eye_l, LEFT_EYE_NAMES)
-                .or_else(|| eye_l.is_none().then(|| vrm_bone(json, "leftEye")).flatten()),
-            &[23, 25],
-        ),
-        (
-            find(json, eye_r, RIGHT_EYE_NAMES).or_else(|| {
-                eye_r
-                    .is_none()
-                    .then(|| vrm_bone(json, "rightEye"))
-                    .flatten()
-            }),
-            &[24, 26],
-        ),
+        (eye_l, &[23, 25]),
+        (eye_r, &[24, 26]),
     ];
     let (world, parent) = world_rotations(json);
     let mut out = Vec::new();
@@ -320,7 +322,7 @@ impl JawNode {
 }
 
 /// World matrix of every node at rest (parents from `children`).
-fn world_matrices(json: &Value) -> (Vec<Mat4>, Vec<Option<usize>>) {
+pub(crate) fn world_matrices(json: &Value) -> (Vec<Mat4>, Vec<Option<usize>>) {
     compose_at_rest(json, local_matrix)
 }
 
@@ -334,7 +336,7 @@ fn vec3_of(v: &Value, default: Vec3) -> Vec3 {
     }
 }
 
-fn local_matrix(n: &Value) -> Mat4 {
+pub(crate) fn local_matrix(n: &Value) -> Mat4 {
     if let Some(m) = n["matrix"].as_array() {
         let v: Vec<f32> = m.iter().map(|x| x.as_f64().unwrap_or(0.0) as f32).collect();
         if v.len() == 16 {
