@@ -464,3 +464,42 @@ fn vrml_and_new_documents_keep_the_eye_motion() {
         }
     }
 }
+
+/// A node named as an eye whose mesh is no eyeball (the hat: no pupil on it) is not used,
+/// with a warning; the other eye node still turns its eye, and the unused eye's motion stays
+/// in morph targets of its mesh.
+#[test]
+fn an_eye_node_without_its_eyeball_is_not_used_and_said_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str()])
+        .args(["--eye-nodes", "Hat,RightEye", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("eye node `Hat` is not turned (its mesh holds no pupil 3.5)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("RightEye"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    let transforms = patched["scenes"][0]["extras"]["fbakit"]["transforms"].clone();
+    let on = |node: usize| {
+        transforms
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|t| t["node"] == node && t["userNode"] == true)
+    };
+    assert!(on(RIGHT_EYE_NODE) && !on(LEFT_EYE_NODE) && !on(6), "{transforms}");
+    let left_targets = patched["meshes"][2]["extras"]["targetNames"].to_string();
+    assert!(left_targets.contains("yaw_l_eyeball"), "{left_targets}");
+    assert!(patched["meshes"][3]["primitives"][0].get("targets").is_none());
+}
