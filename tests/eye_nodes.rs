@@ -498,8 +498,13 @@ fn an_eye_node_without_its_eyeball_is_not_used_and_said_so() {
             .iter()
             .any(|t| t["node"] == node && t["userNode"] == true)
     };
-    assert!(on(RIGHT_EYE_NODE) && !on(LEFT_EYE_NODE) && !on(6), "{transforms}");
+    assert!(
+        on(RIGHT_EYE_NODE) && !on(LEFT_EYE_NODE) && !on(6),
+        "{transforms}"
+    );
     let left_targets = patched["meshes"][2]["extras"]["targetNames"].to_string();
     assert!(left_targets.contains("yaw_l_eyeball"), "{left_targets}");
-    assert!(patched["meshes"][3]["primitives"][0].get("targets").is_none());
+    assert!(patched["meshes"][3]["primitives"][0]
+        .get("targets")
+        .is_none());
 }

@@ -224,3 +224,38 @@ pub fn world_delta(parent: Affine3A, rest: Affine3A, animated: Affine3A, unit: f
     let s = Affine3A::from_scale(Vec3::splat(unit));
     s * d * s.inverse()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A world-frame turn about a pivot off the node's origin, under a turned and scaled
+    /// parent, comes back as the node's local rotation and translation: the node's world
+    /// matrix is the turn applied to its rest one.
+    #[test]
+    fn a_world_turn_becomes_the_nodes_local_pose() {
+        let parent = Quat::from_rotation_x(-1.2);
+        let json = serde_json::json!({"nodes": [
+            {"scale": [0.01, 0.01, 0.01], "rotation": parent.to_array(), "children": [1]},
+            {"translation": [3.0, 1.0, 2.0], "rotation": Quat::from_rotation_z(0.3).to_array()}
+        ]});
+        let node = UserNode::new(&json, 1).unwrap();
+        assert!(
+            node.local(Affine3A::IDENTITY)
+                .0
+                .angle_between(Quat::from_rotation_z(0.3))
+                < 1e-3
+        );
+        let pivot = Vec3::new(0.02, 0.0, 0.05);
+        let turn = Affine3A::from_translation(pivot)
+            * Affine3A::from_rotation_y(0.2)
+            * Affine3A::from_translation(-pivot);
+        let (r, t) = node.local(turn);
+        let local = Mat4::from_rotation_translation(r, t);
+        let (world, _) = world_matrices(&json);
+        let got = world[0] * local;
+        let want = Mat4::from(turn) * world[1];
+        assert!(got.abs_diff_eq(want, 1e-5), "{got} vs {want}");
+        assert!(descends(&[None, Some(0)], 1, 0) && !descends(&[None, Some(0)], 0, 1));
+    }
+}

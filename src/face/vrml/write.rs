@@ -97,7 +97,8 @@ fn is_vrml_name(name: &str) -> bool {
 }
 
 /// `face` with every mesh and transform name that cannot be a DEF name made one (characters
-/// VRML does not allow become `_`; a repeat gets `_2`, `_3`), and the FAT's and feature
+/// VRML does not allow become `_`, a leading digit gets a `_` before it; a repeat gets `_2`,
+/// `_3`), and the FAT's and feature
 /// points' references renamed with them; `None` when every name already is one.
 fn with_vrml_names(face: &FaceModel) -> Option<FaceModel> {
     let names = face
@@ -116,20 +117,15 @@ fn with_vrml_names(face: &FaceModel) -> Option<FaceModel> {
         }
         let mut base: String = name
             .chars()
-            .enumerate()
-            .map(|(i, c)| {
-                let ok = if i == 0 {
-                    crate::vrml::lexer::is_id_first(c)
-                } else {
-                    crate::vrml::lexer::is_id_rest(c)
-                };
-                if ok {
+            .map(|c| {
+                if crate::vrml::lexer::is_id_rest(c) {
                     c
                 } else {
                     '_'
                 }
             })
             .collect();
+        // A leading digit, sign or keyword is kept behind a `_`.
         if !is_vrml_name(&base) {
             base.insert(0, '_');
         }
@@ -240,4 +236,59 @@ pub(super) fn add(scene: &mut Scene, node: Node) -> NodeRef {
 /// A `USE` of node `id`.
 pub(super) fn use_of(id: NodeId) -> NodeRef {
     NodeRef { id, is_use: true }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// alma with a mesh and a transform renamed as glTF names them (`Body.0`, `1st`) is
+    /// written with DEF names VRML allows and reads back with its FAT on the renamed parts.
+    #[test]
+    fn names_vrml_does_not_allow_are_made_def_names() {
+        let mut face = crate::synth::alma().to_face_model();
+        let (mesh, transform) = (face.meshes[0].name.clone(), face.transforms[0].name.clone());
+        for m in face.meshes.iter_mut() {
+            if m.name == mesh {
+                m.name = "Body.0".into();
+            }
+        }
+        face.transforms[0].name = "1st".into();
+        for t in face.fat.tables.iter_mut() {
+            for m in t.meshes.iter_mut().filter(|m| m.mesh == mesh) {
+                m.mesh = "Body.0".into();
+            }
+            for x in t.transforms.iter_mut().filter(|x| x.transform == transform) {
+                x.transform = "1st".into();
+            }
+        }
+        let mut points = crate::fdp::FeaturePointSet::new();
+        for p in face.feature_points.iter() {
+            let mut p = p.clone();
+            if let Some(b) = p
+                .binding
+                .as_mut()
+                .filter(|b| b.mesh.as_deref() == Some(&mesh))
+            {
+                b.mesh = Some("Body.0".into());
+            }
+            points.insert(p);
+        }
+        face.feature_points = points;
+        face.scene = None;
+        let text = write_face_string(&face).unwrap();
+        assert!(text.contains("DEF Body_0 ") && text.contains("DEF _1st "));
+        let scene = crate::vrml::parse_vrml(&text, Path::new("t.wrl")).unwrap();
+        let (back, _) = super::super::face_from_scene(scene, "t").unwrap();
+        assert!(back.mesh_index("Body_0").is_some());
+        assert_eq!(back.fat.tables.len(), face.fat.tables.len());
+        let moved = |f: &FaceModel| {
+            f.fat
+                .tables
+                .iter()
+                .map(|t| t.meshes.len() + t.transforms.len())
+                .sum::<usize>()
+        };
+        assert_eq!(moved(&back), moved(&face));
+    }
 }
