@@ -7,6 +7,8 @@
 //! usual names (`Head`, `LeftEye`/`RightEye`, `eye.L`, Mixamo, CC, VRM 0 bone names) or by
 //! the VRM humanoid bones (`VRMC_vrm` 1.0, `VRM` 0.x). A FAP the face's FAT has a table for
 //! is left to that table (its morph targets): never a rotation and a morph for one motion.
+//! A cloned face's eyeball transforms are shown by eye nodes that hold the eyeball alone
+//! ([`super::gltf_user_nodes`]): their tables then turn those nodes through the transform.
 //!
 //! The jaw is the other way round ([`jaw_node`]): a skinned jaw joint carries the chin, the
 //! lower teeth and the lower lip with it, so when the document has one (`play --jaw-node`,
@@ -336,7 +338,7 @@ fn vec3_of(v: &Value, default: Vec3) -> Vec3 {
     }
 }
 
-pub(crate) fn local_matrix(n: &Value) -> Mat4 {
+fn local_matrix(n: &Value) -> Mat4 {
     if let Some(m) = n["matrix"].as_array() {
         let v: Vec<f32> = m.iter().map(|x| x.as_f64().unwrap_or(0.0) as f32).collect();
         if v.len() == 16 {
