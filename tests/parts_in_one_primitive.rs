@@ -37,7 +37,15 @@ fn key(fap: u8) -> TableKey {
 /// The avatar with its teeth primitive as `avatar.glb` in `dir`, and its feature points.
 fn write_avatar(dir: &Path, source: &FaceModel) -> (PathBuf, PathBuf) {
     let glb = dir.join("avatar.glb");
-    std::fs::write(&glb, avatar::build_with(&Options { teeth: true }).to_glb()).unwrap();
+    std::fs::write(
+        &glb,
+        avatar::build_with(&Options {
+            teeth: true,
+            ..Options::default()
+        })
+        .to_glb(),
+    )
+    .unwrap();
     let csv = avatar::fp_csv(source, dir, &avatar::teeth_fp_lines());
     (glb, csv)
 }

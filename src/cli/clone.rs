@@ -67,6 +67,8 @@ pub struct CloneArgs {
     /// glTF (default: the target's own document, patched).
     #[arg(long)]
     pub new_document: bool,
+    #[command(flatten)]
+    pub nodes: super::play::NodeArgs,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -338,6 +340,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     let export_opts = fbakit::export::ExportOptions {
         names: args.names.into(),
         new_document: args.new_document,
+        nodes: args.nodes.rotation_nodes(),
         ..Default::default()
     };
     let mut written = fbakit::export::write(&args.output, &outcome.face, &export_opts)?;

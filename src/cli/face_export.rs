@@ -75,6 +75,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         names: a.names.into(),
         units: a.units,
         new_document: a.new_document,
+        ..Default::default()
     };
     let report = fbakit::export::write(&a.output, &face, &opts)?;
     if a.json {

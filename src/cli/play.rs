@@ -70,19 +70,8 @@ pub struct PlayArgs {
     /// Read the stream strictly.
     #[arg(long)]
     pub strict: bool,
-    /// glTF face: the node head pitch, yaw and roll (FAPs 48-50) turn (default: found by the
-    /// usual names such as `Head`, or the VRM humanoid head bone).
-    #[arg(long, value_name = "NODE")]
-    pub head_node: Option<String>,
-    /// glTF face: the left and right eye nodes eyeball yaw and pitch (FAPs 23-26) turn, as
-    /// `LEFT,RIGHT` (default: `LeftEye`/`RightEye`, `eye.L`/`eye.R` or the VRM eye bones).
-    #[arg(long, value_name = "LEFT,RIGHT", value_parser = parse_node_pair)]
-    pub eye_nodes: Option<(String, String)>,
-    /// glTF face: the jaw node open_jaw turns and thrust_jaw / shift_jaw move (FAPs 3, 14,
-    /// 15), instead of their morph targets (default: a node named `Jaw`/`jaw` or the VRM
-    /// humanoid jaw bone). Needs the face's feature points (FAP units and the chin, 2.1).
-    #[arg(long, value_name = "NODE")]
-    pub jaw_node: Option<String>,
+    #[command(flatten)]
+    pub nodes: NodeArgs,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -233,7 +222,7 @@ pub fn run(a: PlayArgs) -> Result<u8> {
             if let Some(export) = fbakit::export::gltf_patch::patch_if_fits(
                 &face,
                 Some(&anim),
-                &rotation_nodes(&a),
+                &a.nodes.rotation_nodes(),
                 &mut warnings,
             )? {
                 warnings.extend(export.warnings);
@@ -390,6 +379,36 @@ fn report_text(r: &PlayReport) -> String {
     o
 }
 
+/// The user's glTF nodes that turn for head, eye and jaw FAPs (`play`, `clone`).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct NodeArgs {
+    /// glTF face: the node head pitch, yaw and roll (FAPs 48-50) turn (default: found by the
+    /// usual names such as `Head`, or the VRM humanoid head bone).
+    #[arg(long, value_name = "NODE")]
+    pub head_node: Option<String>,
+    /// glTF face: the left and right eye nodes eyeball yaw and pitch (FAPs 23-26) turn, as
+    /// `LEFT,RIGHT` (default: `LeftEye`/`RightEye`, `eye.L`/`eye.R` or the VRM eye bones).
+    /// An eye node that holds its eyeball's mesh alone shows the cloned eye's motion.
+    #[arg(long, value_name = "LEFT,RIGHT", value_parser = parse_node_pair)]
+    pub eye_nodes: Option<(String, String)>,
+    /// glTF face: the jaw node open_jaw turns and thrust_jaw / shift_jaw move (FAPs 3, 14,
+    /// 15), instead of their morph targets (default: a node named `Jaw`/`jaw` or the VRM
+    /// humanoid jaw bone). Needs the face's feature points (FAP units and the chin, 2.1).
+    #[arg(long, value_name = "NODE")]
+    pub jaw_node: Option<String>,
+}
+
+impl NodeArgs {
+    /// The rotation nodes the options name.
+    pub fn rotation_nodes(&self) -> fbakit::export::gltf_rotations::RotationNodes {
+        fbakit::export::gltf_rotations::RotationNodes {
+            head: self.head_node.clone(),
+            eyes: self.eye_nodes.clone(),
+            jaw: self.jaw_node.clone(),
+        }
+    }
+}
+
 /// `--eye-nodes LEFT,RIGHT`.
 fn parse_node_pair(s: &str) -> std::result::Result<(String, String), String> {
     match s.split_once(',') {
@@ -397,15 +416,6 @@ fn parse_node_pair(s: &str) -> std::result::Result<(String, String), String> {
             Ok((l.trim().to_string(), r.trim().to_string()))
         }
         _ => Err(format!("`{s}`: expected LEFT,RIGHT node names")),
-    }
-}
-
-/// The rotation nodes the options name.
-fn rotation_nodes(a: &PlayArgs) -> fbakit::export::gltf_rotations::RotationNodes {
-    fbakit::export::gltf_rotations::RotationNodes {
-        head: a.head_node.clone(),
-        eyes: a.eye_nodes.clone(),
-        jaw: a.jaw_node.clone(),
     }
 }
 

@@ -8,8 +8,11 @@
 //! file's world frame and mapped back into each primitive's own space through the rest pose
 //! it was read with ([`crate::gltf::source::RestPose`]); the file's units are kept.
 //!
-//! FAT motion of transforms (rigid parts turned by the cloner) has no node of its own in
-//! the user's document: it is baked into per-vertex targets, piecewise linear over
+//! FAT motion of transforms (rigid parts turned by the cloner) is shown by the user's own
+//! node where the document has one for it — an eyeball alone under an eye node
+//! ([`super::gltf_user_nodes`]): animated on that node and recorded, not baked. Otherwise it
+//! has no node of its own in the user's document: it is baked into per-vertex targets,
+//! piecewise linear over
 //! `±2 V` in 8 intervals for rotations (`V` the key's reference value), one interval for
 //! translations and scales (linear in the FAP value). A document fbakit generated records
 //! its transforms' nodes (`specs/gltf-fat.md`): their motion is animated on those nodes and
@@ -28,6 +31,7 @@ use super::gltf_carried::carried_share;
 use super::gltf_rotations::{
     head_node, jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes, HEAD_FAPS,
 };
+use super::gltf_user_nodes::{eye_transforms, world_delta, UserNode};
 use crate::error::{Diagnostic, Result};
 use crate::face::gltf_fat::{self, TargetRecord};
 use crate::face::gltf_fat::{exact_offset, rate_of};
@@ -188,11 +192,23 @@ pub fn patch_face(
     // motion is animated there, not baked) and its lengths may be in other units.
     let unit = gltf_fat::face_unit(&source.json);
     let by_name = gltf_fat::transform_nodes(&source.json);
-    let transform_nodes: Vec<Option<usize>> = face
+    let mut transform_nodes: Vec<Option<usize>> = face
         .transforms
         .iter()
         .map(|t| by_name.get(&t.name).copied())
         .collect();
+    // Transforms the user's own nodes show (the eyeballs on eye nodes): recorded by an
+    // earlier write, or found now. Their motion is animated on the node, not baked.
+    let recorded_user = gltf_fat::user_node_transforms(&source.json);
+    let mut user_nodes: Vec<bool> = face
+        .transforms
+        .iter()
+        .map(|t| recorded_user.contains(&t.name))
+        .collect();
+    for (t, n) in eye_transforms(face, source, nodes, &transform_nodes, &mut warnings) {
+        transform_nodes[t] = Some(n);
+        user_nodes[t] = true;
+    }
     // A head node of the user's (named, or found by its usual names) turns the head: the
     // head rotations (48–50) of transforms the document has no node for are left to it, not
     // baked into morph targets (never a rotation and a morph for one motion).
@@ -349,6 +365,7 @@ pub fn patch_face(
         );
     }
     patch.scene_extras = gltf_fat::scene_record(face, unit, &transform_nodes);
+    gltf_fat::mark_user_nodes(&mut patch.scene_extras, &user_nodes);
     if let Some(frames) = frames.filter(|f| !f.is_empty()) {
         // The jaw joint, when there is one, takes open_jaw, thrust_jaw and shift_jaw over
         // from the targets (never a joint and a morph for one motion).
@@ -413,7 +430,14 @@ pub fn patch_face(
                 anim.rotations.push((n.node, values));
             }
         }
-        transform_channels(face, &transform_nodes, unit, frames, &mut patch.animation);
+        transform_channels(
+            face,
+            source,
+            (&transform_nodes, &user_nodes),
+            unit,
+            frames,
+            &mut patch.animation,
+        );
         if let Some(jaw) = &jaw {
             let anim = patch
                 .animation
@@ -640,15 +664,19 @@ fn bake_transforms(
     Ok(())
 }
 
-/// Channels on the nodes that show the face's FAT-driven transforms (a face fbakit generated
-/// and read back): the animated field values, lengths × `unit` (the rule of `export::gltf`).
+/// Channels on the nodes that show the face's FAT-driven transforms: on fbakit's own nodes (a
+/// face fbakit generated and read back) the animated field values, lengths × `unit` (the rule
+/// of `export::gltf`); on the user's nodes (`user`, per transform) the transform's motion
+/// in the face frame carried onto the node's rest pose ([`UserNode`]).
 fn transform_channels(
     face: &FaceModel,
-    transform_nodes: &[Option<usize>],
+    source: &GltfSource,
+    (transform_nodes, user): (&[Option<usize>], &[bool]),
     unit: f32,
     frames: &[AnimationFrame],
     animation: &mut Option<PatchAnimation>,
 ) {
+    let rest_frames = face.frames();
     let mut driven = vec![[false; 3]; face.transforms.len()];
     for x in face.fat.tables.iter().flat_map(|t| &t.transforms) {
         if let Some(i) = face.transform_index(&x.transform) {
@@ -676,6 +704,40 @@ fn transform_channels(
                 .unwrap_or(crate::fat::eval::TransformDelta::IDENTITY)
         };
         let anim = animation.get_or_insert_with(|| empty_animation(frames));
+        if user.get(i).copied().unwrap_or(false) {
+            let Some(frame) = UserNode::new(&source.json, node) else {
+                continue;
+            };
+            let parent = t
+                .parent
+                .and_then(|p| rest_frames.transforms.get(p).copied())
+                .unwrap_or(Affine3A::IDENTITY);
+            let rest = t.local_matrix();
+            let keys: Vec<(Quat, Vec3)> = keyed
+                .iter()
+                .map(|f| {
+                    frame.local(world_delta(
+                        parent,
+                        rest,
+                        t.animated_matrix(&delta(f)),
+                        unit,
+                    ))
+                })
+                .collect();
+            if !anim.rotations.iter().any(|(n, _)| *n == node) {
+                let mut values: Vec<Quat> = keys.iter().map(|k| k.0).collect();
+                same_hemisphere(&mut values);
+                anim.rotations.push((node, values));
+            }
+            // A pivot off the node's origin (or a thrust) moves it.
+            let t0 = frame.rest_translation();
+            let reach = 1e-6 * (t0.length() + unit);
+            if keys.iter().any(|k| k.1.distance(t0) > reach) {
+                anim.translations
+                    .push((node, keys.iter().map(|k| k.1).collect()));
+            }
+            continue;
+        }
         // A node already turned as a head or eye keeps that one rotation.
         if rot && !anim.rotations.iter().any(|(n, _)| *n == node) {
             let mut values: Vec<Quat> = keyed

@@ -7,6 +7,8 @@
 //! usual names (`Head`, `LeftEye`/`RightEye`, `eye.L`, Mixamo, CC, VRM 0 bone names) or by
 //! the VRM humanoid bones (`VRMC_vrm` 1.0, `VRM` 0.x). A FAP the face's FAT has a table for
 //! is left to that table (its morph targets): never a rotation and a morph for one motion.
+//! A cloned face's eyeball transforms are shown by eye nodes that hold the eyeball alone
+//! ([`super::gltf_user_nodes`]): their tables then turn those nodes through the transform.
 //!
 //! The jaw is the other way round ([`jaw_node`]): a skinned jaw joint carries the chin, the
 //! lower teeth and the lower lip with it, so when the document has one (`play --jaw-node`,
@@ -139,6 +141,23 @@ pub fn head_node(source: &GltfSource, names: &RotationNodes) -> Option<usize> {
     })
 }
 
+/// The left and right eye nodes (FAPs 23/25 and 24/26): the nodes named `names.eyes`, else
+/// the first with a usual eye name, else the VRM humanoid `leftEye`/`rightEye` bones.
+pub fn eye_nodes(source: &GltfSource, names: &RotationNodes) -> (Option<usize>, Option<usize>) {
+    let json = &source.json;
+    let (l, r) = match &names.eyes {
+        Some((l, r)) => (Some(l.as_str()), Some(r.as_str())),
+        None => (None, None),
+    };
+    let one = |name: Option<&str>, usual: &[&str], bone: &str| {
+        find(json, name, usual).or_else(|| name.is_none().then(|| vrm_bone(json, bone)).flatten())
+    };
+    (
+        one(l, LEFT_EYE_NAMES, "leftEye"),
+        one(r, RIGHT_EYE_NAMES, "rightEye"),
+    )
+}
+
 /// The head rotation FAPs (pitch, yaw, roll).
 pub const HEAD_FAPS: [u8; 3] = [48, 49, 50];
 
@@ -209,26 +228,11 @@ pub fn rotated_nodes(source: &GltfSource, fat: &Fat, names: &RotationNodes) -> V
             .iter()
             .any(|t| t.key == TableKey::LowLevel(FapId::new(f).expect("a FAP number")))
     };
-    let (eye_l, eye_r) = match &names.eyes {
-        Some((l, r)) => (Some(l.as_str()), Some(r.as_str())),
-        None => (None, None),
-    };
+    let (eye_l, eye_r) = eye_nodes(source, names);
     let wanted: [(Option<usize>, &[u8]); 3] = [
         (head_node(source, names), &[49, 48, 50]),
-        (
-            find(json, eye_l, LEFT_EYE_NAMES)
-                .or_else(|| eye_l.is_none().then(|| vrm_bone(json, "leftEye")).flatten()),
-            &[23, 25],
-        ),
-        (
-            find(json, eye_r, RIGHT_EYE_NAMES).or_else(|| {
-                eye_r
-                    .is_none()
-                    .then(|| vrm_bone(json, "rightEye"))
-                    .flatten()
-            }),
-            &[24, 26],
-        ),
+        (eye_l, &[23, 25]),
+        (eye_r, &[24, 26]),
     ];
     let (world, parent) = world_rotations(json);
     let mut out = Vec::new();
@@ -320,7 +324,7 @@ impl JawNode {
 }
 
 /// World matrix of every node at rest (parents from `children`).
-fn world_matrices(json: &Value) -> (Vec<Mat4>, Vec<Option<usize>>) {
+pub(crate) fn world_matrices(json: &Value) -> (Vec<Mat4>, Vec<Option<usize>>) {
     compose_at_rest(json, local_matrix)
 }
 

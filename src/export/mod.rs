@@ -25,6 +25,7 @@ pub mod gltf;
 pub mod gltf_carried;
 pub mod gltf_patch;
 pub mod gltf_rotations;
+pub mod gltf_user_nodes;
 pub mod movie;
 pub mod obj_sequence;
 pub mod obj_shapes;

@@ -54,6 +54,10 @@ pub struct ExportOptions {
     pub units: Option<LengthUnit>,
     /// Write a new document even when the face came from glTF (default: patch the user's).
     pub new_document: bool,
+    /// The user's nodes that turn for head, eye and jaw FAPs in a patched glTF (default:
+    /// found by their usual names); an eye node holding its eyeball alone shows the eye's
+    /// motion instead of morph targets.
+    pub nodes: super::gltf_rotations::RotationNodes,
 }
 
 /// What kind of asset [`write()`] made.
@@ -214,7 +218,7 @@ fn write_gltf(path: &Path, face: &FaceModel, options: &ExportOptions) -> Result<
         let meshes = source.json["meshes"].as_array().map_or(0, Vec::len);
         let (document, morph_targets, arkit, more) = match options.names {
             ShapeNames::Fat => {
-                let e = super::gltf_patch::patch_face(face, source, None, &Default::default())?;
+                let e = super::gltf_patch::patch_face(face, source, None, &options.nodes)?;
                 (e.document, e.morph_targets, None, e.warnings)
             }
             ShapeNames::Arkit => {

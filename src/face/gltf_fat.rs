@@ -230,6 +230,34 @@ pub fn transform_nodes(json: &Value) -> BTreeMap<String, usize> {
     out
 }
 
+/// The recorded face transforms whose node is the user's own (`userNode`), by name.
+pub fn user_node_transforms(json: &Value) -> std::collections::BTreeSet<String> {
+    scene_value(json).0["transforms"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(|t| t["userNode"] == Value::Bool(true))
+        .filter_map(|t| t["name"].as_str().map(str::to_string))
+        .collect()
+}
+
+/// Marks the face transforms `user` flags (per transform) in a [`scene_record`] as shown by
+/// the user's own nodes (`userNode`): `play` carries their motion onto the node's rest pose.
+pub fn mark_user_nodes(record: &mut Map<String, Value>, user: &[bool]) {
+    let Some(list) = record
+        .get_mut(KEY)
+        .and_then(|r| r.get_mut("transforms"))
+        .and_then(Value::as_array_mut)
+    else {
+        return;
+    };
+    for (t, &flag) in list.iter_mut().zip(user) {
+        if flag {
+            t["userNode"] = Value::Bool(true);
+        }
+    }
+}
+
 /// The shown scene's record and its JSON path (`asset.extras` for a file without scenes).
 fn scene_value(json: &Value) -> (&Value, String) {
     let s = json["scene"].as_u64().unwrap_or(0) as usize;

@@ -81,6 +81,53 @@ fn sphere(
 pub struct Options {
     /// A fifth primitive `teeth`: both rows of teeth in one primitive.
     pub teeth: bool,
+    /// The eyeballs on their own nodes `LeftEye` and `RightEye` (nodes [`LEFT_EYE_NODE`] and
+    /// [`RIGHT_EYE_NODE`], meshes 2 and 3) instead of `Body`'s `eyes` primitive.
+    pub eye_nodes: bool,
+}
+
+/// With [`Options::eye_nodes`]: the `Eyes` node and the eye nodes (indices).
+pub const EYES_NODE: usize = 8;
+pub const LEFT_EYE_NODE: usize = 9;
+pub const RIGHT_EYE_NODE: usize = 10;
+
+/// Centre of an eyeball (cm, armature frame); `left` is the face's own left (+x).
+pub fn eye_centre(left: bool) -> Vec3 {
+    HEAD_CENTRE + Vec3::new(if left { 3.2 } else { -3.2 }, 2.0, 7.5)
+}
+
+/// Rest rotations of the `Eyes` node and of each eye node (their own frames differ from
+/// the face's).
+fn eyes_node_rotation() -> glam::Quat {
+    glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)
+}
+fn eye_node_rotation(left: bool) -> glam::Quat {
+    glam::Quat::from_rotation_z(if left { 0.3 } else { -0.4 })
+}
+/// `Eyes`' translation in the `Head` joint's frame (cm), and each eye's in `Eyes`' frame.
+const EYES_OFFSET: Vec3 = Vec3::new(0.0, 2.0, 7.0);
+fn eye_node_translation(left: bool) -> Vec3 {
+    // The eye's centre relative to `Eyes`, in `Eyes`' turned frame; the right eye's node
+    // sits 0.3 cm off its centre (a pivot an artist placed by eye).
+    let off = eye_centre(left) - HEAD_CENTRE - EYES_OFFSET
+        + if left {
+            Vec3::ZERO
+        } else {
+            Vec3::new(0.0, 0.0, -0.3)
+        };
+    eyes_node_rotation().inverse() * off
+}
+
+/// World matrix (armature cm) of an eye node at rest.
+pub fn eye_node_world(left: bool) -> Mat4 {
+    let head = Mat4::from_translation(HEAD_CENTRE);
+    head * Mat4::from_rotation_translation(eyes_node_rotation(), EYES_OFFSET)
+        * Mat4::from_rotation_translation(eye_node_rotation(left), eye_node_translation(left))
+}
+
+/// One eyeball sphere as the `eyes` primitive has it.
+fn eyeball(left: bool) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
+    sphere(eye_centre(left), 1.2, 4, 8, std::f32::consts::PI)
 }
 
 /// Lip line height and front of the teeth rows (cm, armature frame): just behind the lips
@@ -202,14 +249,8 @@ pub fn body_prims() -> Vec<Prim> {
         triangles: vec![],
         joints: vec![],
     };
-    for x in [-3.2f32, 3.2] {
-        let (p, n, uv, t) = sphere(
-            HEAD_CENTRE + Vec3::new(x, 2.0, 7.5),
-            1.2,
-            4,
-            8,
-            std::f32::consts::PI,
-        );
+    for left in [false, true] {
+        let (p, n, uv, t) = eyeball(left);
         let base = eyes.positions.len() as u16;
         eyes.triangles
             .extend(t.iter().map(|tr| tr.map(|i| i + base)));
@@ -356,6 +397,9 @@ pub fn build_with(opts: &Options) -> Avatar {
     let image_view = b.view(&png, None);
     let mut primitives = Vec::new();
     for (k, p) in prims.iter().enumerate() {
+        if opts.eye_nodes && p.name == "eyes" {
+            continue;
+        }
         let pos = b.vec3(&p.positions, true);
         let nrm = b.vec3(&p.normals, false);
         let uv_bytes: Vec<u8> = p
@@ -426,6 +470,35 @@ pub fn build_with(opts: &Options) -> Avatar {
     let hat_iv = b.view(&hat_i, Some(34963));
     let hat_idx =
         b.acc(json!({"bufferView": hat_iv, "componentType": 5123, "count": 12, "type": "SCALAR"}));
+    // The eye meshes of `Options::eye_nodes`: each sphere in its node's own frame.
+    let mut eye_meshes = Vec::new();
+    if opts.eye_nodes {
+        for left in [true, false] {
+            let (p, n, uv, t) = eyeball(left);
+            let to_local = eye_node_world(left).inverse();
+            let p: Vec<Vec3> = p.iter().map(|&x| to_local.transform_point3(x)).collect();
+            let n: Vec<Vec3> = n
+                .iter()
+                .map(|&x| to_local.transform_vector3(x).normalize())
+                .collect();
+            let pos = b.vec3(&p, true);
+            let nrm = b.vec3(&n, false);
+            let uv_bytes: Vec<u8> = uv
+                .iter()
+                .flat_map(|v| v.to_array())
+                .flat_map(f32::to_le_bytes)
+                .collect();
+            let uv_view = b.view(&uv_bytes, Some(34962));
+            let uv = b.acc(json!({"bufferView": uv_view, "componentType": 5126, "count": p.len(), "type": "VEC2"}));
+            let ib: Vec<u8> = t.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+            let iv = b.view(&ib, Some(34963));
+            let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": t.len() * 3, "type": "SCALAR"}));
+            eye_meshes.push(json!({
+                "name": if left { "LeftEyeMesh" } else { "RightEyeMesh" },
+                "primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv}, "indices": idx, "material": 2}]
+            }));
+        }
+    }
     // Inverse bind matrices: each joint's world inverse times the armature (the mesh's bind
     // frame); the jaw's bind half a centimetre above its rest.
     let worlds = joint_worlds();
@@ -470,7 +543,7 @@ pub fn build_with(opts: &Options) -> Avatar {
     materials.extend(prims[4..].iter().map(|p| mat(p.name, false)));
     let hat_material = materials.len();
     materials.push(mat("hat", false));
-    let json = json!({
+    let mut json = json!({
         "asset": {"version": "2.0", "generator": "fbakit test avatar", "extras": {"author": "tests", "licence": "CC0"}},
         "extensionsUsed": ["KHR_materials_emissive_strength"],
         "scene": 0,
@@ -510,6 +583,21 @@ pub fn build_with(opts: &Options) -> Avatar {
         "bufferViews": b.views,
         "buffers": [{"byteLength": b.bin.len()}]
     });
+    if opts.eye_nodes {
+        json["nodes"][3]["children"] = json!([4, 6, EYES_NODE]);
+        let nodes = json["nodes"].as_array_mut().unwrap();
+        let q = |q: glam::Quat| json!(q.to_array());
+        nodes.push(
+            json!({"name": "Eyes", "translation": EYES_OFFSET.to_array(),
+            "rotation": q(eyes_node_rotation()), "children": [LEFT_EYE_NODE, RIGHT_EYE_NODE]}),
+        );
+        for (left, name, mesh) in [(true, "LeftEye", 2), (false, "RightEye", 3)] {
+            nodes.push(json!({"name": name, "mesh": mesh,
+                "translation": eye_node_translation(left).to_array(),
+                "rotation": q(eye_node_rotation(left))}));
+        }
+        json["meshes"].as_array_mut().unwrap().extend(eye_meshes);
+    }
     let mut bin = b.bin;
     while bin.len() % 4 != 0 {
         bin.push(0);

@@ -1,0 +1,510 @@
+//! Eyeballs on their own glTF nodes (issue 19 §1–2): cloned onto an avatar whose eyes are the
+//! nodes `LeftEye` and `RightEye` (under a turned `Eyes` node on the `Head` joint), the eye
+//! motion (FAPs 23–26) is not baked into morph targets: the patched glb records it as motion
+//! of those nodes, reads back with the same FAT, and `play` turns the nodes — never a
+//! rotation and a morph for one motion. The jaw joint takes `open_jaw` in play with every
+//! `open_jaw` target held at zero. VRML and new-document outputs keep the eye motion.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+
+use fbakit::clone::face::{clone_face, CloneOptions};
+use fbakit::face::{FaceModel, FaceReadOptions};
+use fbakit::fat::eval::Activation;
+use fbakit::fat::TableKey;
+use fbakit::snapshot::{diff, DiffOptions};
+use fbakit::spec::{FapId, FeaturePointId};
+use glam::{Mat4, Quat, Vec3};
+use serde_json::Value;
+use support::avatar::{self, Options, LEFT_EYE_NODE, RIGHT_EYE_NODE};
+
+const JAW_NODE: usize = 4;
+
+fn key(fap: u8) -> TableKey {
+    TableKey::LowLevel(FapId::new(fap).unwrap())
+}
+
+/// The avatar with eye nodes (and both teeth rows in one primitive) in `dir`, and its
+/// feature points.
+fn write_avatar(dir: &Path, source: &FaceModel) -> (PathBuf, PathBuf) {
+    let glb = dir.join("avatar.glb");
+    let opts = Options {
+        teeth: true,
+        eye_nodes: true,
+    };
+    std::fs::write(&glb, avatar::build_with(&opts).to_glb()).unwrap();
+    let csv = avatar::fp_csv(source, dir, &avatar::teeth_fp_lines());
+    (glb, csv)
+}
+
+fn run(args: &[&std::ffi::OsStr]) {
+    let o = support::cli::command().args(args).output().unwrap();
+    assert!(o.status.success(), "{}", support::cli::text(&o.stderr));
+}
+
+fn clone_to(glb: &Path, csv: &Path, out: &Path, more: &[&str]) {
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "clone".as_ref(),
+        "alma".as_ref(),
+        glb.as_os_str(),
+        "--fp-target".as_ref(),
+        csv.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ];
+    args.extend(more.iter().map(std::ffi::OsStr::new));
+    run(&args);
+}
+
+/// The JSON chunk and the BIN chunk of a glb.
+fn glb_parts(p: &Path) -> (Value, Vec<u8>) {
+    let bytes = std::fs::read(p).unwrap();
+    let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+    let json = serde_json::from_slice(chunks.json).unwrap();
+    (json, chunks.bin.unwrap_or_default().to_vec())
+}
+
+/// The float values of accessor `a` (tightly packed, no sparse).
+fn floats(json: &Value, bin: &[u8], a: usize) -> Vec<f32> {
+    let acc = &json["accessors"][a];
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let per = match acc["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC3" => 3,
+        "VEC4" => 4,
+        t => panic!("{t}"),
+    };
+    let n = acc["count"].as_u64().unwrap() as usize * per;
+    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+        + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
+    (0..n)
+        .map(|i| f32::from_le_bytes(bin[start + 4 * i..start + 4 * i + 4].try_into().unwrap()))
+        .collect()
+}
+
+/// A stream of FAPs 23–26 only: per frame (yaw_l, yaw_r, pitch_l, pitch_r).
+const GAZE: [[i32; 4]; 5] = [
+    [0, 0, 0, 0],
+    [20000, 20000, 0, 0],
+    [-15000, -12000, 0, 0],
+    [0, 0, 12000, 9000],
+    [10000, -8000, -9000, 7000],
+];
+
+fn write_gaze(dir: &Path) -> PathBuf {
+    let mut text = format!("2.1 gaze 25 {}\n", GAZE.len());
+    let mask: Vec<&str> = (1..=68)
+        .map(|f| if (23..=26).contains(&f) { "1" } else { "0" })
+        .collect();
+    for (i, v) in GAZE.iter().enumerate() {
+        text.push_str(&mask.join(" "));
+        text.push('\n');
+        text.push_str(&format!("{i} {} {} {} {}\n", v[0], v[1], v[2], v[3]));
+    }
+    let path = dir.join("gaze.fap");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn gaze_activations(v: &[i32; 4]) -> Vec<Activation> {
+    [23u8, 24, 25, 26]
+        .iter()
+        .zip(v)
+        .map(|(&f, &x)| Activation {
+            key: key(f),
+            value: f64::from(x),
+        })
+        .collect()
+}
+
+/// World matrix of node `n` at rest, and with `local` overrides (rotation, translation).
+fn node_world(
+    json: &Value,
+    n: usize,
+    over: &dyn Fn(usize) -> Option<(Quat, Option<Vec3>)>,
+) -> Mat4 {
+    let nodes = json["nodes"].as_array().unwrap();
+    let parent = |i: usize| {
+        nodes.iter().position(|p| {
+            p["children"]
+                .as_array()
+                .is_some_and(|c| c.iter().any(|c| c.as_u64() == Some(i as u64)))
+        })
+    };
+    let v3 = |v: &Value, d: Vec3| {
+        v.as_array().map_or(d, |a| {
+            Vec3::new(
+                a[0].as_f64().unwrap() as f32,
+                a[1].as_f64().unwrap() as f32,
+                a[2].as_f64().unwrap() as f32,
+            )
+        })
+    };
+    let local = |i: usize| {
+        let node = &nodes[i];
+        let mut r = node["rotation"].as_array().map_or(Quat::IDENTITY, |a| {
+            let f = |k: usize| a[k].as_f64().unwrap() as f32;
+            Quat::from_xyzw(f(0), f(1), f(2), f(3))
+        });
+        let mut t = v3(&node["translation"], Vec3::ZERO);
+        if let Some((q, tr)) = over(i) {
+            r = q;
+            if let Some(tr) = tr {
+                t = tr;
+            }
+        }
+        Mat4::from_scale_rotation_translation(v3(&node["scale"], Vec3::ONE), r, t)
+    };
+    let mut m = local(n);
+    let mut at = parent(n);
+    while let Some(p) = at {
+        m = local(p) * m;
+        at = parent(p);
+    }
+    m
+}
+
+/// The eye's centre at rest: the bounding-box centre of the mesh holding `pupil`.
+fn centre(face: &FaceModel, neutral: &[Vec<Vec3>], pupil: FeaturePointId) -> Vec3 {
+    let (m, _) = face.fp_vertex(pupil).unwrap();
+    let p = &neutral[m];
+    let lo = p.iter().fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
+    let hi = p
+        .iter()
+        .fold(Vec3::splat(f32::NEG_INFINITY), |a, &b| a.max(b));
+    (lo + hi) / 2.0
+}
+
+/// The eye's front: its pupil seen from its rest centre.
+fn front(face: &FaceModel, posed: &[Vec<Vec3>], pupil: FeaturePointId, centre: Vec3) -> Vec3 {
+    let (m, v) = face.fp_vertex(pupil).unwrap();
+    (posed[m][v as usize] - centre).normalize()
+}
+
+#[test]
+fn eye_nodes_turn_instead_of_morph_targets() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let out = d.join("out.glb");
+    clone_to(&glb, &csv, &out, &[]);
+    let (patched, _) = glb_parts(&out);
+
+    // The eye meshes get no morph target; no mesh has an eyeball target.
+    for m in [2, 3] {
+        assert!(
+            patched["meshes"][m]["primitives"][0]
+                .get("targets")
+                .is_none(),
+            "{}",
+            patched["meshes"][m]
+        );
+    }
+    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
+    assert!(!names.contains("eyeball"), "{names}");
+    // The scene record says the eye nodes show the eyes' transforms and carries their motion.
+    let record = &patched["scenes"][0]["extras"]["fbakit"];
+    for node in [LEFT_EYE_NODE, RIGHT_EYE_NODE] {
+        let t = record["transforms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|t| t["node"] == node)
+            .unwrap_or_else(|| panic!("no transform on node {node}: {}", record["transforms"]));
+        assert_eq!(t["userNode"], true, "{t}");
+    }
+    let tables = record["transformTables"].to_string();
+    for name in [
+        "yaw_l_eyeball",
+        "yaw_r_eyeball",
+        "pitch_l_eyeball",
+        "pitch_r_eyeball",
+    ] {
+        assert!(tables.contains(name), "{name}: {tables}");
+    }
+
+    // Read back: the same FAT as the clone's (but for the head rotations the `Head` node
+    // takes, which the clone's face keeps and the patched document leaves to the node).
+    let target = fbakit::face::read_with(&glb, &FaceReadOptions::with_feature_points(Some(&csv)))
+        .unwrap()
+        .0;
+    let mut cloned = clone_face(&source, &target, &CloneOptions::default())
+        .unwrap()
+        .face;
+    let back = fbakit::face::read(&out).unwrap();
+    cloned
+        .fat
+        .tables
+        .retain(|t| !matches!(t.key, TableKey::LowLevel(f) if [48, 49, 50].contains(&f.number())));
+    let report = diff(&cloned, &back, &DiffOptions::default());
+    assert!(report.equal, "{report}");
+
+    // Play a gaze stream: both eye nodes turn, no weight is keyed for eyeball targets.
+    let gaze = write_gaze(d);
+    let played = d.join("played.glb");
+    run(&[
+        "play".as_ref(),
+        out.as_os_str(),
+        gaze.as_os_str(),
+        "-o".as_ref(),
+        played.as_os_str(),
+    ]);
+    let (pj, bin) = glb_parts(&played);
+    let play = pj["animations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "play")
+        .unwrap()
+        .clone();
+    let channel = |node: usize, path: &str| {
+        play["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["target"]["node"] == node && c["target"]["path"] == path)
+            .map(|c| {
+                let s = &play["samplers"][c["sampler"].as_u64().unwrap() as usize];
+                floats(&pj, &bin, s["output"].as_u64().unwrap() as usize)
+            })
+    };
+    let eyes = [
+        (LEFT_EYE_NODE, FeaturePointId::FP_3_5, 0usize, 2usize),
+        (RIGHT_EYE_NODE, FeaturePointId::FP_3_6, 1, 3),
+    ];
+    for (node, pupil, yaw, pitch) in eyes {
+        let rot = channel(node, "rotation").unwrap_or_else(|| panic!("node {node} not turned"));
+        let tr = channel(node, "translation");
+        assert!(rot.len() >= 4 * GAZE.len());
+        let rest_world = node_world(&pj, node, &|_| None);
+        // The eye's centre in the node's frame: the pupil's mesh's bounding-box centre.
+        let neutral = back.neutral_world_positions();
+        let c = centre(&back, &neutral, pupil);
+        let rest_front = front(&back, &neutral, pupil, c);
+        for (k, v) in GAZE.iter().enumerate() {
+            let q = Quat::from_slice(&rot[4 * k..4 * k + 4]);
+            let t = tr.as_ref().map(|t| Vec3::from_slice(&t[3 * k..3 * k + 3]));
+            let world = node_world(&pj, node, &|i| (i == node).then_some((q, t)));
+            // Played: the node's motion applied to the eye's rest positions (file = face frame).
+            let (m, _) = back.fp_vertex(pupil).unwrap();
+            let motion = world * rest_world.inverse();
+            let played_pos: Vec<Vec3> = neutral[m]
+                .iter()
+                .map(|&p| motion.transform_point3(p))
+                .collect();
+            let mut posed_played = neutral.clone();
+            posed_played[m] = played_pos;
+            let got = front(&back, &posed_played, pupil, c);
+            // The FAT's own eye turn (the face read back, posed).
+            let want = front(&back, &back.pose(&gaze_activations(v)).unwrap(), pupil, c);
+            let angle = rest_front.angle_between(want);
+            eprintln!(
+                "node {node} frame {k}: played front {got}, FAT front {want} ({angle} rad turn)"
+            );
+            assert!(
+                got.distance(want) <= 0.01 * angle.max(1e-3) + 1e-4,
+                "frame {k}: played {got}, FAT {want}"
+            );
+            // The standard's directions: positive yaw turns the gaze to the face's left
+            // (+x), positive pitch down (−y); the played turn has the FAT's angle.
+            let (y, p) = (f64::from(v[yaw]) * 1e-5, f64::from(v[pitch]) * 1e-5);
+            if y != 0.0 {
+                assert_eq!(
+                    (got.x - rest_front.x).signum(),
+                    y.signum() as f32,
+                    "frame {k}"
+                );
+            }
+            if p != 0.0 {
+                assert_eq!(
+                    (got.y - rest_front.y).signum(),
+                    -p.signum() as f32,
+                    "frame {k}"
+                );
+            }
+            if y == 0.0 || p == 0.0 {
+                let turn = Quat::from_rotation_y(y as f32) * Quat::from_rotation_x(p as f32);
+                let standard = (turn * rest_front).normalize();
+                assert!(
+                    got.distance(standard) < 0.01 * angle + 1e-4,
+                    "frame {k}: played {got}, the standard's turn {standard}"
+                );
+            }
+        }
+    }
+    // No morph weights for eyeball motion: no weights channel drives an eye mesh, and the
+    // eye meshes' nodes are not keyed by weights.
+    for node in [LEFT_EYE_NODE, RIGHT_EYE_NODE] {
+        assert!(channel(node, "weights").is_none());
+    }
+
+    // No new validator issue.
+    let Some(reports) = support::validator::validate(&[glb.clone(), out.clone(), played.clone()])
+    else {
+        return;
+    };
+    let issues = |r: &Value| (r["errors"].clone(), r["warnings"].clone());
+    assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
+    assert_eq!(issues(&reports[0]), issues(&reports[2]), "{}", reports[2]);
+}
+
+/// The jaw joint takes `open_jaw` in play: it turns, and every `open_jaw` target (the lower
+/// teeth's included) stays at weight zero, so the teeth do not move twice.
+#[test]
+fn the_jaw_joint_and_open_jaw_targets_never_both_move() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let out = d.join("out.glb");
+    clone_to(&glb, &csv, &out, &[]);
+    let (patched, _) = glb_parts(&out);
+    let names: Vec<String> = patched["meshes"][0]["extras"]["targetNames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap().to_string())
+        .collect();
+    let jaw_targets: Vec<usize> = names
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.starts_with("open_jaw"))
+        .map(|(i, _)| i)
+        .collect();
+    assert!(!jaw_targets.is_empty(), "{names:?}");
+    let played = d.join("played.glb");
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/lowlevel.fap");
+    run(&[
+        "play".as_ref(),
+        out.as_os_str(),
+        sample.as_os_str(),
+        "-o".as_ref(),
+        played.as_os_str(),
+    ]);
+    let (pj, bin) = glb_parts(&played);
+    let play = pj["animations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "play")
+        .unwrap();
+    let output_of = |node: usize, path: &str| {
+        play["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["target"]["node"] == node && c["target"]["path"] == path)
+            .map(|c| {
+                let s = &play["samplers"][c["sampler"].as_u64().unwrap() as usize];
+                floats(&pj, &bin, s["output"].as_u64().unwrap() as usize)
+            })
+    };
+    let rot = output_of(JAW_NODE, "rotation").expect("the jaw joint turns");
+    let turned = rot
+        .chunks(4)
+        .map(|q| Quat::from_slice(q).angle_between(Quat::from_slice(&rot[..4])))
+        .fold(0.0, f32::max);
+    assert!(turned > 0.01, "the jaw turns at most {turned} rad");
+    let weights = output_of(5, "weights").expect("Body's weights are keyed");
+    let total = names.len();
+    assert_eq!(weights.len() % total, 0);
+    for (k, frame) in weights.chunks(total).enumerate() {
+        for &i in &jaw_targets {
+            assert_eq!(frame[i], 0.0, "frame {k}: {} at {}", names[i], frame[i]);
+        }
+    }
+}
+
+/// Cloned to VRML or to a new glb, the eyes are transforms (nodes of fbakit's own) and turn.
+#[test]
+fn vrml_and_new_documents_keep_the_eye_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let wrl = d.join("out.wrl");
+    clone_to(&glb, &csv, &wrl, &[]);
+    let new = d.join("new.glb");
+    clone_to(&glb, &csv, &new, &["--new-document"]);
+    for out in [wrl, new] {
+        let face = fbakit::face::read(&out).unwrap();
+        let neutral = face.neutral_world_positions();
+        for (pupil, fap, other) in [
+            (FeaturePointId::FP_3_5, 23u8, FeaturePointId::FP_3_6),
+            (FeaturePointId::FP_3_6, 24, FeaturePointId::FP_3_5),
+        ] {
+            let posed = face
+                .pose(&[Activation {
+                    key: key(fap),
+                    value: 20000.0,
+                }])
+                .unwrap();
+            let c = centre(&face, &neutral, pupil);
+            let (before, after) = (
+                front(&face, &neutral, pupil, c),
+                front(&face, &posed, pupil, c),
+            );
+            let want = (Quat::from_rotation_y(0.2) * before).normalize();
+            assert!(
+                after.distance(want) < 0.01 * 0.2,
+                "{}: FAP {fap} turns the eye to {after}, not {want}",
+                out.display()
+            );
+            let (m, _) = face.fp_vertex(other).unwrap();
+            assert!(
+                neutral[m]
+                    .iter()
+                    .zip(&posed[m])
+                    .all(|(a, b)| a.distance(*b) < 1e-6),
+                "{}: FAP {fap} moves the other eye",
+                out.display()
+            );
+        }
+    }
+}
+
+/// A node named as an eye whose mesh is no eyeball (the hat: no pupil on it) is not used,
+/// with a warning; the other eye node still turns its eye, and the unused eye's motion stays
+/// in morph targets of its mesh.
+#[test]
+fn an_eye_node_without_its_eyeball_is_not_used_and_said_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str()])
+        .args(["--eye-nodes", "Hat,RightEye", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("eye node `Hat` is not turned (its mesh holds no pupil 3.5)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("RightEye"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    let transforms = patched["scenes"][0]["extras"]["fbakit"]["transforms"].clone();
+    let on = |node: usize| {
+        transforms
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|t| t["node"] == node && t["userNode"] == true)
+    };
+    assert!(
+        on(RIGHT_EYE_NODE) && !on(LEFT_EYE_NODE) && !on(6),
+        "{transforms}"
+    );
+    let left_targets = patched["meshes"][2]["extras"]["targetNames"].to_string();
+    assert!(left_targets.contains("yaw_l_eyeball"), "{left_targets}");
+    assert!(patched["meshes"][3]["primitives"][0]
+        .get("targets")
+        .is_none());
+}
