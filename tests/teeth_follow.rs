@@ -221,3 +221,49 @@ fn candide_onto_alma_moves_alma_lower_teeth() {
     .unwrap();
     check("candide -> alma", &out, 0.5, 2.0);
 }
+
+/// CANDIDE-3 onto ICT's one mesh: the teeth and gums cut out of it (no source inner piece
+/// lends them a motion) follow ICT's cloned chin too, folded back into the one mesh.
+#[test]
+fn candide_onto_ict_moves_its_lower_teeth() {
+    let Some(candide) = candide::candide(&[]) else {
+        return;
+    };
+    let out = clone_face(&candide, &strip_fat(ict()), &CloneOptions::default()).unwrap();
+    let rows = |part: Part| -> Vec<usize> {
+        out.report
+            .split_parts
+            .iter()
+            .filter(|s| s.part == part)
+            .flat_map(|s| s.source_vertices.iter().map(|&v| v as usize))
+            .collect()
+    };
+    let (lower, upper) = (rows(Part::LowerTeeth), rows(Part::UpperTeeth));
+    assert!(lower.len() > 100 && upper.len() > 100);
+    let d = motion(&out.face, 3, 1024.0);
+    let p = &out.face.meshes[0].mesh.positions;
+    let at = out
+        .face
+        .feature_points
+        .position(FeaturePointId::FP_2_1)
+        .unwrap();
+    let chin_v = (0..p.len())
+        .min_by(|&a, &b| p[a].distance(at).total_cmp(&p[b].distance(at)))
+        .unwrap();
+    let chin = d[0][chin_v].length();
+    let mean = |vs: &[usize]| vs.iter().map(|&v| d[0][v].length()).sum::<f32>() / vs.len() as f32;
+    // Vertices on the cut along the lip line are in both rows and move half.
+    let only_upper: Vec<usize> = upper
+        .iter()
+        .copied()
+        .filter(|v| !lower.contains(v))
+        .collect();
+    let (lo, up) = (mean(&lower), mean(&only_upper));
+    eprintln!("candide -> ict open_jaw: chin {chin:.6}, lower teeth {lo:.6}, upper {up:.6}");
+    assert!(chin > 0.0);
+    assert!(
+        (0.5..=2.0).contains(&(lo / chin)),
+        "lower {lo} vs chin {chin}"
+    );
+    assert!(up < 0.05 * chin, "upper {up} vs chin {chin}");
+}

@@ -33,6 +33,7 @@ use std::collections::HashMap;
 
 use glam::{DMat3, DVec3};
 
+use super::part_motion::PartMeshes;
 use super::{Similarity, SkinSurface};
 use crate::clone::SurfaceMotion;
 use crate::face::FaceModel;
@@ -155,8 +156,8 @@ pub(super) fn jaw_motions(
     tsurf: &SkinSurface,
     frame: &Similarity,
     cloned: &[SurfaceMotion],
-) -> HashMap<(TableKey, u64), Vec<MorphMesh>> {
-    let mut out: HashMap<(TableKey, u64), Vec<MorphMesh>> = HashMap::new();
+) -> PartMeshes {
+    let mut out: PartMeshes = HashMap::new();
     if meshes.is_empty() {
         return out;
     }

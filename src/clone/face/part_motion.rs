@@ -27,6 +27,9 @@ use crate::fdp::Fapu;
 use crate::mesh::VertexIndex;
 use crate::spec::FapuKind;
 
+/// Per source motion (key, value bits), displacements of target part meshes.
+pub(super) type PartMeshes = HashMap<(TableKey, u64), Vec<MorphMesh>>;
+
 /// A part's nearest source vertices must lie within this share of the source surface's
 /// size (median): the source has the part's geometry in its skin, not just skin nearby.
 const MAX_MEDIAN_GAP: f32 = 0.005;
@@ -87,8 +90,8 @@ pub(super) fn part_motions(
     tsurf: &SkinSurface,
     frame: &Similarity,
     motions: &[SurfaceMotion],
-) -> (HashMap<(TableKey, u64), Vec<MorphMesh>>, Vec<usize>) {
-    let mut out: HashMap<(TableKey, u64), Vec<MorphMesh>> = HashMap::new();
+) -> (PartMeshes, Vec<usize>) {
+    let mut out: PartMeshes = HashMap::new();
     let mut placed = Vec::new();
     if todo.is_empty() || motions.is_empty() {
         return (out, placed);
