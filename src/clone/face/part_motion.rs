@@ -11,6 +11,13 @@
 //! open_jaw 7.6 % and thrust_jaw 11.4 % off the ICT identities' true FATs (per vertex: 2.6
 //! and 3.1 %). A source part that moves rigidly hands on a motion that is rigid up to its
 //! interpolation.
+//!
+//! Only parts cut out of a one-mesh target are lent such motion. Whole part meshes of a
+//! multi-mesh target (alma's and bruno's teeth under their transforms, cloned from ICT) lie
+//! within the gap of ICT's inner pieces but on the wrong places of them: lent, alma's lower
+//! teeth moved 0.49× its chin under open_jaw (ICT's own lower teeth 0.73× its chin) and
+//! 0.43× under thrust_jaw and shift_jaw. They follow the target's cloned chin instead
+//! (`jaw_follow`), as do cut parts no inner piece lies under.
 
 use std::collections::HashMap;
 
