@@ -107,6 +107,13 @@
 //!    pieces (closest point around the nearest inner vertex, barycentric; when the source has
 //!    geometry there: median gap under 0.5 % of its size), times the FAPU ratio — not one
 //!    rigid motion per part: a rig's gums and tongue stretch with the jaw (`part_motion`).
+//!    Lower teeth and a tongue the source drives by neither a part nor such inner pieces —
+//!    whole part meshes of the target (alma's teeth under their transform, cloned from ICT,
+//!    whose teeth lie elsewhere), or any target of a source without teeth (CANDIDE-3) —
+//!    take the small rigid motion fitted to the target's own cloned chin region, anchored
+//!    at the chin point, under the jaw FAPs and the high-level tables (`jaw_follow`: the
+//!    tongue rests on the mouth floor, so the jaw carries it). Upper teeth and eyeballs
+//!    never take it.
 //! 8. **`fat`** — per target skin mesh the face-frame displacements go back to the mesh frame
 //!    (inverse world 3×3) and [`fat_from_morph_targets`] rebuilds the tables (multi-interval
 //!    tables keep their borders); transform entries are appended. Every output number must be
@@ -151,7 +158,7 @@
 //! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
 //! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
 //! the surface (steps 4 and 8), `rescale` step 6, the guard and the gain, `smooth` the smooth
-//! step, `rigid` and `part_motion`
+//! step, `rigid`, `part_motion` and `jaw_follow`
 //! step 7, `assemble` step 8 and `fold` step 9. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
@@ -160,6 +167,7 @@ mod align;
 mod assemble;
 mod attached;
 mod fold;
+mod jaw_follow;
 mod motions;
 mod options;
 mod part_deform;
@@ -345,16 +353,24 @@ pub fn clone_face(
         parts: &sparts,
         targets: &rigid_targets,
     };
-    // Split target parts the source moves only by deformation get that motion, rigidly.
-    let mut part_meshes = part_motion::part_motions(
-        &sparts,
-        &report.split_parts,
-        &face,
-        &ssurf,
-        &tsurf,
-        &alignment,
-        &motions,
-    );
+    // Target parts the source has no part for: those cut out of a one-mesh target take the
+    // source's motion where they lie on its inner pieces (a one-mesh source's teeth and
+    // gums), vertex by vertex; the lower teeth and tongue left over (whole part meshes, a
+    // source without teeth) follow the target's own cloned chin (`jaw_follow`).
+    let undriven = part_motion::undriven_parts(&sparts, &tparts, &report.split_parts, &face);
+    let todo: Vec<usize> = undriven.iter().filter(|u| u.cut).map(|u| u.mesh).collect();
+    let (mut part_meshes, placed) =
+        part_motion::part_motions(&todo, &face, &ssurf, &tsurf, &alignment, &motions);
+    let on_jaw: Vec<usize> = undriven
+        .iter()
+        .filter(|u| matches!(u.part, Part::LowerTeeth | Part::Tongue) && !placed.contains(&u.mesh))
+        .map(|u| u.mesh)
+        .collect();
+    for (key, meshes) in
+        jaw_follow::jaw_motions(&face, &on_jaw, &tsurf, &alignment, &cloned_motions)
+    {
+        part_meshes.entry(key).or_default().extend(meshes);
+    }
     for (key, meshes) in deformed.meshes {
         part_meshes.entry(key).or_default().extend(meshes);
     }

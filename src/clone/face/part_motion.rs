@@ -11,6 +11,13 @@
 //! open_jaw 7.6 % and thrust_jaw 11.4 % off the ICT identities' true FATs (per vertex: 2.6
 //! and 3.1 %). A source part that moves rigidly hands on a motion that is rigid up to its
 //! interpolation.
+//!
+//! Only parts cut out of a one-mesh target are lent such motion. Whole part meshes of a
+//! multi-mesh target (alma's and bruno's teeth under their transforms, cloned from ICT) lie
+//! within the gap of ICT's inner pieces but on the wrong places of them: lent, alma's lower
+//! teeth moved 0.49× its chin under open_jaw (ICT's own lower teeth 0.73× its chin) and
+//! 0.43× under thrust_jaw and shift_jaw. They follow the target's cloned chin instead
+//! (`jaw_follow`), as do cut parts no inner piece lies under.
 
 use std::collections::HashMap;
 
@@ -27,32 +34,74 @@ use crate::fdp::Fapu;
 use crate::mesh::VertexIndex;
 use crate::spec::FapuKind;
 
+/// Per source motion (key, value bits), displacements of target part meshes.
+pub(super) type PartMeshes = HashMap<(TableKey, u64), Vec<MorphMesh>>;
+
 /// A part's nearest source vertices must lie within this share of the source surface's
 /// size (median): the source has the part's geometry in its skin, not just skin nearby.
 const MAX_MEDIAN_GAP: f32 = 0.005;
 
-/// Per source motion (key, value bits), the displacements of the target's split parts the
-/// source has no part mesh for.
-pub(super) fn part_motions(
+/// A target part mesh the source has no part mesh for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Undriven {
+    /// Its part.
+    pub part: Part,
+    /// Its mesh index.
+    pub mesh: usize,
+    /// Whether it was cut out of a one-mesh target (step 1), not a part mesh of its own.
+    pub cut: bool,
+}
+
+/// The target part meshes the source has no part mesh for, eyeballs left out (they move
+/// only by the eye FAPs' rotations, never with a lid: not their neighbours' deformation):
+/// parts cut out of a one-mesh target and whole part meshes alike.
+pub(super) fn undriven_parts(
     sparts: &FaceParts,
+    tparts: &FaceParts,
     split: &[SplitPart],
+    face: &FaceModel,
+) -> Vec<Undriven> {
+    let mut out: Vec<Undriven> = split
+        .iter()
+        .filter_map(|s| {
+            Some(Undriven {
+                part: s.part,
+                mesh: face.mesh_index(&s.mesh)?,
+                cut: true,
+            })
+        })
+        .collect();
+    for (&part, meshes) in &tparts.parts {
+        for &mesh in meshes {
+            if !out.iter().any(|u| u.mesh == mesh) {
+                out.push(Undriven {
+                    part,
+                    mesh,
+                    cut: false,
+                });
+            }
+        }
+    }
+    out.retain(|u| !matches!(u.part, Part::LeftEye | Part::RightEye));
+    out.retain(|u| !sparts.parts.contains_key(&u.part));
+    out
+}
+
+/// Per source motion (key, value bits), the displacements of the target part meshes `todo`
+/// (the cut ones of [`undriven_parts`]) that lie on the source's inner pieces; also the
+/// meshes so placed (moving or not).
+pub(super) fn part_motions(
+    todo: &[usize],
     face: &FaceModel,
     ssurf: &SkinSurface,
     tsurf: &SkinSurface,
     frame: &Similarity,
     motions: &[SurfaceMotion],
-) -> HashMap<(TableKey, u64), Vec<MorphMesh>> {
-    let mut out: HashMap<(TableKey, u64), Vec<MorphMesh>> = HashMap::new();
-    let todo: Vec<usize> = split
-        .iter()
-        // Eyeballs move only by the eye FAPs' rotations, never with a lid: not their
-        // neighbours' deformation.
-        .filter(|s| !matches!(s.part, Part::LeftEye | Part::RightEye))
-        .filter(|s| !sparts.parts.contains_key(&s.part))
-        .filter_map(|s| face.mesh_index(&s.mesh))
-        .collect();
+) -> (PartMeshes, Vec<usize>) {
+    let mut out: PartMeshes = HashMap::new();
+    let mut placed = Vec::new();
     if todo.is_empty() || motions.is_empty() {
-        return out;
+        return (out, placed);
     }
     let src = &ssurf.surface;
     let size = bounds_diagonal(&src.positions);
@@ -82,7 +131,7 @@ pub(super) fn part_motions(
         }
     }
     let frames = face.frames();
-    for mi in todo {
+    for &mi in todo {
         let world = frames.meshes[mi];
         let q: Vec<Vec3> = face.meshes[mi]
             .mesh
@@ -99,6 +148,7 @@ pub(super) fn part_motions(
         if gaps[gaps.len() / 2] > MAX_MEDIAN_GAP * size {
             continue;
         }
+        placed.push(mi);
         let places: Vec<Place> = q
             .iter()
             .zip(&near)
@@ -131,7 +181,7 @@ pub(super) fn part_motions(
                 });
         }
     }
-    out
+    (out, placed)
 }
 
 /// Where a target vertex lies on the source: up to three source vertices and their weights.
