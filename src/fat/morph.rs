@@ -185,44 +185,54 @@ pub fn fat_from_morph_targets(targets: &[MorphTarget]) -> Result<Fat> {
             keys.push(t.key);
         }
     }
+    // Tables are independent: built in parallel, kept in key order (and the first key's
+    // error reported, as a sequential build would).
+    use rayon::prelude::*;
+    let tables: Vec<Result<FaceDefTable>> =
+        keys.par_iter().map(|&key| table_of(targets, key)).collect();
     let mut fat = Fat::default();
-    for key in keys {
-        let mut group: Vec<&MorphTarget> = targets.iter().filter(|t| t.key == key).collect();
-        group.sort_by(|a, b| a.value.total_cmp(&b.value));
-        if let Some(w) = group.windows(2).find(|w| w[0].value == w[1].value) {
-            return Err(FatError::DuplicateMorphValue {
-                key,
-                value: w[0].value,
-            }
-            .into());
-        }
-        let mut borders: Vec<f64> = group.iter().map(|t| t.value).collect();
-        let zero_at = borders.partition_point(|&b| b < 0.0);
-        borders.insert(zero_at, 0.0);
-
-        let mut table = FaceDefTable::new(key);
-        for mesh in mesh_names_in_order(&group) {
-            table
-                .meshes
-                .push(mesh_entry(&group, &mesh, &borders, zero_at));
-        }
-        // Transforms are linear in the value: the first target defines them.
-        if let Some(first) = group.first() {
-            for t in &first.transforms {
-                let v = first.value;
-                table.transforms.push(FaceDefTransform {
-                    transform: t.transform.clone(),
-                    field: t.field,
-                    rotation_axis: t.rotation_axis,
-                    rotation_angle: (t.rotation_angle / v) as f32,
-                    scale: (t.scale / v).as_vec3(),
-                    translation: (t.translation / v).as_vec3(),
-                });
-            }
-        }
-        fat.tables.push(table);
+    for t in tables {
+        fat.tables.push(t?);
     }
     Ok(fat)
+}
+
+/// The table of `key` from its morph targets (module docs of [`fat_from_morph_targets`]).
+fn table_of(targets: &[MorphTarget], key: TableKey) -> Result<FaceDefTable> {
+    let mut group: Vec<&MorphTarget> = targets.iter().filter(|t| t.key == key).collect();
+    group.sort_by(|a, b| a.value.total_cmp(&b.value));
+    if let Some(w) = group.windows(2).find(|w| w[0].value == w[1].value) {
+        return Err(FatError::DuplicateMorphValue {
+            key,
+            value: w[0].value,
+        }
+        .into());
+    }
+    let mut borders: Vec<f64> = group.iter().map(|t| t.value).collect();
+    let zero_at = borders.partition_point(|&b| b < 0.0);
+    borders.insert(zero_at, 0.0);
+
+    let mut table = FaceDefTable::new(key);
+    for mesh in mesh_names_in_order(&group) {
+        table
+            .meshes
+            .push(mesh_entry(&group, &mesh, &borders, zero_at));
+    }
+    // Transforms are linear in the value: the first target defines them.
+    if let Some(first) = group.first() {
+        for t in &first.transforms {
+            let v = first.value;
+            table.transforms.push(FaceDefTransform {
+                transform: t.transform.clone(),
+                field: t.field,
+                rotation_axis: t.rotation_axis,
+                rotation_angle: (t.rotation_angle / v) as f32,
+                scale: (t.scale / v).as_vec3(),
+                translation: (t.translation / v).as_vec3(),
+            });
+        }
+    }
+    Ok(table)
 }
 
 fn mesh_names_in_order(group: &[&MorphTarget]) -> Vec<String> {
@@ -238,32 +248,38 @@ fn mesh_names_in_order(group: &[&MorphTarget]) -> Vec<String> {
 }
 
 fn mesh_entry(group: &[&MorphTarget], mesh: &str, borders: &[f64], zero_at: usize) -> FaceDefMesh {
+    // This mesh's entry in each target, with the target's border.
+    let entries: Vec<(usize, &MorphMesh)> = group
+        .iter()
+        .enumerate()
+        .flat_map(|(gi, t)| {
+            let b = if gi < zero_at { gi } else { gi + 1 };
+            t.meshes
+                .iter()
+                .filter(|m| m.mesh == mesh)
+                .map(move |m| (b, m))
+        })
+        .collect();
     // Vertex order: the first target's order, then any vertex only later targets move.
+    let mut slots = VertexSlots::new(entries.iter().map(|(_, m)| m.vertices.as_slice()));
     let mut vertices: Vec<u32> = Vec::new();
-    let mut seen = std::collections::HashSet::new();
-    for t in group {
-        for m in t.meshes.iter().filter(|m| m.mesh == mesh) {
-            for &v in &m.vertices {
-                if seen.insert(v) {
-                    vertices.push(v);
-                }
+    for (_, m) in &entries {
+        for &v in &m.vertices {
+            if slots.insert(v, vertices.len() as u32) {
+                vertices.push(v);
             }
         }
     }
-    let slot: std::collections::HashMap<u32, usize> =
-        vertices.iter().enumerate().map(|(i, &v)| (v, i)).collect();
-    // offsets[k][b]: offset of vertex k at border b (zero at the zero border).
-    let mut offsets = vec![vec![DVec3::ZERO; borders.len()]; vertices.len()];
-    for (gi, t) in group.iter().enumerate() {
-        let b = if gi < zero_at { gi } else { gi + 1 };
-        for m in t.meshes.iter().filter(|m| m.mesh == mesh) {
-            for (&v, o) in m.vertices.iter().zip(&m.offsets) {
-                offsets[slot[&v]][b] = *o;
-            }
+    // offsets[k·nb + b]: offset of vertex k at border b (zero at the zero border).
+    let nb = borders.len();
+    let mut offsets = vec![DVec3::ZERO; vertices.len() * nb];
+    for (b, m) in &entries {
+        for (&v, o) in m.vertices.iter().zip(&m.offsets) {
+            offsets[slots.get(v) as usize * nb + b] = *o;
         }
     }
-    let mut displacements = Vec::with_capacity(vertices.len() * (borders.len() - 1));
-    for per_vertex in &offsets {
+    let mut displacements = Vec::with_capacity(vertices.len() * (nb - 1));
+    for per_vertex in offsets.chunks_exact(nb.max(1)) {
         for (o, b) in per_vertex.windows(2).zip(borders.windows(2)) {
             displacements.push(((o[1] - o[0]) / (b[1] - b[0])).as_vec3());
         }
@@ -273,5 +289,53 @@ fn mesh_entry(group: &[&MorphTarget], mesh: &str, borders: &[f64], zero_at: usiz
         interval_borders: borders.to_vec(),
         coord_index: vertices,
         displacements,
+    }
+}
+
+/// Each vertex's slot in a mesh entry: a table indexed by vertex when the indices are not
+/// much larger than the lists holding them (the usual case, no hashing), else a map, so a
+/// stray huge index costs no huge table.
+enum VertexSlots {
+    Dense(Vec<u32>),
+    Sparse(std::collections::HashMap<u32, u32>),
+}
+
+impl VertexSlots {
+    fn new<'a>(lists: impl Iterator<Item = &'a [u32]> + Clone) -> Self {
+        let total: usize = lists.clone().map(<[u32]>::len).sum();
+        let max = lists.flatten().copied().max();
+        match max {
+            Some(m) if m as usize > 4 * total + 1024 => VertexSlots::Sparse(Default::default()),
+            m => VertexSlots::Dense(vec![u32::MAX; m.map_or(0, |m| m as usize + 1)]),
+        }
+    }
+
+    /// Gives `v` slot `slot` unless it has one; whether it was new.
+    fn insert(&mut self, v: u32, slot: u32) -> bool {
+        match self {
+            VertexSlots::Dense(t) => {
+                let s = &mut t[v as usize];
+                let new = *s == u32::MAX;
+                if new {
+                    *s = slot;
+                }
+                new
+            }
+            VertexSlots::Sparse(m) => match m.entry(v) {
+                std::collections::hash_map::Entry::Occupied(_) => false,
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(slot);
+                    true
+                }
+            },
+        }
+    }
+
+    /// The slot of a vertex given one.
+    fn get(&self, v: u32) -> u32 {
+        match self {
+            VertexSlots::Dense(t) => t[v as usize],
+            VertexSlots::Sparse(m) => m[&v],
+        }
     }
 }

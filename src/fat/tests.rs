@@ -236,6 +236,59 @@ fn multi_interval_fat_round_trips_through_morph_targets() {
 }
 
 #[test]
+fn morph_targets_keep_first_appearance_order_whatever_the_vertex_numbers() {
+    // Two targets of one key moving overlapping vertex lists in no sorted order: the entry
+    // lists vertices as they first appear, a vertex moved twice in one target keeps its last
+    // offset, and a vertex missing from a target is still there. Far-apart vertex numbers
+    // (a map instead of a table per vertex) give the same entry.
+    use super::morph::{MorphMesh, MorphTarget};
+    let key = TableKey::LowLevel(crate::spec::FapId::new(3).unwrap());
+    let targets = |base: u32| {
+        let mesh = |vertices: Vec<u32>, offsets: Vec<DVec3>| MorphMesh {
+            mesh: "skin".into(),
+            vertices: vertices.into_iter().map(|v| base + v).collect(),
+            offsets,
+        };
+        vec![
+            MorphTarget {
+                key,
+                value: 200.0,
+                meshes: vec![mesh(
+                    vec![5, 2, 5, 9],
+                    vec![DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE],
+                )],
+                transforms: vec![],
+            },
+            MorphTarget {
+                key,
+                value: -100.0,
+                meshes: vec![mesh(vec![7, 2], vec![DVec3::NEG_X, DVec3::NEG_Y])],
+                transforms: vec![],
+            },
+        ]
+    };
+    let dense = fat_from_morph_targets(&targets(0)).unwrap();
+    let m = &dense.tables[0].meshes[0];
+    assert_eq!(m.interval_borders, vec![-100.0, 0.0, 200.0]);
+    // The negative target comes first (borders ascending).
+    assert_eq!(m.coord_index, vec![7, 2, 5, 9]);
+    let rates = |a: DVec3, b: DVec3| [(-a / 100.0).as_vec3(), (b / 200.0).as_vec3()];
+    let want: Vec<Vec3> = [
+        rates(DVec3::NEG_X, DVec3::ZERO),
+        rates(DVec3::NEG_Y, DVec3::Y),
+        rates(DVec3::ZERO, DVec3::Z),
+        rates(DVec3::ZERO, DVec3::ONE),
+    ]
+    .concat();
+    assert_eq!(m.displacements, want);
+    let sparse = fat_from_morph_targets(&targets(3_000_000_000)).unwrap();
+    let s = &sparse.tables[0].meshes[0];
+    let shifted: Vec<u32> = m.coord_index.iter().map(|v| v + 3_000_000_000).collect();
+    assert_eq!(s.coord_index, shifted);
+    assert_eq!(s.displacements, m.displacements);
+}
+
+#[test]
 fn morph_targets_with_bad_values_are_rejected() {
     let mut mts = fat_to_morph_targets(&two_vertex_fat());
     mts[0].value = 0.0;

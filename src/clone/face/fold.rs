@@ -8,7 +8,7 @@
 //! meshes, vertices and polygons; its transforms are the target's plus those that still hold
 //! a mesh (a created root `head`).
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap};
 
 use glam::{Affine3A, Vec3};
 
@@ -113,7 +113,8 @@ pub(super) fn fold_into_target(
             .transforms
             .iter()
             .any(|t| baked.contains(&t.transform));
-        let mut rest: Vec<FaceDefMesh> = table.meshes.clone();
+        // The table's entries not yet taken by a cut (cloned only once they are kept).
+        let mut rest: Vec<&FaceDefMesh> = table.meshes.iter().collect();
         for cut in &cuts {
             let mut entries: Vec<FaceDefMesh> = Vec::new();
             rest.retain(|e| {
@@ -130,7 +131,8 @@ pub(super) fn fold_into_target(
                                 .iter()
                                 .map(|&v| m.to_target.get(v as usize).copied().unwrap_or(v))
                                 .collect(),
-                            ..e.clone()
+                            interval_borders: e.interval_borders.clone(),
+                            displacements: e.displacements.clone(),
                         });
                         false
                     }
@@ -190,10 +192,10 @@ pub(super) fn fold_into_target(
                     }
                 }
             }
-            merged.extend(merge_entries(&entries, &cut.multiplicity));
+            merged.extend(merge_entries(entries, &cut.multiplicity));
         }
         out.meshes = merged;
-        out.meshes.append(&mut rest);
+        out.meshes.extend(rest.into_iter().cloned());
         out.transforms = table
             .transforms
             .iter()
@@ -326,7 +328,7 @@ impl<'a> TableMotion<'a> {
 /// the union of their borders, each vertex's rates summed over the view meshes that moved it
 /// and divided by the number of view meshes holding it (a vertex on a cut takes the mean of
 /// both sides, a side without an entry counting as still).
-fn merge_entries(entries: &[FaceDefMesh], multiplicity: &[u8]) -> Option<FaceDefMesh> {
+fn merge_entries(mut entries: Vec<FaceDefMesh>, multiplicity: &[u8]) -> Option<FaceDefMesh> {
     let first = entries.first()?;
     let shared = entries.iter().any(|e| {
         e.coord_index
@@ -334,7 +336,7 @@ fn merge_entries(entries: &[FaceDefMesh], multiplicity: &[u8]) -> Option<FaceDef
             .any(|&v| multiplicity.get(v as usize).is_some_and(|&k| k > 1))
     });
     if entries.len() == 1 && !shared {
-        return Some(first.clone());
+        return entries.pop();
     }
     let mut borders: Vec<f64> = entries
         .iter()
@@ -344,25 +346,38 @@ fn merge_entries(entries: &[FaceDefMesh], multiplicity: &[u8]) -> Option<FaceDef
     borders.sort_by(f64::total_cmp);
     borders.dedup();
     let n = borders.len().saturating_sub(1);
-    let mut rates: BTreeMap<u32, Vec<Vec3>> = BTreeMap::new();
-    for e in entries {
-        let fine = on_borders(e, &borders);
-        for (slot, &v) in fine.coord_index.iter().enumerate() {
-            let sum = rates.entry(v).or_insert_with(|| vec![Vec3::ZERO; n]);
-            for (s, r) in sum
-                .iter_mut()
-                .zip(&fine.displacements[slot * n..(slot + 1) * n])
-            {
+    // Every (vertex, entry, slot), sorted by vertex, entries in order within a vertex (the
+    // sums in the same order as before, without a map of per-vertex vectors).
+    let fine: Vec<FaceDefMesh> = entries.iter().map(|e| on_borders(e, &borders)).collect();
+    let mut rows: Vec<(u32, u32, u32)> = fine
+        .iter()
+        .enumerate()
+        .flat_map(|(i, f)| {
+            f.coord_index
+                .iter()
+                .enumerate()
+                .map(move |(slot, &v)| (v, i as u32, slot as u32))
+        })
+        .collect();
+    rows.sort_unstable();
+    let mut coord_index = Vec::with_capacity(rows.len());
+    let mut displacements = Vec::with_capacity(rows.len() * n);
+    for run in rows.chunk_by(|a, b| a.0 == b.0) {
+        let v = run[0].0;
+        let at = displacements.len();
+        displacements.resize(at + n, Vec3::ZERO);
+        for &(_, i, slot) in run {
+            let slot = slot as usize;
+            let from = &fine[i as usize].displacements[slot * n..(slot + 1) * n];
+            for (s, r) in displacements[at..].iter_mut().zip(from) {
                 *s += *r;
             }
         }
-    }
-    let mut coord_index = Vec::with_capacity(rates.len());
-    let mut displacements = Vec::with_capacity(rates.len() * n);
-    for (v, r) in rates {
         let k = f32::from(multiplicity.get(v as usize).copied().unwrap_or(1).max(1));
+        for s in &mut displacements[at..] {
+            *s /= k;
+        }
         coord_index.push(v);
-        displacements.extend(r.into_iter().map(|x| x / k));
     }
     Some(FaceDefMesh {
         mesh: first.mesh.clone(),

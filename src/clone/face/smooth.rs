@@ -98,6 +98,17 @@ fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u32> {
         .flatten()
         .copied()
         .collect();
+    // Many motions move most of a large mesh: marking is cheaper than sorting there.
+    let max = tris.iter().copied().max().unwrap_or(0) as usize;
+    if tris.len() > 64 && max < 8 * tris.len() {
+        let mut seen = vec![false; max + 1];
+        for &t in &tris {
+            seen[t as usize] = true;
+        }
+        tris.clear();
+        tris.extend((0..=max as u32).filter(|&t| seen[t as usize]));
+        return tris;
+    }
     tris.sort_unstable();
     tris.dedup();
     tris

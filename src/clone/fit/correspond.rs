@@ -136,24 +136,29 @@ pub(crate) struct Labels<'a> {
 }
 
 /// Correspondences of every target vertex (`None`: no allowed source triangle, or beyond
-/// the fade). `source_sides`: the slit side of every source vertex.
+/// the fade) on the registered surface `source` builds. `source_sides`: the slit side of every source vertex.
 pub(crate) fn correspond(
     target: &[Vec3],
     target_triangles: &[[u32; 3]],
     labels: Labels,
-    source: &QuerySurface,
+    source: impl FnOnce() -> QuerySurface + Send,
     (source_triangles, source_sides): (&[[u32; 3]], &[Side]),
     scale: f32,
     opts: &FitOptions,
 ) -> Vec<Option<Correspondence>> {
     let Labels { sides, face } = labels;
-    let normals = vertex_normals(target, target_triangles);
-    let creases = crease_normals(target, target_triangles, &normals);
+    // The source's BVH is built while the target's normals and seams are found.
+    let (source, (normals, creases, probes)) = rayon::join(source, || {
+        let normals = vertex_normals(target, target_triangles);
+        let creases = crease_normals(target, target_triangles, &normals);
+        let probes = seam_probes(target, target_triangles, scale);
+        (normals, creases, probes)
+    });
+    let source = &source;
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let (near, far) = (opts.fade.0 as f32 * scale, opts.fade.1 as f32 * scale);
     let snap = SNAP * scale;
     let far_probe = far * 1.001;
-    let probes = seam_probes(target, target_triangles, scale);
     let seam_slack = SEAM_SLACK * scale;
     target
         .par_iter()

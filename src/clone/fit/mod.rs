@@ -273,11 +273,20 @@ fn register_and_correspond(
 )> {
     // 1. Sides.
     let clock = Instant::now();
-    let adj = adjacency(source.positions.len(), &source.triangles);
-    let t_adj = adjacency(target.positions.len(), &target.triangles);
-    let (s_sides, s_slits) = classify(source, &adj);
-    let (t_sides, t_slits) = classify(target, &t_adj);
-    let (s_face, t_face) = (face_pieces(source), face_pieces(target));
+    // The two surfaces' labels are independent: one core each.
+    let labels = |s: &CloneSurface| {
+        let adj = adjacency(s.positions.len(), &s.triangles);
+        let (sides, slits) = classify(s, &adj);
+        (adj, sides, slits, face_pieces(s))
+    };
+    let ((adj, s_sides, s_slits, s_face), ((_, t_sides, t_slits, t_face), loose)) = rayon::join(
+        || labels(source),
+        || {
+            let t = labels(target);
+            let loose = loose_duplicates(target, &t.1);
+            (t, loose)
+        },
+    );
     for (n, side) in [(s_slits, "source"), (t_slits, "target")] {
         if n < 3 {
             warnings.push(format!(
@@ -308,7 +317,6 @@ fn register_and_correspond(
              surface; they are not used as landmarks"
         ));
     }
-    let loose = loose_duplicates(target, &t_sides);
     if loose > 0 {
         warnings.push(format!(
             "fit: {loose} target vertices duplicate another vertex away from the mouth and \
@@ -327,11 +335,13 @@ fn register_and_correspond(
     // 2. Registration of the source onto the target.
     let clock = Instant::now();
     let scale = face_scale(source);
-    let fixed = QuerySurface::new(
-        &target.positions,
-        &target.triangles,
-        triangle_masks(&t_sides, &t_face, &target.triangles),
-    );
+    let fixed = || {
+        QuerySurface::new(
+            &target.positions,
+            &target.triangles,
+            triangle_masks(&t_sides, &t_face, &target.triangles),
+        )
+    };
     let moving = Moving {
         positions: &source.positions,
         triangles: &source.triangles,
@@ -341,18 +351,20 @@ fn register_and_correspond(
         landmarks: &landmarks,
         scale,
     };
-    let reg = register(&moving, &fixed, opts)?;
+    let reg = register(&moving, fixed, opts)?;
     stats.insert("fit_solves".into(), reg.solves as f64);
     stats.insert("fit_matched".into(), reg.matched);
     stats.insert("fit_gap_es0".into(), reg.mean_gap);
     timings.push("register", clock.elapsed().as_secs_f64());
     // 3. Correspondence.
     let clock = Instant::now();
-    let registered = QuerySurface::new(
-        &reg.positions,
-        &source.triangles,
-        triangle_masks(&s_sides, &s_face, &source.triangles),
-    );
+    let registered = || {
+        QuerySurface::new(
+            &reg.positions,
+            &source.triangles,
+            triangle_masks(&s_sides, &s_face, &source.triangles),
+        )
+    };
     let corr = correspond::correspond(
         &target.positions,
         &target.triangles,
@@ -360,7 +372,7 @@ fn register_and_correspond(
             sides: &t_sides,
             face: &t_face,
         },
-        &registered,
+        registered,
         (&source.triangles, &s_sides),
         scale,
         opts,

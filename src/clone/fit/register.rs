@@ -80,11 +80,16 @@ pub(crate) struct Registered {
     pub mean_gap: f64,
 }
 
-/// Registers `m` onto `fixed` (module docs).
-pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> Result<Registered> {
+/// Registers `m` onto the surface `fixed` builds (module docs). The fixed surface is built
+/// while the smoothness system is analysed and the landmark-only step solved, which need
+/// only the moving surface.
+pub(crate) fn register(
+    m: &Moving,
+    fixed: impl FnOnce() -> QuerySurface + Send,
+    opts: &FitOptions,
+) -> Result<Registered> {
     let n = m.positions.len();
     let p: Vec<DVec3> = m.positions.iter().map(|v| v.as_dvec3()).collect();
-    let mut system = SmoothSystem::new(m.adjacency, opts.membrane)?;
     let beta = opts.landmark_weight;
     let mut lm_diag = vec![0.0; n];
     let mut lm_rhs = vec![DVec3::ZERO; n];
@@ -94,9 +99,12 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
             lm_rhs[v as usize] += beta * (l.as_dvec3() - *pv);
         }
     }
-    let mut u = vec![DVec3::ZERO; n];
-    let mut solves = 0;
-    let mut solve = |alpha: f64, w: &[f64], c: &[DVec3], u: &mut Vec<DVec3>| -> Result<()> {
+    let solve = |system: &mut SmoothSystem,
+                 alpha: f64,
+                 w: &[f64],
+                 c: &[DVec3],
+                 u: &mut Vec<DVec3>|
+     -> Result<()> {
         let diag: Vec<f64> = (0..n).map(|i| w[i] + lm_diag[i] + DAMPING).collect();
         let rhs: Vec<[f64; 3]> = (0..n)
             .map(|i| (w[i] * (c[i] - p[i]) + lm_rhs[i]).to_array())
@@ -108,11 +116,25 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
         Ok(())
     };
     let stiff = opts.stiffness.first().copied().unwrap_or(1.0);
-    if !m.landmarks.is_empty() {
+    let start = || -> Result<(SmoothSystem, Vec<DVec3>, usize)> {
+        let mut system = SmoothSystem::new(m.adjacency, opts.membrane)?;
+        let mut u = vec![DVec3::ZERO; n];
+        if m.landmarks.is_empty() {
+            return Ok((system, u, 0));
+        }
         // Landmarks alone first: a smooth warp that brings the surfaces close.
-        solve(stiff, &vec![0.0; n], &vec![DVec3::ZERO; n], &mut u)?;
-        solves += 1;
-    }
+        solve(
+            &mut system,
+            stiff,
+            &vec![0.0; n],
+            &vec![DVec3::ZERO; n],
+            &mut u,
+        )?;
+        Ok((system, u, 1))
+    };
+    let (fixed, started) = rayon::join(fixed, start);
+    let fixed = &fixed;
+    let (mut system, mut u, mut solves) = started?;
     let cos = (opts.normal_degrees.to_radians()).cos() as f32;
     let limit = opts.max_distance as f32 * m.scale;
     let snap = super::correspond::SNAP * m.scale;
@@ -175,7 +197,7 @@ pub(crate) fn register(m: &Moving, fixed: &QuerySurface, opts: &FitOptions) -> R
             if count == 0 && m.landmarks.is_empty() {
                 break;
             }
-            solve(alpha, &w, &c, &mut u)?;
+            solve(&mut system, alpha, &w, &c, &mut u)?;
             solves += 1;
             matched = count as f64 / n.max(1) as f64;
             mean_gap = if count > 0 {

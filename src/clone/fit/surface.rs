@@ -97,13 +97,23 @@ impl QuerySurface {
     /// Builds the BVH over `positions` / `triangles` with the triangles' side masks (empty:
     /// no slit filter).
     pub fn new(positions: &[Vec3], triangles: &[[u32; 3]], masks: Vec<TriMask>) -> Self {
-        let verts: Vec<PVec> = positions.iter().map(|p| PVec::new(p.x, p.y, p.z)).collect();
-        let mesh = if triangles.is_empty() {
-            None
-        } else {
-            TriMesh::new(verts, triangles.to_vec()).ok()
-        };
-        let normals = triangle_normals(positions, triangles);
+        // parry's BVH on one core, the per-triangle tables on the other.
+        let (mesh, (normals, border)) = rayon::join(
+            || {
+                let verts: Vec<PVec> = positions.iter().map(|p| PVec::new(p.x, p.y, p.z)).collect();
+                if triangles.is_empty() {
+                    None
+                } else {
+                    TriMesh::new(verts, triangles.to_vec()).ok()
+                }
+            },
+            || {
+                (
+                    triangle_normals(positions, triangles),
+                    border_edges(triangles),
+                )
+            },
+        );
         let tree = mesh
             .as_ref()
             .and_then(|m| FilterTree::new(m, &masks, &normals));
@@ -114,7 +124,7 @@ impl QuerySurface {
             triangles: triangles.to_vec(),
             masks,
             normals,
-            border: border_edges(triangles),
+            border,
         }
     }
 
