@@ -635,7 +635,7 @@ fn the_jaw_joint_takes_the_jaw_faps_over_from_the_morphs() {
     let out = dir.path().join("found.glb");
     let (y, stderr) = play(&out, &[]);
     assert!(
-        stderr.contains("carries the chin (2.1) by 0 % only") && stderr.contains("stay morph"),
+        stderr.contains("carries feature point 2.1 by 0 % only") && stderr.contains("stay morph"),
         "{stderr}"
     );
     let jaw = y["nodes"]
@@ -767,4 +767,45 @@ fn sampler_output(
     (0..n)
         .map(|i| f32::from_le_bytes(bin[start + i * 4..start + i * 4 + 4].try_into().unwrap()))
         .collect()
+}
+
+/// A node found by the name `Head` that does not carry the face (here the hat, renamed; the
+/// real head joint renamed `Skull`) does not take the head rotations: they stay morph targets,
+/// with a warning. Named with `--head-node`, it takes them, with a warning.
+#[test]
+fn a_head_node_that_does_not_carry_the_face_is_not_taken_by_its_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = avatar::build();
+    a.json["nodes"][3]["name"] = "Skull".into();
+    a.json["nodes"][6]["name"] = "Head".into();
+    let input = dir.path().join("avatar.glb");
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let alma = fbakit::face::read("alma").unwrap();
+    let fp = avatar::fp_csv(&alma, dir.path(), "");
+    let clone = |out: &Path, extra: &[&str]| {
+        let o = command()
+            .args(["clone".as_ref(), "alma".as_ref(), input.as_os_str()])
+            .args(["--fp-target".as_ref(), fp.as_os_str()])
+            .args(["-o".as_ref(), out.as_os_str()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let names = json_of(out)["meshes"][0]["extras"]["targetNames"].to_string();
+        (names, text(&o.stderr))
+    };
+    let (names, stderr) = clone(&dir.path().join("found.glb"), &[]);
+    assert!(
+        stderr.contains("head node `Head` carries feature point 9.3 by 0 % only")
+            && stderr.contains("head rotations stay morph targets"),
+        "{stderr}"
+    );
+    assert!(names.contains("head_pitch"), "{names}");
+    let (names, stderr) = clone(&dir.path().join("named.glb"), &["--head-node", "Head"]);
+    assert!(stderr.contains("as --head-node asks"), "{stderr}");
+    assert!(!names.contains("head_"), "{names}");
+    // The real head joint, named: taken without a word.
+    let (names, stderr) = clone(&dir.path().join("skull.glb"), &["--head-node", "Skull"]);
+    assert!(!stderr.contains("head node"), "{stderr}");
+    assert!(!names.contains("head_"), "{names}");
 }

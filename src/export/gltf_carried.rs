@@ -2,15 +2,68 @@
 //! the vertex's skin weight on that joint and the joints below it; for a plain one, all of it
 //! when the node is the primitive's node or one of its ancestors, else nothing.
 //!
-//! `play` hands the jaw FAPs to a jaw node only when it carries the chin: a `Jaw` bone that
-//! no vertex of the chin is weighted to (an unused bone of a generic rig, a helper empty)
-//! would take `open_jaw` from the morph targets and move nothing.
+//! `play` hands the jaw FAPs to a jaw node only when it carries the chin (2.1), and the head
+//! rotations to a head node only when it carries the nose tip (9.3): a `Jaw` bone no chin
+//! vertex is weighted to (an unused bone of a generic rig, a helper empty) would take
+//! `open_jaw` from the morph targets and move nothing.
 
 use std::collections::BTreeSet;
 
 use serde_json::Value;
 
+use crate::face::FaceModel;
 use crate::gltf::source::GltfSource;
+use crate::spec::FeaturePointId;
+
+/// Whether `node` (playing the `role`, e.g. "jaw") carries the vertex of feature point `fp`
+/// at least half (see [`carried_share`]; a point given by position takes the face's nearest
+/// vertex), else why not, in words.
+pub fn carries_point(
+    source: &GltfSource,
+    face: &FaceModel,
+    node: usize,
+    role: &str,
+    fp: FeaturePointId,
+) -> Result<(), String> {
+    let name = source.json["nodes"][node]["name"].as_str().unwrap_or("");
+    let Some((mesh, vertex)) = face.fp_vertex(fp).or_else(|| {
+        let at = face.feature_points.position(fp)?;
+        let world = face.neutral_world_positions();
+        world
+            .iter()
+            .enumerate()
+            .flat_map(|(m, ps)| ps.iter().enumerate().map(move |(v, p)| (m, v, p)))
+            .min_by(|a, b| a.2.distance(at).total_cmp(&b.2.distance(at)))
+            .map(|(m, v, _)| (m, v as u32))
+    }) else {
+        return Err(format!(
+            "{role} node `{name}`: the face has no feature point {fp} to check it by"
+        ));
+    };
+    let mesh_name = &face.meshes[mesh].name;
+    let Some(part) = source.part(mesh_name) else {
+        return Err(format!(
+            "{role} node `{name}`: the mesh `{mesh_name}` of feature point {fp} is not in the document"
+        ));
+    };
+    match carried_share(
+        source,
+        part.node,
+        part.mesh,
+        part.primitive,
+        vertex as usize,
+        node,
+    ) {
+        Some(s) if s >= 0.5 => Ok(()),
+        Some(s) => Err(format!(
+            "{role} node `{name}` carries feature point {fp} by {:.0} % only",
+            s * 100.0
+        )),
+        None => Err(format!(
+            "{role} node `{name}`: the skin weights of feature point {fp} cannot be read"
+        )),
+    }
+}
 
 /// The share (0–1) of vertex `vertex` of the document's `mesh`/`primitive`, instanced by
 /// `mesh_node`, that `node` moves; `None` when the document cannot say (unreadable weights).

@@ -27,7 +27,7 @@ use glam::{Affine3A, Quat, Vec3};
 use serde_json::Map;
 
 use super::gltf::FaceMorphs;
-use super::gltf_carried::carried_share;
+use super::gltf_carried::carries_point;
 use super::gltf_rotations::{
     head_node, jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes, HEAD_FAPS,
 };
@@ -212,8 +212,37 @@ pub fn patch_face(
     // A head node of the user's (named, or found by its usual names) turns the head: the
     // head rotations (48–50) of transforms the document has no node for are left to it, not
     // baked into morph targets (never a rotation and a morph for one motion).
+    // A head node found by its name must carry the face (its nose tip); one the user names
+    // is taken at their word, with a warning when it does not.
+    // (A face without those points cannot be checked: the node is taken.)
+    let head = head_node(source, nodes).filter(|&n| {
+        let Some(nose) = [FeaturePointId::FP_9_3, FeaturePointId::FP_2_1]
+            .into_iter()
+            .find(|&id| face.feature_points.position(id).is_some())
+        else {
+            return true;
+        };
+        match carries_point(source, face, n, "head", nose) {
+            Ok(()) => true,
+            Err(why) if nodes.head.is_some() => {
+                warnings.push(Diagnostic::warning(format!(
+                    "{}: {why}; it takes the head rotations as --head-node asks",
+                    source.path.display()
+                )));
+                true
+            }
+            Err(why) => {
+                warnings.push(Diagnostic::warning(format!(
+                    "{}: {why}; head rotations stay morph targets (--head-node NAME hands \
+                     them to a node anyway)",
+                    source.path.display()
+                )));
+                false
+            }
+        }
+    });
     let trimmed;
-    let face = match head_node(source, nodes) {
+    let face = match head {
         Some(n) if !transform_nodes.contains(&Some(n)) => {
             trimmed = without_head_rotations(face, &transform_nodes);
             &trimmed
@@ -373,25 +402,27 @@ pub fn patch_face(
         let jaw = match jaw_node(source, face, nodes.jaw.as_deref(), unit, &driven) {
             // A node found by its name must carry the chin; one the user names is taken at
             // their word, with a warning when it does not.
-            Ok(Some(jaw)) => match carries_chin(source, face, &jaw) {
-                Ok(()) => Some(jaw),
-                Err(why) if nodes.jaw.is_some() => {
-                    warnings.push(Diagnostic::warning(format!(
-                        "{}: {why}; it takes open_jaw, thrust_jaw and shift_jaw as --jaw-node \
+            Ok(Some(jaw)) => {
+                match carries_point(source, face, jaw.node, "jaw", FeaturePointId::FP_2_1) {
+                    Ok(()) => Some(jaw),
+                    Err(why) if nodes.jaw.is_some() => {
+                        warnings.push(Diagnostic::warning(format!(
+                            "{}: {why}; it takes open_jaw, thrust_jaw and shift_jaw as --jaw-node \
                          asks",
-                        source.path.display()
-                    )));
-                    Some(jaw)
-                }
-                Err(why) => {
-                    warnings.push(Diagnostic::warning(format!(
-                        "{}: {why}; open_jaw, thrust_jaw and shift_jaw stay morph targets \
+                            source.path.display()
+                        )));
+                        Some(jaw)
+                    }
+                    Err(why) => {
+                        warnings.push(Diagnostic::warning(format!(
+                            "{}: {why}; open_jaw, thrust_jaw and shift_jaw stay morph targets \
                          (--jaw-node NAME hands them to a node anyway)",
-                        source.path.display()
-                    )));
-                    None
+                            source.path.display()
+                        )));
+                        None
+                    }
                 }
-            },
+            }
             Ok(None) => None,
             Err(why) => {
                 warnings.push(Diagnostic::warning(format!(
@@ -843,55 +874,6 @@ fn animation(
         anim.weights.push((node, values));
     }
     (!anim.weights.is_empty()).then_some(anim)
-}
-
-/// Whether `jaw` carries the chin's vertex (feature point 2.1) at least half (skin weights on
-/// the joint and below it, or the chin's mesh under the node), else why not: a jaw bone no
-/// chin vertex is weighted to would take the jaw FAPs from the morph targets and move nothing.
-fn carries_chin(source: &GltfSource, face: &FaceModel, jaw: &JawNode) -> Result<(), String> {
-    let name = source.json["nodes"][jaw.node]["name"]
-        .as_str()
-        .unwrap_or("")
-        .to_string();
-    let Some((mesh, vertex)) = face.fp_vertex(FeaturePointId::FP_2_1).or_else(|| {
-        // A point given by position: the face's nearest vertex.
-        let chin = face.feature_points.position(FeaturePointId::FP_2_1)?;
-        let world = face.neutral_world_positions();
-        world
-            .iter()
-            .enumerate()
-            .flat_map(|(m, ps)| ps.iter().enumerate().map(move |(v, p)| (m, v, p)))
-            .min_by(|a, b| a.2.distance(chin).total_cmp(&b.2.distance(chin)))
-            .map(|(m, v, _)| (m, v as u32))
-    }) else {
-        return Err(format!(
-            "jaw node `{name}`: the face has no chin (feature point 2.1)"
-        ));
-    };
-    let Some(part) = source.part(&face.meshes[mesh].name) else {
-        return Err(format!(
-            "jaw node `{name}`: the chin's mesh `{}` is not in the document",
-            face.meshes[mesh].name
-        ));
-    };
-    let share = carried_share(
-        source,
-        part.node,
-        part.mesh,
-        part.primitive,
-        vertex as usize,
-        jaw.node,
-    );
-    match share {
-        Some(s) if s >= 0.5 => Ok(()),
-        Some(s) => Err(format!(
-            "jaw node `{name}` carries the chin (2.1) by {:.0} % only",
-            s * 100.0
-        )),
-        None => Err(format!(
-            "jaw node `{name}`: the chin's skin weights cannot be read"
-        )),
-    }
 }
 
 #[cfg(test)]
