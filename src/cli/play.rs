@@ -383,7 +383,8 @@ fn report_text(r: &PlayReport) -> String {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct NodeArgs {
     /// glTF face: the node head pitch, yaw and roll (FAPs 48-50) turn (default: found by the
-    /// usual names such as `Head`, or the VRM humanoid head bone).
+    /// usual names such as `Head`, or the VRM humanoid head bone, when it carries the nose
+    /// tip 9.3).
     #[arg(long, value_name = "NODE")]
     pub head_node: Option<String>,
     /// glTF face: the left and right eye nodes eyeball yaw and pitch (FAPs 23-26) turn, as
@@ -393,7 +394,8 @@ pub struct NodeArgs {
     pub eye_nodes: Option<(String, String)>,
     /// glTF face: the jaw node open_jaw turns and thrust_jaw / shift_jaw move (FAPs 3, 14,
     /// 15), instead of their morph targets (default: a node named `Jaw`/`jaw` or the VRM
-    /// humanoid jaw bone). Needs the face's feature points (FAP units and the chin, 2.1).
+    /// humanoid jaw bone, when it carries the chin 2.1: skinned to it at least half, or under
+    /// it). Needs the face's feature points (FAP units and the chin, 2.1).
     #[arg(long, value_name = "NODE")]
     pub jaw_node: Option<String>,
 }
