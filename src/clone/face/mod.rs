@@ -299,7 +299,8 @@ pub fn clone_face(
         .timings
         .push("motions", clock.elapsed().as_secs_f64());
     // 5, 6. Surface method and FAPU rescale.
-    let cloned_motions = clone_skin_motions(&ssurf, &tsurf, &motions, opts, &mut report)?;
+    let cloned_motions =
+        clone_skin_motions(&ssurf, &tsurf, &motions, &alignment, opts, &mut report)?;
     let cloned: HashMap<(TableKey, u64), &SurfaceMotion> = cloned_motions
         .iter()
         .map(|m| ((m.key, m.value.to_bits()), m))
@@ -420,11 +421,13 @@ pub fn clone_face(
 }
 
 /// Steps 5 and 6: the surface method on the motions that move the skin, then (RBF) the FAPU
-/// rescale. Returns one cloned motion per moving source motion.
+/// rescale, the guard, `smooth` and `gain` (which turns the wanted motions by the
+/// `alignment`'s rotation). Returns one cloned motion per moving source motion.
 fn clone_skin_motions(
     ssurf: &SkinSurface,
     tsurf: &SkinSurface,
     motions: &[SurfaceMotion],
+    alignment: &Similarity,
     opts: &CloneOptions,
     report: &mut CloneReport,
 ) -> Result<Vec<SurfaceMotion>> {
@@ -490,8 +493,13 @@ fn clone_skin_motions(
     };
     if scaled {
         let clock = Instant::now();
-        report.fapu_gain =
-            gain_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+        report.fapu_gain = gain_to_fapu(
+            &ssurf.surface,
+            &moving,
+            &tsurf.surface,
+            &mut result.motions,
+            alignment.rotation,
+        );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
     Ok(result.motions)

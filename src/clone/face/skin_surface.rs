@@ -216,7 +216,11 @@ fn concatenate_skin(
     (positions, triangles, starts)
 }
 
-/// The face's placed feature points mapped by `frame`, and the FAPU measured on them.
+/// The face's placed feature points mapped by `frame`, and the face's own FAPU in the frame's
+/// units. The FAPU are measured on the face's own points, then scaled: they are component
+/// differences along the face's axes (MNS0 = 9.15.y − 2.2.y), so measured on turned points
+/// they would read part of another axis (CANDIDE aligned onto the ICT head turns 6.65°, and
+/// its nose–mouth z offset made every cloned FAP 3.9 % off its FAPU).
 fn framed_feature_points(
     face: &FaceModel,
     frame: &Similarity,
@@ -225,15 +229,25 @@ fn framed_feature_points(
     let mut fp_positions = BTreeMap::new();
     for fp in face.feature_points.iter() {
         if let Some(p) = fp.position {
-            let q = frame.point(p);
-            fp_positions.insert(fp.id, q);
-            fp_set.insert(FeaturePoint::at(fp.id, q));
+            fp_positions.insert(fp.id, frame.point(p));
+            fp_set.insert(FeaturePoint::at(fp.id, p));
         }
     }
-    let fapu = Fapu::from_feature_points(&fp_set).map_err(|e| CloneError::Fapu {
+    let fapu_error = |e| CloneError::Fapu {
         face: face.name.clone(),
         source: Box::new(e),
-    })?;
+    };
+    let own = Fapu::from_feature_points(&fp_set).map_err(fapu_error)?;
+    let d = own.distances;
+    let s = frame.scale;
+    let fapu = Fapu::from_distances(crate::fdp::FapuDistances {
+        irisd0: d.irisd0 * s,
+        es0: d.es0 * s,
+        ens0: d.ens0 * s,
+        mns0: d.mns0 * s,
+        mw0: d.mw0 * s,
+    })
+    .map_err(|e| fapu_error(e.into()))?;
     Ok((fp_positions, fapu))
 }
 
