@@ -76,10 +76,12 @@
 //!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
 //!    changed. Smoothed motions are listed in [`CloneReport::smoothed`].
 //!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
-//!    the FAPU-scaled source motion by a smooth gain field around it (Wendland C² bump over
-//!    half an ES0, gain 1/10–10; [`CloneReport::fapu_gain`]): a registration that put the
-//!    target's feature point off the source's peak (a stylised brow onto a real one) no
-//!    longer leaves the FAP half as strong. Not with FAPU scaling off
+//!    the FAPU-scaled source motion, turned by the alignment's rotation into the target's own
+//!    axes, by a smooth gain and turn field around it (Wendland C² bump over half an ES0,
+//!    gain 1/10–10, turn up to 45°; else the difference is added over the point's edge
+//!    neighbourhood; [`CloneReport::fapu_gain`]): a registration that put the target's
+//!    feature point off the source's peak (a stylised brow onto a real one) no longer leaves
+//!    the FAP half as strong. Not with FAPU scaling off
 //!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part

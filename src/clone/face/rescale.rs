@@ -172,26 +172,33 @@ fn edge_ball(positions: &[Vec3], adj: &[Vec<u32>], centre: u32, reach: f32) -> V
 
 /// Makes each low-level translation FAP's feature point move by the FAPU-scaled source
 /// displacement (the compliance MPEG-4 asks for), smoothly, within `R` = [`GAIN_REACH_ES0`]
-/// × ES0 of the target's feature point `f` along mesh edges ([`edge_ball`]), with `φ` =
-/// [`bump`] of that distance over `R`. The wanted displacement `w` is the source's × the
-/// target/source FAPU of the FAP's unit, turned by the alignment's rotation `turn` (target →
-/// source frame): FAP directions live in each face's own axes, so a source moving its chin
-/// down and back asks the target to move down and back along *its* axes, not along the
-/// source's (bruno's 3.15° alignment tipped the chin's large backward motion into the
-/// target's y, 10 % of the FAP, before). With `d_f` the cloned feature-point displacement:
+/// × ES0 of the target's feature point `f`, with `φ` = [`bump`] of the distance over `R`. The
+/// wanted displacement `w` is the source's × the target/source FAPU of the FAP's unit, turned
+/// by the alignment's rotation `turn` (target → source frame): FAP directions live in each
+/// face's own axes, so a source moving its chin down and back asks the target to move down
+/// and back along *its* axes, not along the source's (bruno's 3.15° alignment tipped the
+/// chin's large backward motion into the target's y, 10 % of the FAP, before). With `d_f`
+/// the cloned feature-point displacement:
 ///
 /// - when `d_f` is within [`MAX_GAIN_TURN`] of `w` and `k = ‖w‖/‖d_f‖` within `[1/10, 10]`,
 ///   the motion `d` becomes `g·Q·d`, the gain `g = 1 + (k − 1)·φ` and `Q` the turn about
-///   `d_f × w` by `θ·φ` (`θ` the angle from `d_f` to `w`): still vertices stay still;
+///   `d_f × w` by `θ·φ` (`θ` the angle from `d_f` to `w`), `φ` of the straight distance:
+///   still vertices stay still;
 /// - otherwise (a coarse target whose registration read the wrong side of a feature, so its
-///   point moves the other way or barely) `d` becomes `d + (w − d_f)·φ`.
+///   point moves the other way or barely: CANDIDE's brows and lips under the ICT head's FAPs)
+///   `d` becomes `d + (w − d_f)·φ`, `φ` of the distance along mesh edges ([`edge_ball`]), so
+///   the added motion does not jump an open slit. (Along edges for the gain too moved the
+///   CANDIDE sparse → dense known-FAT case from 1.33 to 1.36 % median: the edge paths of a
+///   dense mesh are longer than the straight line, which narrows the bump.)
 ///
 /// At `f` the motion is exactly `w`; beyond `R` it is untouched; in between the field is
 /// smooth, so the motion stays as smooth as it was. A registration that put the feature
 /// point off the source's peak (a cartoon's brow onto a real one) so no longer leaves the FAP
 /// weak, without a uniform rescale of the whole motion. Motions within 1 % of `w`, and those
-/// whose feature point barely moves (the guard's business), are left alone. Returns, by FAP
-/// name and value, the least-squares factor `(w·d_f)/(d_f·d_f)` of each corrected motion.
+/// whose feature point barely moves (the guard's business), are left alone. The target
+/// follows its source: a source whose own motion is not compliant is cloned as it is (a
+/// self-clone stays exact). Returns, by FAP name and value, the least-squares factor
+/// `(w·d_f)/(d_f·d_f)` of each corrected motion.
 pub(super) fn gain_to_fapu(
     source: &CloneSurface,
     motions: &[SurfaceMotion],
@@ -220,7 +227,6 @@ pub(super) fn gain_to_fapu(
         if (want - got).length() <= GAIN_TOLERANCE * wl {
             continue;
         }
-        let ball = edge_ball(&target.positions, &adj, tv, reach);
         let angle = got.angle_between(want);
         let k = wl / gl;
         if angle <= MAX_GAIN_TURN && (1.0 / MAX_GAIN..=MAX_GAIN).contains(&k) {
@@ -230,17 +236,19 @@ pub(super) fn gain_to_fapu(
             } else {
                 angle as f32
             };
-            let weight: std::collections::HashMap<u32, f32> =
-                ball.iter().map(|&(v, x)| (v, bump(x / reach))).collect();
+            let centre = target.positions[tv as usize];
             for (v, d) in &mut dst.offsets {
-                let Some(&w) = weight.get(v) else { continue };
+                let w = bump(target.positions[*v as usize].distance(centre) / reach);
+                if w == 0.0 {
+                    continue;
+                }
                 let q = Quat::from_axis_angle(axis, angle * w);
                 *d = q * *d * (1.0 + (k as f32 - 1.0) * w);
             }
         } else {
             let fix = (want - got).as_vec3();
             let mut dense: BTreeMap<u32, Vec3> = dst.offsets.iter().copied().collect();
-            for &(v, x) in &ball {
+            for (v, x) in edge_ball(&target.positions, &adj, tv, reach) {
                 *dense.entry(v).or_insert(Vec3::ZERO) += fix * bump(x / reach);
             }
             dst.offsets = dense
