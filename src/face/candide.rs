@@ -12,7 +12,10 @@
 //! [`crate::fat::interval_weights`]), so the same rate also applies to negative values and
 //! beyond 1024: the motion is linear in the value, exactly what a CANDIDE unit is. Because the
 //! FAPU are measured on the face *after* shaping, the tables are exact for every shape: the
-//! feature point of FAP `n` moves by `P × FAPU × direction` at value `P`.
+//! feature point of FAP `n` moves by `P × FAPU × direction` at value `P`. A unit that moves its
+//! FAP's own feature point against the standard's direction (CANDIDE-3's FAP 18
+//! `depress_chin` lowers the chin boss 2.10; MPEG-4's positive `depress_chin` raises it) gets
+//! the reversed table, with a note: a FAP stream means the standard's direction.
 //!
 //! **Left out (and listed in the notes).** FAPs 23–30 (eyeball yaw, pitch, thrust, pupil
 //! dilation): the model implements them as translations of the four iris corners without a
@@ -102,7 +105,21 @@ pub fn candide_face_with_notes(
                 kind.abbreviation()
             ));
         }
-        let u = fapu.unit(kind);
+        // A unit moving its FAP's own feature point against the standard's direction (FAP 18
+        // `depress_chin` moves the chin boss 2.10 down; MPEG-4's positive is up) is played
+        // reversed: a stream means the standard's direction, and every face cloned from this
+        // one inherits the table (its own compliance was 200 % off).
+        let sign = if reversed(&face, fap, &unit.displacements) {
+            notes.push(format!(
+                "FAP {} {}: the model moves its feature point against the standard's direction; the table is reversed",
+                fap.number(),
+                fap.name()
+            ));
+            -1.0
+        } else {
+            1.0
+        };
+        let u = sign * fapu.unit(kind);
         let mut coord_index = Vec::with_capacity(unit.displacements.len());
         let mut displacements = Vec::with_capacity(unit.displacements.len());
         for &(v, d) in &unit.displacements {
@@ -150,6 +167,20 @@ pub fn candide_face_with_notes(
         ));
     }
     Ok(CandideFace { face, notes })
+}
+
+/// Whether a CANDIDE unit of `fap` moves the FAP's own (first placed) feature point against
+/// the standard's direction for a positive value.
+fn reversed(face: &FaceModel, fap: crate::spec::FapId, displacements: &[(u32, Vec3)]) -> bool {
+    let info = fap.info();
+    let Some(dir) = info.direction() else {
+        return false;
+    };
+    info.feature_points
+        .iter()
+        .find_map(|&id| face.fp_vertex(id))
+        .and_then(|(_, v)| displacements.iter().find(|(x, _)| *x == v))
+        .is_some_and(|&(_, d)| d.dot(dir) < 0.0)
 }
 
 /// The feature points of the CANDIDE CSV table as bindings to the `candide` mesh (helper for
@@ -225,7 +256,9 @@ mod tests {
                     panic!()
                 };
                 let unit = model.fap_unit(fap).unwrap();
-                let u = fapu.unit(fap.info().fapu.unwrap());
+                // FAP 18 is the one CANDIDE-3 unit against the standard's direction.
+                let sign = if fap.number() == 18 { -1.0 } else { 1.0 };
+                let u = sign * fapu.unit(fap.info().fapu.unwrap());
                 for p in [300.0, -700.0, 2000.0] {
                     eval.evaluate(
                         &[Activation {
@@ -249,13 +282,18 @@ mod tests {
                 if let Some((_, v)) = own.and_then(|id| face.fp_vertex(id)) {
                     if let Some(&(_, dir)) = unit.displacements.iter().find(|(x, _)| *x == v) {
                         let sd = fap.info().direction().unwrap();
-                        if (dir - sd).length() < 1e-6 {
+                        if (dir * sign as f32 - sd).length() < 1e-6 {
                             checked_fp += 1;
                         }
                     }
                 }
             }
-            assert!(checked_fp >= 30, "{checked_fp}");
+            assert!(checked_fp >= 31, "{checked_fp}");
+            assert!(
+                c.notes.iter().any(|n| n.starts_with("FAP 18 depress_chin")),
+                "{:?}",
+                c.notes
+            );
             // FAP 3 on vertex 10 (FP 2.1), explicitly.
             let jaw = TableKey::LowLevel(FapId::from_name("open_jaw").unwrap());
             eval.evaluate(

@@ -76,10 +76,12 @@
 //!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
 //!    changed. Smoothed motions are listed in [`CloneReport::smoothed`].
 //!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
-//!    the FAPU-scaled source motion by a smooth gain field around it (Wendland C² bump over
-//!    half an ES0, gain 1/10–10; [`CloneReport::fapu_gain`]): a registration that put the
-//!    target's feature point off the source's peak (a stylised brow onto a real one) no
-//!    longer leaves the FAP half as strong. Not with FAPU scaling off
+//!    the FAPU-scaled source motion, turned by the alignment's rotation into the target's own
+//!    axes, by a smooth gain and turn field around it (Wendland C² bump over half an ES0,
+//!    gain 1/10–10, turn up to 45°; else the difference is added over the point's edge
+//!    neighbourhood; [`CloneReport::fapu_gain`]): a registration that put the target's
+//!    feature point off the source's peak (a stylised brow onto a real one) no longer leaves
+//!    the FAP half as strong. Not with FAPU scaling off
 //!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
@@ -307,7 +309,8 @@ pub fn clone_face(
         .timings
         .push("motions", clock.elapsed().as_secs_f64());
     // 5, 6. Surface method and FAPU rescale.
-    let cloned_motions = clone_skin_motions(&ssurf, &tsurf, &motions, opts, &mut report)?;
+    let cloned_motions =
+        clone_skin_motions(&ssurf, &tsurf, &motions, &alignment, opts, &mut report)?;
     let cloned: HashMap<(TableKey, u64), &SurfaceMotion> = cloned_motions
         .iter()
         .map(|m| ((m.key, m.value.to_bits()), m))
@@ -436,11 +439,13 @@ pub fn clone_face(
 }
 
 /// Steps 5 and 6: the surface method on the motions that move the skin, then (RBF) the FAPU
-/// rescale. Returns one cloned motion per moving source motion.
+/// rescale, the guard, `smooth` and `gain` (which turns the wanted motions by the
+/// `alignment`'s rotation). Returns one cloned motion per moving source motion.
 fn clone_skin_motions(
     ssurf: &SkinSurface,
     tsurf: &SkinSurface,
     motions: &[SurfaceMotion],
+    alignment: &Similarity,
     opts: &CloneOptions,
     report: &mut CloneReport,
 ) -> Result<Vec<SurfaceMotion>> {
@@ -506,8 +511,13 @@ fn clone_skin_motions(
     };
     if scaled {
         let clock = Instant::now();
-        report.fapu_gain =
-            gain_to_fapu(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+        report.fapu_gain = gain_to_fapu(
+            &ssurf.surface,
+            &moving,
+            &tsurf.surface,
+            &mut result.motions,
+            alignment.rotation,
+        );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
     Ok(result.motions)

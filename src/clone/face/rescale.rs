@@ -6,11 +6,12 @@
 
 use std::collections::BTreeMap;
 
-use glam::Vec3;
+use glam::{DQuat, Quat, Vec3};
 use serde::Serialize;
 
 use crate::clone::{CloneSurface, SurfaceMotion};
 use crate::fat::TableKey;
+use crate::mesh::geometry::adjacency;
 use crate::mesh::VertexIndex;
 use crate::spec::{FapuKind, FeaturePointId};
 
@@ -123,6 +124,7 @@ const GAIN_TOLERANCE: f64 = 0.01;
 /// corner or brow registered beside a real head's moving peak leaves the feature point
 /// 1/4–1/7 of its motion (bruno ↔ `ict`), which the smooth gain field repairs without a
 /// crease (the normal-turn ratios did not change); the guard's bound is for whole motions.
+/// Beyond it the gain adds the difference instead of scaling ([`gain_to_fapu`]).
 const MAX_GAIN: f64 = 10.0;
 
 /// Wendland's C² bump `(1 − x)⁴ (4x + 1)` on `[0, 1]`, 0 beyond: 1 at the centre, flat at
@@ -136,55 +138,128 @@ fn bump(x: f32) -> f32 {
     }
 }
 
+/// Largest turn (radians, 45°) the gain gives a feature point's motion towards the wanted
+/// direction; a motion further off (or needing a gain outside `[1/10, 10]`) is corrected by
+/// adding the difference instead (see [`gain_to_fapu`]).
+const MAX_GAIN_TURN: f64 = std::f64::consts::FRAC_PI_4;
+
+/// Target vertices within `reach` of `centre` along mesh edges, with that distance (Dijkstra,
+/// stopped at `reach`). Along edges, not straight: a bump around an upper-lip point does not
+/// jump the open slit onto the lower lip, nor from a lid onto the other lid.
+fn edge_ball(positions: &[Vec3], adj: &[Vec<u32>], centre: u32, reach: f32) -> Vec<(u32, f32)> {
+    use std::cmp::Reverse;
+    use std::collections::{BinaryHeap, HashMap};
+    let mut best: HashMap<u32, f32> = HashMap::from([(centre, 0.0)]);
+    // Non-negative floats order like their bits.
+    let mut heap = BinaryHeap::from([Reverse((0f32.to_bits(), centre))]);
+    let mut done = Vec::new();
+    while let Some(Reverse((bits, v))) = heap.pop() {
+        let d = f32::from_bits(bits);
+        if best.get(&v).is_some_and(|&b| b < d) {
+            continue;
+        }
+        done.push((v, d));
+        for &w in adj.get(v as usize).map_or(&[][..], |a| a.as_slice()) {
+            let nd = d + positions[v as usize].distance(positions[w as usize]);
+            if nd < reach && best.get(&w).is_none_or(|&b| nd < b) {
+                best.insert(w, nd);
+                heap.push(Reverse((nd.to_bits(), w)));
+            }
+        }
+    }
+    done
+}
+
 /// Makes each low-level translation FAP's feature point move by the FAPU-scaled source
-/// displacement (the compliance MPEG-4 asks for), smoothly: the cloned motion `d` becomes
-/// `g·d` with the gain field `g(x) = 1 + (k − 1)·φ(‖x − f‖ / R)` — `f` the target's feature
-/// point, `φ` [`bump`], `R` = [`GAIN_REACH_ES0`] × ES0 and `k = (w·d_f)/(d_f·d_f)` the
-/// least-squares factor taking the cloned feature-point displacement `d_f` to the wanted
-/// `w` = source displacement × target/source FAPU of the FAP's unit. At `f` the motion is
-/// exactly `k·d_f`; beyond `R` it is untouched; in between the gain is smooth, so the motion
-/// stays as smooth as it was (its gradient gains `d·∇g`, with `‖∇g‖ ≤ 1.5·|k − 1| / R`) and
-/// still vertices stay still. A cloned motion whose registration put the feature point off
-/// the source's peak (a cartoon's brow onto a real one) so moves its feature point by the
-/// FAPU without a uniform rescale of the whole motion. Motions within 1 % of the wanted
-/// displacement, and those beyond repair (a gain outside `[1/10, 10]`, a feature point
-/// that barely moves), are left alone. Returns the gains by FAP name and value.
+/// displacement (the compliance MPEG-4 asks for), smoothly, within `R` = [`GAIN_REACH_ES0`]
+/// × ES0 of the target's feature point `f`, with `φ` = [`bump`] of the distance over `R`. The
+/// wanted displacement `w` is the source's × the target/source FAPU of the FAP's unit, turned
+/// by the alignment's rotation `turn` (target → source frame): FAP directions live in each
+/// face's own axes, so a source moving its chin down and back asks the target to move down
+/// and back along *its* axes, not along the source's (bruno's 3.15° alignment tipped the
+/// chin's large backward motion into the target's y, 10 % of the FAP, before). With `d_f`
+/// the cloned feature-point displacement:
+///
+/// - when `d_f` is within [`MAX_GAIN_TURN`] of `w` and `k = ‖w‖/‖d_f‖` within `[1/10, 10]`,
+///   the motion `d` becomes `g·Q·d`, the gain `g = 1 + (k − 1)·φ` and `Q` the turn about
+///   `d_f × w` by `θ·φ` (`θ` the angle from `d_f` to `w`), `φ` of the straight distance:
+///   still vertices stay still;
+/// - otherwise (a coarse target whose registration read the wrong side of a feature, so its
+///   point moves the other way or barely: CANDIDE's brows and lips under the ICT head's FAPs)
+///   `d` becomes `d + (w − d_f)·φ`, `φ` of the distance along mesh edges ([`edge_ball`]), so
+///   the added motion does not jump an open slit. (Along edges for the gain too moved the
+///   CANDIDE sparse → dense known-FAT case from 1.33 to 1.36 % median: the edge paths of a
+///   dense mesh are longer than the straight line, which narrows the bump.)
+///
+/// At `f` the motion is exactly `w`; beyond `R` it is untouched; in between the field is
+/// smooth, so the motion stays as smooth as it was. A registration that put the feature
+/// point off the source's peak (a cartoon's brow onto a real one) so no longer leaves the FAP
+/// weak, without a uniform rescale of the whole motion. Motions within 1 % of `w`, and those
+/// whose feature point barely moves (the guard's business), are left alone. The target
+/// follows its source: a source whose own motion is not compliant is cloned as it is (a
+/// self-clone stays exact). Returns, by FAP name and value, the least-squares factor
+/// `(w·d_f)/(d_f·d_f)` of each corrected motion.
 pub(super) fn gain_to_fapu(
     source: &CloneSurface,
     motions: &[SurfaceMotion],
     target: &CloneSurface,
     out: &mut [SurfaceMotion],
+    turn: DQuat,
 ) -> BTreeMap<String, f64> {
     let mut gains = BTreeMap::new();
     let reach = GAIN_REACH_ES0 * target.fapu.distances.es0 as f32;
     if !(reach > 0.0 && reach.is_finite()) {
         return gains;
     }
+    let adj = adjacency(target.positions.len(), &target.triangles);
     for (src, dst) in motions.iter().zip(out.iter_mut()) {
         let Some((fp, kind)) = fap_fp(src.key, source, target) else {
             continue;
         };
         let (sv, tv) = (source.fp_vertices[&fp], target.fp_vertices[&fp]);
         let r = fapu_ratio(source, target, kind);
-        let want = offset_at(src, sv).as_dvec3() * r;
+        let want = turn * (offset_at(src, sv).as_dvec3() * r);
         let got = offset_at(dst, tv).as_dvec3();
         let (wl, gl) = (want.length(), got.length());
-        if !(wl > 0.0 && gl >= MIN_MOTION_SHARE * wl) {
+        if !(wl > 0.0 && want.is_finite() && gl >= MIN_MOTION_SHARE * wl) {
             continue;
         }
         if (want - got).length() <= GAIN_TOLERANCE * wl {
             continue;
         }
-        let k = want.dot(got) / got.length_squared();
-        if !(k.is_finite() && (1.0 / MAX_GAIN..=MAX_GAIN).contains(&k)) {
-            continue;
+        let angle = got.angle_between(want);
+        let k = wl / gl;
+        if angle <= MAX_GAIN_TURN && (1.0 / MAX_GAIN..=MAX_GAIN).contains(&k) {
+            let axis = got.cross(want).normalize_or_zero().as_vec3();
+            let angle = if axis == Vec3::ZERO {
+                0.0
+            } else {
+                angle as f32
+            };
+            let centre = target.positions[tv as usize];
+            for (v, d) in &mut dst.offsets {
+                let w = bump(target.positions[*v as usize].distance(centre) / reach);
+                if w == 0.0 {
+                    continue;
+                }
+                let q = Quat::from_axis_angle(axis, angle * w);
+                *d = q * *d * (1.0 + (k as f32 - 1.0) * w);
+            }
+        } else {
+            let fix = (want - got).as_vec3();
+            let mut dense: BTreeMap<u32, Vec3> = dst.offsets.iter().copied().collect();
+            for (v, x) in edge_ball(&target.positions, &adj, tv, reach) {
+                *dense.entry(v).or_insert(Vec3::ZERO) += fix * bump(x / reach);
+            }
+            dst.offsets = dense
+                .into_iter()
+                .filter(|(_, d)| *d != Vec3::ZERO)
+                .collect();
         }
-        let centre = target.positions[tv as usize];
-        for (v, d) in &mut dst.offsets {
-            let x = target.positions[*v as usize].distance(centre) / reach;
-            *d *= 1.0 + (k as f32 - 1.0) * bump(x);
-        }
-        gains.insert(format!("{}@{}", src.key.name(), src.value), k);
+        gains.insert(
+            format!("{}@{}", src.key.name(), src.value),
+            want.dot(got) / got.length_squared(),
+        );
     }
     gains
 }
@@ -367,6 +442,7 @@ mod tests {
     use super::*;
     use crate::fdp::{Fapu, FapuDistances};
     use crate::spec::FapId;
+    use glam::DVec3;
 
     fn surface(positions: Vec<Vec3>, scale: f64) -> CloneSurface {
         let d = FapuDistances {
@@ -453,7 +529,7 @@ mod tests {
             (1, Vec3::new(0.0, 0.05, 0.0)),
             (2, Vec3::new(0.0, 0.05, 0.0)),
         ])];
-        let gains = gain_to_fapu(&s, &src, &t, &mut out);
+        let gains = gain_to_fapu(&s, &src, &t, &mut out, DQuat::IDENTITY);
         assert!(
             (gains.values().next().unwrap() - 2.0).abs() < 1e-6,
             "{gains:?}"
@@ -464,8 +540,33 @@ mod tests {
         assert!(mid > 0.05 && mid < 0.1, "{mid}");
         // A compliant motion is left alone.
         let before = out.clone();
-        assert!(gain_to_fapu(&s, &src, &t, &mut out).is_empty());
+        assert!(gain_to_fapu(&s, &src, &t, &mut out, DQuat::IDENTITY).is_empty());
         assert_eq!(out, before);
+    }
+
+    #[test]
+    fn the_gain_turns_the_wanted_motion_by_the_alignment_and_adds_what_it_cannot_scale() {
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y * 0.25];
+        let (s, t) = (surface(pos.clone(), 1.0), surface(pos, 1.0));
+        // The source moves its point down and back; the target is aligned by 10° about x.
+        let src = vec![motion(vec![(0, Vec3::new(0.0, -0.1, -0.2))])];
+        let turn = DQuat::from_rotation_x(10f64.to_radians());
+        let want = (turn * DVec3::new(0.0, -0.1, -0.2)).as_vec3();
+        let mut out = vec![motion(vec![(0, Vec3::new(0.0, -0.1, -0.2))])];
+        gain_to_fapu(&s, &src, &t, &mut out, turn);
+        assert!(offset_at(&out[0], 0).distance(want) < 1e-6);
+        // A feature point moving the wrong way is brought to the wanted motion by adding the
+        // difference, which fades out along the edge to vertex 2 and misses vertex 1.
+        let mut out = vec![motion(vec![
+            (0, Vec3::new(0.0, 0.1, 0.2)),
+            (1, Vec3::new(0.0, 0.1, 0.2)),
+        ])];
+        let gains = gain_to_fapu(&s, &src, &t, &mut out, DQuat::IDENTITY);
+        assert!(gains.values().next().unwrap() < &0.0, "{gains:?}");
+        assert!(offset_at(&out[0], 0).distance(Vec3::new(0.0, -0.1, -0.2)) < 1e-6);
+        assert_eq!(offset_at(&out[0], 1), Vec3::new(0.0, 0.1, 0.2));
+        let mid = offset_at(&out[0], 2);
+        assert!(mid.y < 0.0 && mid.y > -0.1, "{mid}");
     }
 
     #[test]
