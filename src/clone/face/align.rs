@@ -9,6 +9,10 @@ use crate::clone::CloneError;
 use crate::error::Result;
 use crate::face::FaceModel;
 
+/// Largest turn (degrees) of a face's alignment under which it keeps its own axes
+/// ([`Similarity::keeps_own_axes`]).
+pub const OWN_AXES_MAX_DEGREES: f64 = 20.0;
+
 /// A similarity `p ↦ s·R·p + t`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Similarity {
@@ -37,6 +41,22 @@ impl Similarity {
     /// Maps a point.
     pub fn point(&self, p: Vec3) -> Vec3 {
         (self.rotation * p.as_dvec3() * self.scale + self.translation).as_vec3()
+    }
+
+    /// The rotation's angle, degrees in [0, 180].
+    pub fn turn_degrees(&self) -> f64 {
+        // A quaternion's angle comes in [0, 360); q and −q turn alike.
+        let a = self.rotation.to_axis_angle().1.to_degrees();
+        a.min(360.0 - a)
+    }
+
+    /// Whether the face this maps is taken as modelled upright in its own axes: the turn is at
+    /// most [`OWN_AXES_MAX_DEGREES`]. FAP directions and FAPU are along a face's own axes, so
+    /// two upright faces tilted a few degrees apart keep their own (CANDIDE onto the ICT head
+    /// turns 6.65°); a face turned further is taken as placed turned (a scan lying on its
+    /// side, a Z-up file), and clones like the same face upright.
+    pub fn keeps_own_axes(&self) -> bool {
+        self.turn_degrees() <= OWN_AXES_MAX_DEGREES
     }
 
     /// Maps a displacement.

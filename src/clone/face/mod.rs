@@ -516,7 +516,12 @@ fn clone_skin_motions(
             &moving,
             &tsurf.surface,
             &mut result.motions,
-            alignment.rotation,
+            // FAP directions follow each face's own axes only while both are upright.
+            if alignment.keeps_own_axes() {
+                alignment.rotation
+            } else {
+                glam::DQuat::IDENTITY
+            },
         );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }

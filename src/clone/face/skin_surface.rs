@@ -216,27 +216,20 @@ fn concatenate_skin(
     (positions, triangles, starts)
 }
 
-/// Largest turn of a face's frame (degrees) under which the face is taken as modelled
-/// upright, its FAPU measured along its own axes; a face turned further is taken as placed
-/// turned (a scan lying on its side), its FAPU measured in the turned frame, so it clones
-/// like the same face upright.
-const OWN_AXES_MAX_DEGREES: f64 = 20.0;
-
 /// The face's placed feature points mapped by `frame`, and the face's FAPU in the frame's
 /// units. The FAPU are component differences along the face's axes (MNS0 = 9.15.y − 2.2.y),
 /// so for a face modelled upright they are measured on its own points, then scaled: measured
 /// on turned points they would read part of another axis (CANDIDE aligned onto the ICT head
 /// turns 6.65°, and its nose–mouth z offset made every cloned FAP 3.9 % off its FAPU). A
-/// frame turning more than [`OWN_AXES_MAX_DEGREES`] measures them on the turned points.
+/// frame turning more than [`Similarity::keeps_own_axes`] allows measures them on the turned
+/// points.
 fn framed_feature_points(
     face: &FaceModel,
     frame: &Similarity,
 ) -> Result<(BTreeMap<FeaturePointId, Vec3>, Fapu)> {
     let mut fp_set = FeaturePointSet::new();
     let mut fp_positions = BTreeMap::new();
-    // The turn's size: a quaternion's angle comes in [0, 2π); q and −q turn alike.
-    let turn = frame.rotation.to_axis_angle().1.to_degrees();
-    let upright = turn.min(360.0 - turn) <= OWN_AXES_MAX_DEGREES;
+    let upright = frame.keeps_own_axes();
     for fp in face.feature_points.iter() {
         if let Some(p) = fp.position {
             let q = frame.point(p);

@@ -212,14 +212,19 @@ fn rotated_scaled_target_clones_like_the_plain_one() {
             .zip(&dt)
             .map(|(p, t)| (turn.vector(*p) - *t).length())
             .sum();
-        // FMC is equivariant to float precision (measured 1.5e-6 of the summed displacement).
-        // RBF is not: float noise from the alignment changes which 125 worst vertices each
-        // refinement round picks, so the fit differs (measured 6.8 % for FAP 5).
+        // FMC was equivariant to float precision (1.5e-6 of the summed displacement) until
+        // FAPU and FAP directions followed a face's own axes while it is upright (alignment
+        // turn ≤ 20°, `Similarity::keeps_own_axes`): the plain target's alignment keeps a
+        // small spurious tilt, so it keeps its own axes, while the turned one is measured in
+        // the aligned frame; they differ by that tilt's share (measured 5.0 % of the largest
+        // displacement). RBF: float noise from the alignment changes which 125 worst vertices
+        // each refinement round picks, so the fit differs (measured 6.8 % for FAP 5).
         match method {
-            Method::Fmc => assert!(worst < 1e-3 * scale * 3.0, "{worst} vs {scale}"),
+            Method::Fmc => assert!(worst < 0.06 * scale, "{worst} vs {scale}"),
             Method::Rbf => assert!(diff < 0.1 * sum, "{diff} vs {sum}"),
-            // Fit: closest points move with float noise, nothing chooses discretely.
-            Method::Fit => assert!(diff < 0.01 * sum, "{diff} vs {sum}"),
+            // Fit: closest points move with float noise, nothing chooses discretely; the tilt's
+            // share as for FMC (3.6 % of the summed displacement, was under 1 %).
+            Method::Fit => assert!(diff < 0.05 * sum, "{diff} vs {sum}"),
         }
         eprintln!("{method:?}: worst {worst} of {scale}, sum {diff} of {sum}");
     }
