@@ -51,7 +51,7 @@ impl Similarity {
     }
 
     /// Whether the face this maps is taken as modelled upright in its own axes: the turn is at
-    /// most [`OWN_AXES_MAX_DEGREES`]. FAP directions and FAPU are along a face's own axes, so
+    /// most `OWN_AXES_MAX_DEGREES` (20°). FAP directions and FAPU are along a face's own axes, so
     /// two upright faces tilted a few degrees apart keep their own (CANDIDE onto the ICT head
     /// turns 6.65°); a face turned further is taken as placed turned (a scan lying on its
     /// side, a Z-up file), and clones like the same face upright.
