@@ -7,12 +7,14 @@
 //! vertex is weighted to (an unused bone of a generic rig, a helper empty) would take
 //! `open_jaw` from the morph targets and move nothing.
 
-use std::collections::BTreeSet;
+use gltf::mesh::Semantic;
+use serde::Deserialize;
 
-use serde_json::Value;
-
+use super::gltf_rotations::{descends, node_parents};
+use crate::face::vertex_index::FaceVertexIndex;
 use crate::face::FaceModel;
 use crate::gltf::source::GltfSource;
+use crate::rig::gltf_accessor::{AccessorData, Want};
 use crate::spec::FeaturePointId;
 
 /// Whether `node` (playing the `role`, e.g. "jaw") carries the vertex of feature point `fp`
@@ -28,13 +30,8 @@ pub fn carries_point(
     let name = source.json["nodes"][node]["name"].as_str().unwrap_or("");
     let Some((mesh, vertex)) = face.fp_vertex(fp).or_else(|| {
         let at = face.feature_points.position(fp)?;
-        let world = face.neutral_world_positions();
-        world
-            .iter()
-            .enumerate()
-            .flat_map(|(m, ps)| ps.iter().enumerate().map(move |(v, p)| (m, v, p)))
-            .min_by(|a, b| a.2.distance(at).total_cmp(&b.2.distance(at)))
-            .map(|(m, v, _)| (m, v as u32))
+        let (m, v, _) = FaceVertexIndex::new(face).nearest(at)?;
+        Some((m, v))
     }) else {
         return Err(format!(
             "{role} node `{name}`: the face has no feature point {fp} to check it by"
@@ -76,12 +73,12 @@ pub fn carried_share(
     node: usize,
 ) -> Option<f32> {
     let json = &source.json;
-    let below = subtree(json, node);
+    let parents = node_parents(json);
     let Some(mesh_node) = mesh_node else {
         return Some(0.0);
     };
     let Some(skin) = json["nodes"][mesh_node]["skin"].as_u64() else {
-        let carried = ancestors(json, mesh_node).contains(&node);
+        let carried = descends(&parents, mesh_node, node);
         return Some(if carried { 1.0 } else { 0.0 });
     };
     let joints: Vec<usize> = json["skins"][skin as usize]["joints"]
@@ -89,9 +86,25 @@ pub fn carried_share(
         .iter()
         .filter_map(|j| j.as_u64().map(|j| j as usize))
         .collect();
-    let root: gltf::json::Root = serde_json::from_value(json.clone()).ok()?;
+    let root = gltf::json::Root::deserialize(json).ok()?;
     let doc = gltf::Document::from_json_without_validation(root);
     let prim = doc.meshes().nth(mesh)?.primitives().nth(primitive)?;
+    // The skin's accessors checked before the reader trusts them (a short or mistyped one
+    // would make it stop or panic).
+    let data = AccessorData {
+        file: &source.path,
+        buffers: &source.buffers,
+    };
+    for (semantic, want) in [
+        (Semantic::Joints(0), Want::Joints),
+        (Semantic::Weights(0), Want::Weights),
+    ] {
+        let acc = prim.get(&semantic)?;
+        if acc.count() <= vertex {
+            return None;
+        }
+        data.check(&acc, "skin", want, None).ok()?;
+    }
     let reader = prim.reader(|b| source.buffers.get(b.index()).map(Vec::as_slice));
     let js = reader.read_joints(0)?.into_u16().nth(vertex)?;
     let ws = reader.read_weights(0)?.into_f32().nth(vertex)?;
@@ -107,59 +120,20 @@ pub fn carried_share(
         .iter()
         .zip(ws)
         .filter(|(j, w)| {
-            w.is_finite() && joints.get(**j as usize).is_some_and(|n| below.contains(n))
+            w.is_finite()
+                && joints
+                    .get(**j as usize)
+                    .is_some_and(|&n| descends(&parents, n, node))
         })
         .fold(0.0f32, |a, (_, w)| a + w);
     Some(on / total)
-}
-
-/// `node` and every node below it.
-fn subtree(json: &Value, node: usize) -> BTreeSet<usize> {
-    let mut out = BTreeSet::new();
-    let mut todo = vec![node];
-    while let Some(n) = todo.pop() {
-        // A cycle (an invalid document) visits each node once.
-        if !out.insert(n) {
-            continue;
-        }
-        if let Some(children) = json["nodes"][n]["children"].as_array() {
-            todo.extend(
-                children
-                    .iter()
-                    .filter_map(|c| c.as_u64().map(|c| c as usize)),
-            );
-        }
-    }
-    out
-}
-
-/// `node` and its ancestors.
-fn ancestors(json: &Value, node: usize) -> BTreeSet<usize> {
-    let nodes = json["nodes"].as_array().map_or(&[][..], Vec::as_slice);
-    let mut parent = vec![None; nodes.len()];
-    for (p, n) in nodes.iter().enumerate() {
-        for c in n["children"].as_array().into_iter().flatten() {
-            if let Some(c) = c.as_u64().and_then(|c| parent.get_mut(c as usize)) {
-                *c = Some(p);
-            }
-        }
-    }
-    let mut out = BTreeSet::new();
-    let mut at = Some(node);
-    while let Some(n) = at {
-        if !out.insert(n) {
-            break;
-        }
-        at = parent.get(n).copied().flatten();
-    }
-    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn source(json: Value, buffers: Vec<Vec<u8>>) -> GltfSource {
+    fn source(json: serde_json::Value, buffers: Vec<Vec<u8>>) -> GltfSource {
         GltfSource {
             path: "a.glb".into(),
             json,
@@ -226,10 +200,15 @@ mod tests {
                 {"name": "Face", "mesh": 0, "skin": 0}
             ]
         });
-        let s = source(json, vec![bin]);
+        let mut float_joints = json.clone();
+        float_joints["accessors"][1]["componentType"] = 5126.into();
+        let s = source(json, vec![bin.clone()]);
         assert_eq!(carried_share(&s, Some(3), 0, 0, 0, 1), Some(0.0));
         assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 1), Some(0.75));
         assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 0), Some(1.0));
         assert_eq!(carried_share(&s, Some(3), 0, 0, 9, 1), None);
+        // Float joints (not glTF) are refused, never read.
+        let s = source(float_joints, vec![bin]);
+        assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 1), None);
     }
 }

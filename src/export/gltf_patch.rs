@@ -209,37 +209,29 @@ pub fn patch_face(
         transform_nodes[t] = Some(n);
         user_nodes[t] = true;
     }
-    // A head node of the user's (named, or found by its usual names) turns the head: the
-    // head rotations (48–50) of transforms the document has no node for are left to it, not
-    // baked into morph targets (never a rotation and a morph for one motion).
-    // A head node found by its name must carry the face (its nose tip); one the user names
-    // is taken at their word, with a warning when it does not.
-    // (A face without those points cannot be checked: the node is taken.)
+    // A head node of the user's (named, or found by its usual names and carrying the nose
+    // tip) turns the head: the head rotations (48–50) of transforms the document has no node
+    // for are left to it, not baked into morph targets (never a rotation and a morph for one
+    // motion). A face without a nose tip or chin cannot be checked: the node is taken.
     let head = head_node(source, nodes).filter(|&n| {
-        let Some(nose) = [FeaturePointId::FP_9_3, FeaturePointId::FP_2_1]
+        [FeaturePointId::FP_9_3, FeaturePointId::FP_2_1]
             .into_iter()
             .find(|&id| face.feature_points.position(id).is_some())
-        else {
-            return true;
-        };
-        match carries_point(source, face, n, "head", nose) {
-            Ok(()) => true,
-            Err(why) if nodes.head.is_some() => {
-                warnings.push(Diagnostic::warning(format!(
-                    "{}: {why}; it takes the head rotations as --head-node asks",
-                    source.path.display()
-                )));
-                true
-            }
-            Err(why) => {
-                warnings.push(Diagnostic::warning(format!(
-                    "{}: {why}; head rotations stay morph targets (--head-node NAME hands \
-                     them to a node anyway)",
-                    source.path.display()
-                )));
-                false
-            }
-        }
+            .is_none_or(|nose| {
+                node_takes(
+                    NodeCheck {
+                        source,
+                        face,
+                        node: n,
+                        role: "head",
+                        fp: nose,
+                        named: nodes.head.is_some(),
+                        motion: "the head rotations",
+                        option: "--head-node",
+                    },
+                    &mut warnings,
+                )
+            })
     });
     let trimmed;
     let face = match head {
@@ -400,29 +392,20 @@ pub fn patch_face(
         // from the targets (never a joint and a morph for one motion).
         let driven: Vec<usize> = transform_nodes.iter().flatten().copied().collect();
         let jaw = match jaw_node(source, face, nodes.jaw.as_deref(), unit, &driven) {
-            // A node found by its name must carry the chin; one the user names is taken at
-            // their word, with a warning when it does not.
-            Ok(Some(jaw)) => {
-                match carries_point(source, face, jaw.node, "jaw", FeaturePointId::FP_2_1) {
-                    Ok(()) => Some(jaw),
-                    Err(why) if nodes.jaw.is_some() => {
-                        warnings.push(Diagnostic::warning(format!(
-                            "{}: {why}; it takes open_jaw, thrust_jaw and shift_jaw as --jaw-node \
-                         asks",
-                            source.path.display()
-                        )));
-                        Some(jaw)
-                    }
-                    Err(why) => {
-                        warnings.push(Diagnostic::warning(format!(
-                            "{}: {why}; open_jaw, thrust_jaw and shift_jaw stay morph targets \
-                         (--jaw-node NAME hands them to a node anyway)",
-                            source.path.display()
-                        )));
-                        None
-                    }
-                }
-            }
+            Ok(Some(jaw)) => node_takes(
+                NodeCheck {
+                    source,
+                    face,
+                    node: jaw.node,
+                    role: "jaw",
+                    fp: FeaturePointId::FP_2_1,
+                    named: nodes.jaw.is_some(),
+                    motion: "open_jaw, thrust_jaw and shift_jaw",
+                    option: "--jaw-node",
+                },
+                &mut warnings,
+            )
+            .then_some(jaw),
             Ok(None) => None,
             Err(why) => {
                 warnings.push(Diagnostic::warning(format!(
@@ -874,6 +857,42 @@ fn animation(
         anim.weights.push((node, values));
     }
     (!anim.weights.is_empty()).then_some(anim)
+}
+
+/// A user's node checked before it takes a motion from the morph targets (see
+/// [`NodeCheck`]).
+struct NodeCheck<'a> {
+    source: &'a GltfSource,
+    face: &'a FaceModel,
+    node: usize,
+    /// "head", "jaw": for messages.
+    role: &'a str,
+    /// The feature point the node must carry.
+    fp: FeaturePointId,
+    /// Whether the user named the node (`option`), rather than it being found by its name.
+    named: bool,
+    /// The FAPs it would take, for messages.
+    motion: &'a str,
+    option: &'a str,
+}
+
+/// Whether the node takes its motion: when it carries the feature point
+/// ([`carries_point`]); else a node the user named is taken at their word and one found by
+/// its name is not, with a warning either way.
+fn node_takes(c: NodeCheck, warnings: &mut Vec<Diagnostic>) -> bool {
+    let Err(why) = carries_point(c.source, c.face, c.node, c.role, c.fp) else {
+        return true;
+    };
+    let (file, motion, option) = (c.source.path.display(), c.motion, c.option);
+    warnings.push(Diagnostic::warning(if c.named {
+        format!("{file}: {why}; it takes {motion} as {option} asks")
+    } else {
+        format!(
+            "{file}: {why}; {motion} stay morph targets ({option} NAME hands them to a node \
+             anyway)"
+        )
+    }));
+    c.named
 }
 
 #[cfg(test)]

@@ -173,15 +173,8 @@ fn compose_at_rest<T: Copy + std::ops::Mul<Output = T>>(
     json: &Value,
     local: fn(&Value) -> T,
 ) -> (Vec<T>, Vec<Option<usize>>) {
-    let nodes = json["nodes"].as_array().cloned().unwrap_or_default();
-    let mut parent = vec![None; nodes.len()];
-    for (i, n) in nodes.iter().enumerate() {
-        for c in n["children"].as_array().into_iter().flatten() {
-            if let Some(c) = c.as_u64().filter(|&c| (c as usize) < nodes.len()) {
-                parent[c as usize] = Some(i);
-            }
-        }
-    }
+    let nodes = json["nodes"].as_array().map_or(&[][..], Vec::as_slice);
+    let parent = node_parents(json);
     let local: Vec<T> = nodes.iter().map(local).collect();
     let world = (0..nodes.len())
         .map(|i| {
@@ -200,6 +193,38 @@ fn compose_at_rest<T: Copy + std::ops::Mul<Output = T>>(
         })
         .collect();
     (world, parent)
+}
+
+/// Each node's parent (from `children`).
+pub(crate) fn node_parents(json: &Value) -> Vec<Option<usize>> {
+    let nodes = json["nodes"].as_array().map_or(&[][..], Vec::as_slice);
+    let mut parent = vec![None; nodes.len()];
+    for (i, n) in nodes.iter().enumerate() {
+        for c in n["children"].as_array().into_iter().flatten() {
+            if let Some(c) = c.as_u64().filter(|&c| (c as usize) < nodes.len()) {
+                parent[c as usize] = Some(i);
+            }
+        }
+    }
+    parent
+}
+
+/// Whether node `n` is `ancestor` or below it (`parents` from [`node_parents`]; a cycle in a
+/// broken graph ends the walk).
+pub(crate) fn descends(parents: &[Option<usize>], n: usize, ancestor: usize) -> bool {
+    let mut at = Some(n);
+    let mut depth = 0;
+    while let Some(i) = at {
+        if i == ancestor {
+            return true;
+        }
+        depth += 1;
+        if depth > parents.len() {
+            return false;
+        }
+        at = parents.get(i).copied().flatten();
+    }
+    false
 }
 
 fn local_rotation(n: &Value) -> Quat {

@@ -16,7 +16,7 @@
 use glam::{Affine3A, Mat4, Quat, Vec3};
 use serde_json::Value;
 
-use super::gltf_rotations::{eye_nodes, world_matrices, RotationNodes};
+use super::gltf_rotations::{descends, eye_nodes, node_parents, world_matrices, RotationNodes};
 use crate::error::Diagnostic;
 use crate::face::FaceModel;
 use crate::gltf::source::GltfSource;
@@ -150,28 +150,6 @@ pub fn eye_transforms(
         out.push((transform, node));
     }
     out
-}
-
-/// Each node's parent (from `children`).
-fn node_parents(json: &Value) -> Vec<Option<usize>> {
-    world_matrices(json).1
-}
-
-/// Whether node `n` is `ancestor` or below it.
-fn descends(parents: &[Option<usize>], n: usize, ancestor: usize) -> bool {
-    let mut at = Some(n);
-    let mut depth = 0;
-    while let Some(i) = at {
-        if i == ancestor {
-            return true;
-        }
-        depth += 1;
-        if depth > parents.len() {
-            return false;
-        }
-        at = parents.get(i).copied().flatten();
-    }
-    false
 }
 
 /// A user's node showing a face transform: its rest frames in the file.

@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 
 /// The element an accessor must hold.
 #[derive(Clone, Copy, Debug)]
-pub(super) enum Want {
+pub(crate) enum Want {
     /// `VEC3` of float or (normalised or not) 8/16-bit integers: positions, normals, morph
     /// deltas.
     Vec3,
@@ -28,10 +28,14 @@ pub(super) enum Want {
     Vec2,
     /// `SCALAR` unsigned 8/16/32-bit integers: indices.
     Index,
+    /// `VEC4` unsigned 8/16-bit integers: skin joints (`JOINTS_n`).
+    Joints,
+    /// `VEC4` of float or normalised unsigned byte/short: skin weights (`WEIGHTS_n`).
+    Weights,
 }
 
 /// The loaded buffers of one file, read through accessors.
-pub(super) struct AccessorData<'a> {
+pub(crate) struct AccessorData<'a> {
     /// The file, named in errors.
     pub file: &'a Path,
     /// Buffer bytes by buffer index.
@@ -50,7 +54,13 @@ impl AccessorData<'_> {
 
     /// Checks type, count and byte ranges of `acc` (at JSON path `at`) so the readers stay in
     /// bounds; `count` is the element count required, if any.
-    pub fn check(&self, acc: &Accessor, at: &str, want: Want, count: Option<usize>) -> Result<()> {
+    pub(crate) fn check(
+        &self,
+        acc: &Accessor,
+        at: &str,
+        want: Want,
+        count: Option<usize>,
+    ) -> Result<()> {
         let at = format!("{at} (accessors[{}])", acc.index());
         let attribute_type = matches!(
             acc.data_type(),
@@ -66,12 +76,25 @@ impl AccessorData<'_> {
                         DataType::U8 | DataType::U16 | DataType::U32
                     )
             }
+            Want::Joints => {
+                acc.dimensions() == Dimensions::Vec4
+                    && matches!(acc.data_type(), DataType::U8 | DataType::U16)
+            }
+            Want::Weights => {
+                acc.dimensions() == Dimensions::Vec4
+                    && matches!(
+                        acc.data_type(),
+                        DataType::F32 | DataType::U8 | DataType::U16
+                    )
+            }
         };
         if !ok_type {
             let wanted = match want {
                 Want::Vec3 => "VEC3 of FLOAT or (normalised) byte/short",
                 Want::Vec2 => "VEC2 of FLOAT or (normalised) byte/short",
                 Want::Index => "SCALAR unsigned byte/short/int",
+                Want::Joints => "VEC4 unsigned byte/short",
+                Want::Weights => "VEC4 of FLOAT or normalised unsigned byte/short",
             };
             return Err(self.err(
                 &at,

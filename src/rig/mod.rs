@@ -30,7 +30,7 @@ pub mod capture;
 mod error;
 pub mod fap_map;
 pub mod fat_build;
-mod gltf_accessor;
+pub(crate) mod gltf_accessor;
 #[cfg(test)]
 mod gltf_encodings_tests;
 pub mod gltf_read;
