@@ -809,3 +809,35 @@ fn a_head_node_that_does_not_carry_the_face_is_not_taken_by_its_name() {
     assert!(!stderr.contains("head node"), "{stderr}");
     assert!(!names.contains("head_"), "{names}");
 }
+
+/// Float skin joints (glTF allows unsigned byte/short only) are refused with the accessor's
+/// place, never handed to the reader (which panicked on them).
+#[test]
+fn float_joints_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = avatar::build();
+    // The mouth primitive, whose vertices the jaw and head joints share (read per vertex):
+    // its JOINTS_0 pointed at a float VEC4 accessor of the right size (its weights').
+    let mouth = &mut a.json["meshes"][0]["primitives"][1]["attributes"];
+    mouth["JOINTS_0"] = mouth["WEIGHTS_0"].clone();
+    let input = dir.path().join("float-joints.glb");
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let out = dir.path().join("out.glb");
+    let run = command()
+        .args([
+            "face".as_ref(),
+            "export".as_ref(),
+            input.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
+    let err = text(&run.stderr);
+    assert!(
+        err.contains("float-joints.glb") && err.contains("JOINTS_0"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

@@ -101,13 +101,16 @@ impl Placement {
         reader.check_plain(
             &ja,
             &format!("{at}.attributes.JOINTS_0"),
-            Dimensions::Vec4,
+            (Dimensions::Vec4, &[DataType::U8, DataType::U16]),
             n,
         )?;
         reader.check_plain(
             &wa,
             &format!("{at}.attributes.WEIGHTS_0"),
-            Dimensions::Vec4,
+            (
+                Dimensions::Vec4,
+                &[DataType::U8, DataType::U16, DataType::F32],
+            ),
             n,
         )?;
         let buffers = reader.buffers;
@@ -153,7 +156,7 @@ impl Reader<'_> {
                     format!("{} matrices for {} joints", acc.count(), joints.len()),
                 ));
             }
-            self.check_plain(&acc, &at, Dimensions::Mat4, acc.count())?;
+            self.check_plain(&acc, &at, (Dimensions::Mat4, &[DataType::F32]), acc.count())?;
             let buffers = self.buffers;
             let r = skin.reader(|b| buffers.get(b.index()).map(|v| v.as_slice()));
             if let Some(list) = r.read_inverse_bind_matrices() {
@@ -176,16 +179,17 @@ impl Reader<'_> {
 
     /// Checks an accessor read directly by the crate (joints, weights, matrices): its shape,
     /// at least `count` elements, and byte ranges inside the buffers (sparse ones included).
-    fn check_plain(&self, acc: &Accessor, at: &str, dims: Dimensions, count: usize) -> Result<()> {
+    /// `types` are the component types the crate's reader takes for it (it panics on others:
+    /// float joints, say).
+    fn check_plain(
+        &self,
+        acc: &Accessor,
+        at: &str,
+        (dims, types): (Dimensions, &[DataType]),
+        count: usize,
+    ) -> Result<()> {
         let at = format!("{at} (accessors[{}])", acc.index());
-        let type_ok = acc.dimensions() == dims
-            && match dims {
-                Dimensions::Mat4 => acc.data_type() == DataType::F32,
-                _ => matches!(
-                    acc.data_type(),
-                    DataType::U8 | DataType::U16 | DataType::F32
-                ),
-            };
+        let type_ok = acc.dimensions() == dims && types.contains(&acc.data_type());
         if !type_ok {
             return Err(self.err(
                 &at,
