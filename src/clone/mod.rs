@@ -161,6 +161,15 @@ pub struct SurfaceMotion {
     pub offsets: Vec<(u32, Vec3)>,
 }
 
+impl SurfaceMotion {
+    /// Vertex `v`'s displacement (zero where it does not move).
+    pub fn offset_at(&self, v: u32) -> Vec3 {
+        self.offsets
+            .binary_search_by_key(&v, |o| o.0)
+            .map_or(Vec3::ZERO, |i| self.offsets[i].1)
+    }
+}
+
 /// Time spent in each step of a cloning run, in seconds.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct StepTimings {

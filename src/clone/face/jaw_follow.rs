@@ -189,7 +189,7 @@ pub(super) fn jaw_motions(
     };
     let chin_at = tsurf.surface.positions[chin as usize].as_dvec3();
     for m in cloned.iter().filter(|m| moves_jaw(m.key)) {
-        let d: Vec<DVec3> = region.iter().map(|&v| offset_at(m, v)).collect();
+        let d: Vec<DVec3> = region.iter().map(|&v| m.offset_at(v).as_dvec3()).collect();
         if d.iter().all(|x| *x == DVec3::ZERO) {
             continue;
         }
@@ -199,7 +199,7 @@ pub(super) fn jaw_motions(
         let fitted = fit_small_rigid(&pos, &d);
         let rigid = SmallRigid {
             c: chin_at,
-            t: offset_at(m, chin),
+            t: m.offset_at(chin).as_dvec3(),
             omega: fitted.omega,
         };
         for (mi, q, inv) in &parts {
@@ -220,12 +220,6 @@ pub(super) fn jaw_motions(
         }
     }
     out
-}
-
-fn offset_at(m: &SurfaceMotion, v: u32) -> DVec3 {
-    m.offsets
-        .binary_search_by_key(&v, |o| o.0)
-        .map_or(DVec3::ZERO, |i| m.offsets[i].1.as_dvec3())
 }
 
 #[cfg(test)]

@@ -164,7 +164,7 @@ pub(super) fn part_motions(
                         .vertices
                         .iter()
                         .zip(&pl.weights)
-                        .map(|(&v, &w)| offset_at(m, v).as_dvec3() * f64::from(w))
+                        .map(|(&v, &w)| m.offset_at(v).as_dvec3() * f64::from(w))
                         .sum();
                     inv * frame.inverse_vector(d * ratio)
                 })
@@ -217,12 +217,6 @@ fn place(p: Vec3, v: u32, tris: &[u32], src: &crate::clone::CloneSurface) -> Pla
         }
     }
     best
-}
-
-fn offset_at(m: &SurfaceMotion, v: u32) -> Vec3 {
-    m.offsets
-        .binary_search_by_key(&v, |o| o.0)
-        .map_or(Vec3::ZERO, |i| m.offsets[i].1)
 }
 
 /// Target / source FAPU of the key's unit (MNS for high-level tables and angles: parts in

@@ -58,12 +58,6 @@ pub(super) fn fap_fp(
         .map(|&id| (id, kind))
 }
 
-fn offset_at(m: &SurfaceMotion, v: u32) -> Vec3 {
-    m.offsets
-        .binary_search_by_key(&v, |o| o.0)
-        .map_or(Vec3::ZERO, |i| m.offsets[i].1)
-}
-
 /// Target / source FAPU of `kind` (1 when the source's is zero).
 fn fapu_ratio(source: &CloneSurface, target: &CloneSurface, kind: FapuKind) -> f64 {
     let s = source.fapu.unit(kind);
@@ -83,8 +77,8 @@ fn measure(
     dst: &SurfaceMotion,
 ) -> Option<(f64, f64, f64)> {
     let (fp, kind) = fap_fp(src.key, source, target)?;
-    let ds = offset_at(src, source.fp_vertices[&fp]).length() as f64;
-    let dt = offset_at(dst, target.fp_vertices[&fp]).length() as f64;
+    let ds = src.offset_at(source.fp_vertices[&fp]).length() as f64;
+    let dt = dst.offset_at(target.fp_vertices[&fp]).length() as f64;
     (ds > 0.0).then_some((ds, dt, fapu_ratio(source, target, kind)))
 }
 
@@ -218,8 +212,8 @@ pub(super) fn gain_to_fapu(
         };
         let (sv, tv) = (source.fp_vertices[&fp], target.fp_vertices[&fp]);
         let r = fapu_ratio(source, target, kind);
-        let want = turn * (offset_at(src, sv).as_dvec3() * r);
-        let got = offset_at(dst, tv).as_dvec3();
+        let want = turn * (src.offset_at(sv).as_dvec3() * r);
+        let got = dst.offset_at(tv).as_dvec3();
         let (wl, gl) = (want.length(), got.length());
         if !(wl > 0.0 && want.is_finite() && gl >= MIN_MOTION_SHARE * wl) {
             continue;
@@ -369,7 +363,7 @@ fn feature_point_transfer(
 ) -> Option<SurfaceMotion> {
     let (fp, kind) = fap_fp(src.key, source, target)?;
     let (sv, tv) = (source.fp_vertices[&fp], target.fp_vertices[&fp]);
-    let want = offset_at(src, sv) * fapu_ratio(source, target, kind) as f32;
+    let want = src.offset_at(sv) * fapu_ratio(source, target, kind) as f32;
     let centre = *target.positions.get(tv as usize)?;
     let shared = target
         .fp_vertices
@@ -426,7 +420,7 @@ fn direct_transfer(src: &SurfaceMotion, nearest: &[u32], ratio: f32) -> SurfaceM
         .iter()
         .enumerate()
         .filter_map(|(t, &s)| {
-            let d = offset_at(src, s);
+            let d = src.offset_at(s);
             (s != u32::MAX && d != Vec3::ZERO).then_some((t as u32, d * ratio))
         })
         .collect();
@@ -485,8 +479,8 @@ mod tests {
         assert_eq!(f.len(), 1);
         assert!(f[0].repaired && f[0].factor > 1e5, "{f:?}");
         // Direct transfer: 2.5 takes its own source motion × the MNS ratio 2.
-        assert!(offset_at(&out[0], 0).distance(Vec3::new(0.0, 0.2, 0.0)) < 1e-6);
-        assert_eq!(offset_at(&out[0], 1), Vec3::ZERO);
+        assert!(out[0].offset_at(0).distance(Vec3::new(0.0, 0.2, 0.0)) < 1e-6);
+        assert_eq!(out[0].offset_at(1), Vec3::ZERO);
     }
 
     #[test]
@@ -514,7 +508,7 @@ mod tests {
         let f = guard_motions(&s, &src, &t, &mut out, false);
         assert!(f.len() == 1 && f[0].repaired, "{f:?}");
         // 2.5 takes its source motion; the others, a unit away (beyond half an ES0), stay.
-        assert_eq!(offset_at(&out[0], 0), Vec3::new(0.0, 0.1, 0.0));
+        assert_eq!(out[0].offset_at(0), Vec3::new(0.0, 0.1, 0.0));
         assert_eq!(out[0].offsets.len(), 1);
     }
 
@@ -534,9 +528,9 @@ mod tests {
             (gains.values().next().unwrap() - 2.0).abs() < 1e-6,
             "{gains:?}"
         );
-        assert!(offset_at(&out[0], 0).distance(Vec3::new(0.0, 0.1, 0.0)) < 1e-6);
-        assert_eq!(offset_at(&out[0], 1), Vec3::new(0.0, 0.05, 0.0));
-        let mid = offset_at(&out[0], 2).y;
+        assert!(out[0].offset_at(0).distance(Vec3::new(0.0, 0.1, 0.0)) < 1e-6);
+        assert_eq!(out[0].offset_at(1), Vec3::new(0.0, 0.05, 0.0));
+        let mid = out[0].offset_at(2).y;
         assert!(mid > 0.05 && mid < 0.1, "{mid}");
         // A compliant motion is left alone.
         let before = out.clone();
@@ -554,7 +548,7 @@ mod tests {
         let want = (turn * DVec3::new(0.0, -0.1, -0.2)).as_vec3();
         let mut out = vec![motion(vec![(0, Vec3::new(0.0, -0.1, -0.2))])];
         gain_to_fapu(&s, &src, &t, &mut out, turn);
-        assert!(offset_at(&out[0], 0).distance(want) < 1e-6);
+        assert!(out[0].offset_at(0).distance(want) < 1e-6);
         // A feature point moving the wrong way is brought to the wanted motion by adding the
         // difference, which fades out along the edge to vertex 2 and misses vertex 1.
         let mut out = vec![motion(vec![
@@ -563,9 +557,9 @@ mod tests {
         ])];
         let gains = gain_to_fapu(&s, &src, &t, &mut out, DQuat::IDENTITY);
         assert!(gains.values().next().unwrap() < &0.0, "{gains:?}");
-        assert!(offset_at(&out[0], 0).distance(Vec3::new(0.0, -0.1, -0.2)) < 1e-6);
-        assert_eq!(offset_at(&out[0], 1), Vec3::new(0.0, 0.1, 0.2));
-        let mid = offset_at(&out[0], 2);
+        assert!(out[0].offset_at(0).distance(Vec3::new(0.0, -0.1, -0.2)) < 1e-6);
+        assert_eq!(out[0].offset_at(1), Vec3::new(0.0, 0.1, 0.2));
+        let mid = out[0].offset_at(2);
         assert!(mid.y < 0.0 && mid.y > -0.1, "{mid}");
     }
 

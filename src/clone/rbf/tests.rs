@@ -320,11 +320,7 @@ fn mirror_symmetric_faces_get_mirror_symmetric_motions() {
     for i in 0..n {
         let a = mirrored(&r.motions[i], &mt);
         let b = &r.motions[n + i];
-        let at = |m: &SurfaceMotion, v: u32| {
-            m.offsets
-                .binary_search_by_key(&v, |o| o.0)
-                .map_or(Vec3::ZERO, |k| m.offsets[k].1)
-        };
+        let at = |m: &SurfaceMotion, v: u32| m.offset_at(v);
         let peak = a.offsets.iter().map(|o| o.1.length()).fold(0.0, f32::max);
         let (gv, gap) = (0..tgt.surface.positions.len() as u32)
             .map(|v| (v, at(&a, v).distance(at(b, v))))
