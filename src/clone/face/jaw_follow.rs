@@ -175,11 +175,10 @@ pub(super) fn jaw_motions(
         .iter()
         .filter_map(|&mi| {
             let world = *frames.meshes.get(mi)?;
-            let q = face.meshes[mi]
-                .mesh
-                .positions
-                .iter()
-                .map(|&p| frame.point(world.transform_point3(p)).as_dvec3())
+            let q = face
+                .mesh_world(&frames, mi)
+                .into_iter()
+                .map(|p| frame.point(p).as_dvec3())
                 .collect();
             Some((mi, q, world.matrix3.as_dmat3().inverse()))
         })
