@@ -14,19 +14,12 @@
 #
 # Exit code 3: numpy missing (callers treat that as "skip").
 import json
+import os
 import sys
-import warnings
 
-try:
-    import numpy
-except ImportError:
-    print("numpy is missing (Debian: python3-numpy)", file=sys.stderr)
-    sys.exit(3)
-
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")
-    if not hasattr(numpy, "bool"):
-        numpy.bool = bool  # Debian's Blender 3.4 glTF add-on still uses np.bool
+# The numpy fix both Blender scripts need lives beside them.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_numpy  # noqa: E402,F401  (exits 3 without numpy)
 
 import bpy  # noqa: E402
 from mathutils import Vector  # noqa: E402

@@ -8,23 +8,13 @@
 # .glb/.gltf go through the glTF importer, .obj through the OBJ importer with split_mode='OFF'
 # (one object, vertices in the file's order).
 import json
+import os
 import sys
 import traceback
-import warnings
 
-# Debian's Blender 3.4 glTF importer still uses `np.bool`, which numpy removed in 1.24; without
-# this alias every import stops with an AttributeError.
-try:
-    import numpy
-except ImportError:
-    print("numpy is missing (Debian: python3-numpy)", file=sys.stderr)
-    sys.exit(3)
-
-with warnings.catch_warnings():
-    # numpy 1.24 warns on the very look-up that finds the alias gone.
-    warnings.simplefilter("ignore")
-    if not hasattr(numpy, "bool"):
-        numpy.bool = bool
+# The numpy fix both Blender scripts need lives beside them.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_numpy  # noqa: E402,F401  (exits 3 without numpy)
 
 import bpy  # noqa: E402
 
