@@ -778,3 +778,76 @@ fn an_eye_node_without_its_eyeball_is_not_used_and_said_so() {
         .get("targets")
         .is_none());
 }
+
+/// `face export` takes the node options as `clone` does: a face read back from a patched
+/// avatar, exported with `--head-node Neck`, shows its head rotations on `Neck` as a clone
+/// with that option does (and on `Head` without it); `--eye-nodes Hat,RightEye` warns about
+/// the hat as the clone does.
+#[test]
+fn face_export_takes_the_node_options_as_clone_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let out = d.join("out.glb");
+    clone_to(&glb, &csv, &out, &[]);
+    let cloned = d.join("cloned-neck.glb");
+    clone_to(&glb, &csv, &cloned, &["--head-node", "Neck"]);
+    let export = |name: &str, more: &[&str]| {
+        let path = d.join(name);
+        let o = support::cli::command()
+            .args([
+                "face".as_ref(),
+                "export".as_ref(),
+                out.as_os_str(),
+                "-o".as_ref(),
+            ])
+            .arg(&path)
+            .args(more)
+            .output()
+            .unwrap();
+        let stderr = support::cli::text(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        (path, stderr)
+    };
+    let (neck, _) = export("neck.glb", &["--head-node", "Neck"]);
+    let (plain, _) = export("plain.glb", &[]);
+    // Per transform name, its node and whether it is the user's.
+    let shown = |p: &Path| {
+        let (json, _) = glb_parts(p);
+        let mut list: Vec<(String, Value, Value)> = json["scenes"][0]["extras"]["fbakit"]
+            ["transforms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| {
+                (
+                    t["name"].as_str().unwrap().to_string(),
+                    t["node"].clone(),
+                    t["userNode"].clone(),
+                )
+            })
+            .collect();
+        list.sort_by(|a, b| a.0.cmp(&b.0));
+        list
+    };
+    let on_neck = shown(&neck);
+    assert_eq!(on_neck, shown(&cloned));
+    assert!(
+        on_neck.iter().any(|(_, n, u)| *n == 2 && *u == true),
+        "{on_neck:?}"
+    );
+    let on_head = shown(&plain);
+    assert_eq!(on_head, shown(&out));
+    assert!(
+        on_head
+            .iter()
+            .any(|(_, n, u)| *n == HEAD_NODE && *u == true),
+        "{on_head:?}"
+    );
+    let (_, stderr) = export("hat.glb", &["--eye-nodes", "Hat,RightEye"]);
+    assert!(
+        stderr.contains("eye node `Hat` is not turned (its mesh holds no pupil 3.5)"),
+        "{stderr}"
+    );
+}
