@@ -851,3 +851,48 @@ fn face_export_takes_the_node_options_as_clone_does() {
         "{stderr}"
     );
 }
+
+/// An eye joint that also moves the skin (here `Head` named as the left eye: the face's skin
+/// is weighted to it) does not turn the left eyeball: a warning says so, the left eye's
+/// motion stays in morph targets, and the right eye joint still turns its eyeball.
+#[test]
+fn an_eye_joint_that_moves_skin_too_is_not_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let opts = Options {
+        skinned_eyes: Some(1.0),
+        ..Options::default()
+    };
+    let (glb, csv) = write_avatar_with(d, &source, &opts);
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str()])
+        .args(["--eye-nodes", "Head,RightEye", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("eye node `Head` is not turned (its mesh carries skin"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("RightEye"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    let names = patched["meshes"][2]["extras"]["targetNames"].to_string();
+    assert!(names.contains("yaw_l_eyeball"), "{names}");
+    assert!(patched["meshes"][3]["primitives"][0]
+        .get("targets")
+        .is_none());
+    let transforms = &patched["scenes"][0]["extras"]["fbakit"]["transforms"];
+    assert!(
+        transforms
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|t| t["node"] == RIGHT_EYE_JOINT && t["userNode"] == true),
+        "{transforms}"
+    );
+}
