@@ -78,7 +78,6 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         units: a.units,
         new_document: a.new_document,
         nodes: a.nodes.rotation_nodes(),
-        ..Default::default()
     };
     let report = fbakit::export::write(&a.output, &face, &opts)?;
     if a.json {
