@@ -2,7 +2,10 @@
 //! nodes `LeftEye` and `RightEye` (under a turned `Eyes` node on the `Head` joint), the eye
 //! motion (FAPs 23–26) is not baked into morph targets: the patched glb records it as motion
 //! of those nodes, reads back with the same FAT, and `play` turns the nodes — never a
-//! rotation and a morph for one motion. The jaw joint takes `open_jaw` in play with every
+//! rotation and a morph for one motion. Eyeballs skinned to eye joints (`LeftEye`,
+//! `RightEye` under `Head`, ReadyPlayerMe style) turn those joints the same way; a partly
+//! weighted eyeball stays in morph targets with a warning. The head rotations are recorded on
+//! the `Head` joint and read back. The jaw joint takes `open_jaw` in play with every
 //! `open_jaw` target held at zero. VRML and new-document outputs keep the eye motion.
 
 mod support;
@@ -17,9 +20,13 @@ use fbakit::snapshot::{diff, DiffOptions};
 use fbakit::spec::{FapId, FeaturePointId};
 use glam::{Mat4, Quat, Vec3};
 use serde_json::Value;
-use support::avatar::{self, Options, LEFT_EYE_NODE, RIGHT_EYE_NODE};
+use support::avatar::{
+    self, Options, LEFT_EYE_JOINT, LEFT_EYE_MESH_NODE, LEFT_EYE_NODE, RIGHT_EYE_JOINT,
+    RIGHT_EYE_MESH_NODE, RIGHT_EYE_NODE,
+};
 
 const JAW_NODE: usize = 4;
+const HEAD_NODE: usize = 3;
 
 fn key(fap: u8) -> TableKey {
     TableKey::LowLevel(FapId::new(fap).unwrap())
@@ -28,13 +35,27 @@ fn key(fap: u8) -> TableKey {
 /// The avatar with eye nodes (and both teeth rows in one primitive) in `dir`, and its
 /// feature points.
 fn write_avatar(dir: &Path, source: &FaceModel) -> (PathBuf, PathBuf) {
+    write_avatar_with(
+        dir,
+        source,
+        &Options {
+            teeth: true,
+            eye_nodes: true,
+            ..Options::default()
+        },
+    )
+}
+
+/// The avatar with `opts` in `dir`, and its feature points (teeth points with the teeth).
+fn write_avatar_with(dir: &Path, source: &FaceModel, opts: &Options) -> (PathBuf, PathBuf) {
     let glb = dir.join("avatar.glb");
-    let opts = Options {
-        teeth: true,
-        eye_nodes: true,
+    std::fs::write(&glb, avatar::build_with(opts).to_glb()).unwrap();
+    let teeth = if opts.teeth {
+        avatar::teeth_fp_lines()
+    } else {
+        String::new()
     };
-    std::fs::write(&glb, avatar::build_with(&opts).to_glb()).unwrap();
-    let csv = avatar::fp_csv(source, dir, &avatar::teeth_fp_lines());
+    let csv = avatar::fp_csv(source, dir, &teeth);
     (glb, csv)
 }
 
@@ -225,19 +246,262 @@ fn eye_nodes_turn_instead_of_morph_targets() {
         assert!(tables.contains(name), "{name}: {tables}");
     }
 
-    // Read back: the same FAT as the clone's (but for the head rotations the `Head` node
-    // takes, which the clone's face keeps and the patched document leaves to the node).
-    let target = fbakit::face::read_with(&glb, &FaceReadOptions::with_feature_points(Some(&csv)))
+    check_eyes_round_trip_and_play(
+        d,
+        (&glb, &csv, &out),
+        &source,
+        (LEFT_EYE_NODE, RIGHT_EYE_NODE),
+    );
+}
+
+/// Eyeballs skinned to eye joints (their own meshes, every vertex weighted to `LeftEye` or
+/// `RightEye` under `Head`, the joints' rest frames turned away from the face's): no morph
+/// target moves them, the joints show their transforms (recorded, read back with the same
+/// FAT) and `play` turns the joints as the FAT turns the eyes.
+#[test]
+fn skinned_eyes_turn_their_eye_joints() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let opts = Options {
+        skinned_eyes: Some(1.0),
+        ..Options::default()
+    };
+    let (glb, csv) = write_avatar_with(d, &source, &opts);
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str(), "-o".as_ref()])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(!stderr.contains("eye node"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    // The eye meshes get no morph target, `Body` no eyeball target.
+    for m in [2, 3] {
+        assert_eq!(
+            patched["nodes"][[LEFT_EYE_MESH_NODE, RIGHT_EYE_MESH_NODE][m - 2]]["mesh"],
+            m
+        );
+        assert!(
+            patched["meshes"][m]["primitives"][0]
+                .get("targets")
+                .is_none(),
+            "{}",
+            patched["meshes"][m]
+        );
+    }
+    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
+    assert!(!names.contains("eyeball"), "{names}");
+    let record = &patched["scenes"][0]["extras"]["fbakit"];
+    for node in [LEFT_EYE_JOINT, RIGHT_EYE_JOINT] {
+        let t = record["transforms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|t| t["node"] == node)
+            .unwrap_or_else(|| panic!("no transform on joint {node}: {}", record["transforms"]));
+        assert_eq!(t["userNode"], true, "{t}");
+    }
+    check_eyes_round_trip_and_play(
+        d,
+        (&glb, &csv, &out),
+        &source,
+        (LEFT_EYE_JOINT, RIGHT_EYE_JOINT),
+    );
+}
+
+/// An eyeball weighted to its eye joint by 60 % only (the rest to `Head`) cannot be turned by
+/// the joint: its motion stays in morph targets, with one warning per joint naming it and why.
+#[test]
+fn a_partly_weighted_eyeball_stays_in_morph_targets_and_is_said_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let opts = Options {
+        skinned_eyes: Some(0.6),
+        ..Options::default()
+    };
+    let (glb, csv) = write_avatar_with(d, &source, &opts);
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str(), "-o".as_ref()])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    for joint in ["LeftEye", "RightEye"] {
+        let said = format!("eye node `{joint}` is not turned (mesh ");
+        assert_eq!(stderr.matches(&said).count(), 1, "{joint}: {stderr}");
+    }
+    assert!(stderr.contains("by 60 % only"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    for (m, name) in [(2, "yaw_l_eyeball"), (3, "yaw_r_eyeball")] {
+        let names = patched["meshes"][m]["extras"]["targetNames"].to_string();
+        assert!(names.contains(name), "{names}");
+    }
+    let transforms = &patched["scenes"][0]["extras"]["fbakit"]["transforms"];
+    assert!(
+        !transforms
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|t| t["node"] == LEFT_EYE_JOINT || t["node"] == RIGHT_EYE_JOINT),
+        "{transforms}"
+    );
+}
+
+/// The head rotations (48–50) are recorded on the `Head` joint, read back, and played there:
+/// the nose tip moves as the FAT read back from the written file moves it.
+#[test]
+fn head_rotations_are_recorded_on_the_head_node_and_read_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let out = d.join("out.glb");
+    clone_to(&glb, &csv, &out, &[]);
+    let (patched, _) = glb_parts(&out);
+    let record = &patched["scenes"][0]["extras"]["fbakit"];
+    let head = record["transforms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|t| t["node"] == HEAD_NODE)
+        .unwrap_or_else(|| panic!("no transform on Head: {}", record["transforms"]));
+    assert_eq!(record["transforms"][head]["userNode"], true);
+    let tables = record["transformTables"].to_string();
+    for name in ["head_pitch", "head_yaw", "head_roll"] {
+        assert!(tables.contains(name), "{name}: {tables}");
+    }
+    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
+    assert!(!names.contains("head_"), "{names}");
+    let back = fbakit::face::read(&out).unwrap();
+    for fap in [48u8, 49, 50] {
+        assert!(
+            back.fat
+                .tables
+                .iter()
+                .any(|t| t.key == key(fap) && !t.transforms.is_empty()),
+            "FAP {fap} not read back"
+        );
+    }
+
+    // Played from the written file alone: the `Head` joint turns the nose tip as the FAT does.
+    let values = [
+        [0, 0, 0],
+        [15000, 0, 0],
+        [0, 20000, 0],
+        [0, 0, -18000],
+        [8000, -9000, 7000],
+    ];
+    let mut text = format!("2.1 head 25 {}\n", values.len());
+    let mask: Vec<&str> = (1..=68)
+        .map(|f| if (48..=50).contains(&f) { "1" } else { "0" })
+        .collect();
+    for (i, v) in values.iter().enumerate() {
+        text.push_str(&mask.join(" "));
+        text.push_str(&format!("\n{i} {} {} {}\n", v[0], v[1], v[2]));
+    }
+    let stream = d.join("head.fap");
+    std::fs::write(&stream, text).unwrap();
+    let played = d.join("played.glb");
+    run(&[
+        "play".as_ref(),
+        out.as_os_str(),
+        stream.as_os_str(),
+        "-o".as_ref(),
+        played.as_os_str(),
+    ]);
+    let (pj, bin) = glb_parts(&played);
+    let play = pj["animations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "play")
+        .unwrap()
+        .clone();
+    let channel = |path: &str| {
+        play["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["target"]["node"] == HEAD_NODE && c["target"]["path"] == path)
+            .map(|c| {
+                let s = &play["samplers"][c["sampler"].as_u64().unwrap() as usize];
+                floats(&pj, &bin, s["output"].as_u64().unwrap() as usize)
+            })
+    };
+    let rot = channel("rotation").expect("Head turns");
+    let tr = channel("translation");
+    let rest_world = node_world(&pj, HEAD_NODE, &|_| None);
+    let (m, v) = back.fp_vertex(FeaturePointId::FP_9_3).unwrap();
+    let nose = back.neutral_world_positions()[m][v as usize];
+    for (k, vals) in values.iter().enumerate() {
+        let q = Quat::from_slice(&rot[4 * k..4 * k + 4]);
+        let t = tr.as_ref().map(|t| Vec3::from_slice(&t[3 * k..3 * k + 3]));
+        let world = node_world(&pj, HEAD_NODE, &|i| (i == HEAD_NODE).then_some((q, t)));
+        let got = (world * rest_world.inverse()).transform_point3(nose);
+        let a: Vec<Activation> = [48u8, 49, 50]
+            .iter()
+            .zip(vals)
+            .map(|(&f, &x)| Activation {
+                key: key(f),
+                value: f64::from(x),
+            })
+            .collect();
+        let want = back.pose(&a).unwrap()[m][v as usize];
+        let moved = want.distance(nose);
+        eprintln!("frame {k}: played nose {got}, FAT {want} (moved {moved})");
+        assert!(
+            got.distance(want) <= 0.01 * moved + 1e-5,
+            "frame {k}: played {got}, FAT {want}"
+        );
+    }
+    // Head yaw alone (frame 2) turns the nose to the face's left (+x) as the standard's
+    // direction says for a positive value.
+    let yaw_axis = FapId::new(49).unwrap().info().rotation_axis().unwrap();
+    let q = Quat::from_slice(&rot[8..12]);
+    let t = tr.as_ref().map(|t| Vec3::from_slice(&t[6..9]));
+    let world = node_world(&pj, HEAD_NODE, &|i| (i == HEAD_NODE).then_some((q, t)));
+    let got = (world * rest_world.inverse()).transform_point3(nose);
+    let standard = Quat::from_axis_angle(yaw_axis, 0.2) * Vec3::Z;
+    assert_eq!(
+        (got.x - nose.x).signum(),
+        standard.x.signum(),
+        "{got} {nose}"
+    );
+}
+
+/// The clone `out` of `source` onto the avatar `glb` (feature points `csv`) reads back with
+/// the clone's FAT; played with a gaze stream, eye nodes `left` and `right` turn each eyeball
+/// as the FAT does (within 1 %, in the standard's directions) and no weights are keyed on
+/// them; the files add no validator issue.
+fn check_eyes_round_trip_and_play(
+    d: &Path,
+    (glb, csv, out): (&Path, &Path, &Path),
+    source: &FaceModel,
+    (left, right): (usize, usize),
+) {
+    // Read back: the same FAT as the clone's, the head rotations the `Head` node takes and
+    // the eye turns the eye nodes take included.
+    let target = fbakit::face::read_with(glb, &FaceReadOptions::with_feature_points(Some(csv)))
         .unwrap()
         .0;
-    let mut cloned = clone_face(&source, &target, &CloneOptions::default())
+    let mut cloned = clone_face(source, &target, &CloneOptions::default())
         .unwrap()
         .face;
-    let back = fbakit::face::read(&out).unwrap();
+    // Tables the cloner left empty (pupil dilation and tongue FAPs onto skinned eyeballs and
+    // a face without a tongue) move nothing and have nothing to write.
     cloned
         .fat
         .tables
-        .retain(|t| !matches!(t.key, TableKey::LowLevel(f) if [48, 49, 50].contains(&f.number())));
+        .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
+    let back = fbakit::face::read(out).unwrap();
     let report = diff(&cloned, &back, &DiffOptions::default());
     assert!(report.equal, "{report}");
 
@@ -271,8 +535,8 @@ fn eye_nodes_turn_instead_of_morph_targets() {
             })
     };
     let eyes = [
-        (LEFT_EYE_NODE, FeaturePointId::FP_3_5, 0usize, 2usize),
-        (RIGHT_EYE_NODE, FeaturePointId::FP_3_6, 1, 3),
+        (left, FeaturePointId::FP_3_5, 0usize, 2usize),
+        (right, FeaturePointId::FP_3_6, 1, 3),
     ];
     for (node, pupil, yaw, pitch) in eyes {
         let rot = channel(node, "rotation").unwrap_or_else(|| panic!("node {node} not turned"));
@@ -287,7 +551,9 @@ fn eye_nodes_turn_instead_of_morph_targets() {
             let q = Quat::from_slice(&rot[4 * k..4 * k + 4]);
             let t = tr.as_ref().map(|t| Vec3::from_slice(&t[3 * k..3 * k + 3]));
             let world = node_world(&pj, node, &|i| (i == node).then_some((q, t)));
-            // Played: the node's motion applied to the eye's rest positions (file = face frame).
+            // Played: the node's motion applied to the eye's rest positions (file = face frame;
+            // a skinned eyeball is placed by its joint's world matrix times its inverse bind
+            // matrix, so it moves with the joint's world matrix as a child mesh does).
             let (m, _) = back.fp_vertex(pupil).unwrap();
             let motion = world * rest_world.inverse();
             let played_pos: Vec<Vec3> = neutral[m]
@@ -336,13 +602,13 @@ fn eye_nodes_turn_instead_of_morph_targets() {
     }
     // No morph weights for eyeball motion: no weights channel drives an eye mesh, and the
     // eye meshes' nodes are not keyed by weights.
-    for node in [LEFT_EYE_NODE, RIGHT_EYE_NODE] {
+    for node in [left, right] {
         assert!(channel(node, "weights").is_none());
     }
 
     // No new validator issue.
-    let Some(reports) = support::validator::validate(&[glb.clone(), out.clone(), played.clone()])
-    else {
+    let files = [glb.to_path_buf(), out.to_path_buf(), played.clone()];
+    let Some(reports) = support::validator::validate(&files) else {
         return;
     };
     let issues = |r: &Value| (r["errors"].clone(), r["warnings"].clone());
@@ -511,4 +777,122 @@ fn an_eye_node_without_its_eyeball_is_not_used_and_said_so() {
     assert!(patched["meshes"][3]["primitives"][0]
         .get("targets")
         .is_none());
+}
+
+/// `face export` takes the node options as `clone` does: a face read back from a patched
+/// avatar, exported with `--head-node Neck`, shows its head rotations on `Neck` as a clone
+/// with that option does (and on `Head` without it); `--eye-nodes Hat,RightEye` warns about
+/// the hat as the clone does.
+#[test]
+fn face_export_takes_the_node_options_as_clone_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv) = write_avatar(d, &source);
+    let out = d.join("out.glb");
+    clone_to(&glb, &csv, &out, &[]);
+    let cloned = d.join("cloned-neck.glb");
+    clone_to(&glb, &csv, &cloned, &["--head-node", "Neck"]);
+    let export = |name: &str, more: &[&str]| {
+        let path = d.join(name);
+        let o = support::cli::command()
+            .args([
+                "face".as_ref(),
+                "export".as_ref(),
+                out.as_os_str(),
+                "-o".as_ref(),
+            ])
+            .arg(&path)
+            .args(more)
+            .output()
+            .unwrap();
+        let stderr = support::cli::text(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        (path, stderr)
+    };
+    let (neck, _) = export("neck.glb", &["--head-node", "Neck"]);
+    let (plain, _) = export("plain.glb", &[]);
+    // Per transform name, its node and whether it is the user's.
+    let shown = |p: &Path| {
+        let (json, _) = glb_parts(p);
+        let mut list: Vec<(String, Value, Value)> = json["scenes"][0]["extras"]["fbakit"]
+            ["transforms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| {
+                (
+                    t["name"].as_str().unwrap().to_string(),
+                    t["node"].clone(),
+                    t["userNode"].clone(),
+                )
+            })
+            .collect();
+        list.sort_by(|a, b| a.0.cmp(&b.0));
+        list
+    };
+    let on_neck = shown(&neck);
+    assert_eq!(on_neck, shown(&cloned));
+    assert!(
+        on_neck.iter().any(|(_, n, u)| *n == 2 && *u == true),
+        "{on_neck:?}"
+    );
+    let on_head = shown(&plain);
+    assert_eq!(on_head, shown(&out));
+    assert!(
+        on_head
+            .iter()
+            .any(|(_, n, u)| *n == HEAD_NODE && *u == true),
+        "{on_head:?}"
+    );
+    let (_, stderr) = export("hat.glb", &["--eye-nodes", "Hat,RightEye"]);
+    assert!(
+        stderr.contains("eye node `Hat` is not turned (its mesh holds no pupil 3.5)"),
+        "{stderr}"
+    );
+}
+
+/// An eye joint that also moves the skin (here `Head` named as the left eye: the face's skin
+/// is weighted to it) does not turn the left eyeball: a warning says so, the left eye's
+/// motion stays in morph targets, and the right eye joint still turns its eyeball.
+#[test]
+fn an_eye_joint_that_moves_skin_too_is_not_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let opts = Options {
+        skinned_eyes: Some(1.0),
+        ..Options::default()
+    };
+    let (glb, csv) = write_avatar_with(d, &source, &opts);
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str()])
+        .args(["--eye-nodes", "Head,RightEye", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("eye node `Head` is not turned (its mesh carries skin"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("RightEye"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    let names = patched["meshes"][2]["extras"]["targetNames"].to_string();
+    assert!(names.contains("yaw_l_eyeball"), "{names}");
+    assert!(patched["meshes"][3]["primitives"][0]
+        .get("targets")
+        .is_none());
+    let transforms = &patched["scenes"][0]["extras"]["fbakit"]["transforms"];
+    assert!(
+        transforms
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|t| t["node"] == RIGHT_EYE_JOINT && t["userNode"] == true),
+        "{transforms}"
+    );
 }

@@ -84,7 +84,9 @@ pub enum FaceCommand {
         after_help = "Examples:\n  fbakit face export alma -o alma.glb\n  \
                       fbakit face export avatar.glb -o avatar_fat.glb --names arkit\n  \
                       fbakit face export samples/faces/bruno.wrl.gz -o bruno_shapes/\n  \
-                      fbakit face export alma -o alma-arkit.glb --names arkit --units mm"
+                      fbakit face export alma -o alma-arkit.glb --names arkit --units mm\n  \
+                      fbakit face export cloned.glb -o out.glb --head-node mixamorig:Head \\\n    \
+                      --eye-nodes mixamorig:LeftEye,mixamorig:RightEye --jaw-node Jaw"
     )]
     Export(super::face_export::FaceExportArgs),
     /// Build a face with a FAP-compliant FAT from a blendshape rig (ARKit names by default).

@@ -34,6 +34,8 @@ pub struct FaceExportArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub nodes: super::play::NodeArgs,
 }
 
 /// Morph target naming of `face export` and `clone`.
@@ -75,7 +77,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         names: a.names.into(),
         units: a.units,
         new_document: a.new_document,
-        ..Default::default()
+        nodes: a.nodes.rotation_nodes(),
     };
     let report = fbakit::export::write(&a.output, &face, &opts)?;
     if a.json {

@@ -384,12 +384,14 @@ fn report_text(r: &PlayReport) -> String {
 pub struct NodeArgs {
     /// glTF face: the node head pitch, yaw and roll (FAPs 48-50) turn (default: found by the
     /// usual names such as `Head`, or the VRM humanoid head bone, when it carries the nose
-    /// tip 9.3).
+    /// tip 9.3). A cloned face's head transform is shown and recorded on it.
     #[arg(long, value_name = "NODE")]
     pub head_node: Option<String>,
     /// glTF face: the left and right eye nodes eyeball yaw and pitch (FAPs 23-26) turn, as
     /// `LEFT,RIGHT` (default: `LeftEye`/`RightEye`, `eye.L`/`eye.R` or the VRM eye bones).
-    /// An eye node that holds its eyeball's mesh alone shows the cloned eye's motion.
+    /// An eye node that holds its eyeball's mesh alone, or an eye joint its eyeball is
+    /// skinned to (95 % of its weight or more, none of the skin's), shows the cloned eye's
+    /// motion.
     #[arg(long, value_name = "LEFT,RIGHT", value_parser = parse_node_pair)]
     pub eye_nodes: Option<(String, String)>,
     /// glTF face: the jaw node open_jaw turns and thrust_jaw / shift_jaw move (FAPs 3, 14,

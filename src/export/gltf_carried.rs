@@ -72,14 +72,49 @@ pub fn carried_share(
     vertex: usize,
     node: usize,
 ) -> Option<f32> {
+    match primitive_shares(source, mesh_node, mesh, primitive, node)? {
+        Shares::All(s) => Some(s),
+        Shares::PerVertex(list) => list.get(vertex).copied(),
+    }
+}
+
+/// How much of each vertex of a primitive a node moves ([`primitive_shares`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shares {
+    /// The same share for every vertex (a plain mesh: 1 under the node, else 0).
+    All(f32),
+    /// Per vertex, from the skin weights.
+    PerVertex(Vec<f32>),
+}
+
+impl Shares {
+    /// The shares of the first `count` vertices.
+    pub fn of(&self, count: usize) -> Vec<f32> {
+        match self {
+            Shares::All(s) => vec![*s; count],
+            Shares::PerVertex(list) => list.iter().copied().take(count).collect(),
+        }
+    }
+}
+
+/// The share (0–1) of every vertex of the document's `mesh`/`primitive`, instanced by
+/// `mesh_node`, that `node` moves: its skin weight on `node` and the joints below it, or all
+/// or nothing for a plain mesh; `None` when the document cannot say (unreadable weights).
+pub fn primitive_shares(
+    source: &GltfSource,
+    mesh_node: Option<usize>,
+    mesh: usize,
+    primitive: usize,
+    node: usize,
+) -> Option<Shares> {
     let json = &source.json;
     let parents = node_parents(json);
     let Some(mesh_node) = mesh_node else {
-        return Some(0.0);
+        return Some(Shares::All(0.0));
     };
     let Some(skin) = json["nodes"][mesh_node]["skin"].as_u64() else {
         let carried = descends(&parents, mesh_node, node);
-        return Some(if carried { 1.0 } else { 0.0 });
+        return Some(Shares::All(if carried { 1.0 } else { 0.0 }));
     };
     let joints: Vec<usize> = json["skins"][skin as usize]["joints"]
         .as_array()?
@@ -100,33 +135,38 @@ pub fn carried_share(
         (Semantic::Weights(0), Want::Weights),
     ] {
         let acc = prim.get(&semantic)?;
-        if acc.count() <= vertex {
-            return None;
-        }
         data.check(&acc, "skin", want, None).ok()?;
     }
+    // Which joint slots `node` moves.
+    let on_node: Vec<bool> = joints
+        .iter()
+        .map(|&n| descends(&parents, n, node))
+        .collect();
     let reader = prim.reader(|b| source.buffers.get(b.index()).map(Vec::as_slice));
-    let js = reader.read_joints(0)?.into_u16().nth(vertex)?;
-    let ws = reader.read_weights(0)?.into_f32().nth(vertex)?;
-    // fold from +0: an empty f32 `sum` is −0, which prints as "-0 %".
-    let total = ws
-        .iter()
-        .filter(|w| w.is_finite())
-        .fold(0.0f32, |a, w| a + w);
-    if total <= 0.0 {
-        return Some(0.0);
-    }
-    let on: f32 = js
-        .iter()
+    let js = reader.read_joints(0)?.into_u16();
+    let ws = reader.read_weights(0)?.into_f32();
+    let shares = js
         .zip(ws)
-        .filter(|(j, w)| {
-            w.is_finite()
-                && joints
-                    .get(**j as usize)
-                    .is_some_and(|&n| descends(&parents, n, node))
+        .map(|(js, ws)| {
+            // fold from +0: an empty f32 `sum` is −0, which prints as "-0 %".
+            let total = ws
+                .iter()
+                .filter(|w| w.is_finite())
+                .fold(0.0f32, |a, w| a + w);
+            if total <= 0.0 {
+                return 0.0;
+            }
+            let on = js
+                .iter()
+                .zip(ws)
+                .filter(|(j, w)| {
+                    w.is_finite() && on_node.get(usize::from(**j)).copied().unwrap_or(false)
+                })
+                .fold(0.0f32, |a, (_, w)| a + w);
+            on / total
         })
-        .fold(0.0f32, |a, (_, w)| a + w);
-    Some(on / total)
+        .collect();
+    Some(Shares::PerVertex(shares))
 }
 
 #[cfg(test)]
@@ -207,6 +247,15 @@ mod tests {
         assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 1), Some(0.75));
         assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 0), Some(1.0));
         assert_eq!(carried_share(&s, Some(3), 0, 0, 9, 1), None);
+        // The whole primitive at once, as the eye joints are checked.
+        assert_eq!(
+            primitive_shares(&s, Some(3), 0, 0, 1),
+            Some(Shares::PerVertex(vec![0.0, 0.75]))
+        );
+        assert_eq!(
+            primitive_shares(&s, Some(3), 0, 0, 1).unwrap().of(1),
+            vec![0.0]
+        );
         // Float joints (not glTF) are refused, never read.
         let s = source(float_joints, vec![bin]);
         assert_eq!(carried_share(&s, Some(3), 0, 0, 1, 1), None);

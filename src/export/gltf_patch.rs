@@ -9,8 +9,9 @@
 //! it was read with ([`crate::gltf::source::RestPose`]); the file's units are kept.
 //!
 //! FAT motion of transforms (rigid parts turned by the cloner) is shown by the user's own
-//! node where the document has one for it — an eyeball alone under an eye node
-//! ([`super::gltf_user_nodes`]): animated on that node and recorded, not baked. Otherwise it
+//! node where the document has one for it — an eyeball alone under an eye node or skinned to
+//! an eye joint ([`super::gltf_user_nodes`]), the head rotations' transform on the head
+//! node: animated on that node and recorded, not baked. Otherwise it
 //! has no node of its own in the user's document: it is baked into per-vertex targets,
 //! piecewise linear over
 //! `±2 V` in 8 intervals for rotations (`V` the key's reference value), one interval for
@@ -210,9 +211,9 @@ pub fn patch_face(
         user_nodes[t] = true;
     }
     // A head node of the user's (named, or found by its usual names and carrying the nose
-    // tip) turns the head: the head rotations (48–50) of transforms the document has no node
-    // for are left to it, not baked into morph targets (never a rotation and a morph for one
-    // motion). A face without a nose tip or chin cannot be checked: the node is taken.
+    // tip) turns the head: the head rotations (48–50) are left to it, not baked into morph
+    // targets (never a rotation and a morph for one motion). A face without a nose tip or
+    // chin cannot be checked: the node is taken.
     let head = head_node(source, nodes).filter(|&n| {
         [FeaturePointId::FP_9_3, FeaturePointId::FP_2_1]
             .into_iter()
@@ -233,13 +234,27 @@ pub fn patch_face(
                 )
             })
     });
+    // The transform the head rotations turn (the cloner's `head`) is shown by that node:
+    // recorded as a user node like the eyes, so the written file reads back with the head's
+    // motion, and animated there. A transform on a node of fbakit's own keeps it.
+    if let (Some(n), Some(t)) = (head, head_transform(face)) {
+        let own = transform_nodes[t].is_some() && !user_nodes[t];
+        let elsewhere = transform_nodes
+            .iter()
+            .enumerate()
+            .any(|(i, x)| i != t && *x == Some(n));
+        if !own && !elsewhere {
+            transform_nodes[t] = Some(n);
+            user_nodes[t] = true;
+        }
+    }
     let trimmed;
     let face = match head {
-        Some(n) if !transform_nodes.contains(&Some(n)) => {
+        Some(_) => {
             trimmed = without_head_rotations(face, &transform_nodes);
             &trimmed
         }
-        _ => face,
+        None => face,
     };
     let world_pieces = face_pieces(face, &transform_nodes)?;
     let mut meshes: BTreeMap<usize, MeshTargets> = BTreeMap::new();
@@ -497,6 +512,24 @@ fn without_head_rotations(face: &FaceModel, transform_nodes: &[Option<usize>]) -
         .tables
         .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
     out
+}
+
+/// The one transform the head rotation tables (48–50) turn, if they turn exactly one.
+fn head_transform(face: &FaceModel) -> Option<usize> {
+    let mut found = None;
+    for table in &face.fat.tables {
+        if !matches!(table.key, TableKey::LowLevel(f) if HEAD_FAPS.contains(&f.number())) {
+            continue;
+        }
+        for x in &table.transforms {
+            let t = face.transform_index(&x.transform)?;
+            if found.is_some_and(|f| f != t) {
+                return None;
+            }
+            found = Some(t);
+        }
+    }
+    found
 }
 
 /// Where a mesh's pieces land among its targets after the patch.

@@ -7,8 +7,9 @@
 //! usual names (`Head`, `LeftEye`/`RightEye`, `eye.L`, Mixamo, CC, VRM 0 bone names) or by
 //! the VRM humanoid bones (`VRMC_vrm` 1.0, `VRM` 0.x). A FAP the face's FAT has a table for
 //! is left to that table (its morph targets): never a rotation and a morph for one motion.
-//! A cloned face's eyeball transforms are shown by eye nodes that hold the eyeball alone
-//! ([`super::gltf_user_nodes`]): their tables then turn those nodes through the transform.
+//! A cloned face's eyeball transforms are shown by eye nodes that move the eyeball alone
+//! (holding its mesh, or its skin weights: [`super::gltf_user_nodes`]), and its head
+//! transform by the head node: their tables then turn those nodes through the transform.
 //!
 //! The jaw is the other way round ([`jaw_node`]): a skinned jaw joint carries the chin, the
 //! lower teeth and the lower lip with it, so when the document has one (`play --jaw-node`,

@@ -2,8 +2,10 @@
 //!
 //! A cloned face turns each eyeball by a transform of its own (FAPs 23–26). When the user's
 //! document has eye nodes (`--eye-nodes`, the usual names such as `LeftEye`, or the VRM eye
-//! bones, as [`super::gltf_rotations::eye_nodes`] finds them) that hold that eyeball's mesh
-//! and nothing else of the face, the transform is shown by that node: its motion is animated
+//! bones, as [`super::gltf_rotations::eye_nodes`] finds them) that move that eyeball's mesh
+//! and nothing else of the face — the mesh under the node, or skinned to it as an eye joint
+//! (`world × inverseBind` of the joint places the eyeball, so turning the joint turns it) —
+//! the transform is shown by that node: its motion is animated
 //! on the node, not baked into morph targets, and recorded in the document's FAT extras
 //! (`userNode`, `specs/gltf-fat.md`) so the face reads back with the same eye motion.
 //!
@@ -16,17 +18,29 @@
 use glam::{Affine3A, Mat4, Quat, Vec3};
 use serde_json::Value;
 
-use super::gltf_rotations::{descends, eye_nodes, node_parents, world_matrices, RotationNodes};
+use super::gltf_carried::primitive_shares;
+use super::gltf_rotations::{eye_nodes, world_matrices, RotationNodes};
 use crate::error::Diagnostic;
 use crate::face::FaceModel;
 use crate::gltf::source::GltfSource;
 use crate::spec::FeaturePointId;
 
+/// Least share of an eyeball's skin weight on its eye joint (and the joints below it) for
+/// the joint to turn it: a few stray weights are tolerated.
+const EYEBALL_CARRIED: f32 = 0.95;
+/// Largest share of a vertex the eye node may move when it is not the eyeball's: more would
+/// turn skin (a lid weighted to the eye bone) with the eye.
+const STRAY_SHARE: f32 = 1e-3;
+
 /// The face transforms of `face` that the user's eye nodes show, as `(transform, node)`.
-/// Nodes already showing a transform (`taken`) are left as they are. An eye node whose
-/// meshes are not one eyeball turned alone by the FAT (no pupil 3.5/3.6 on them, other
-/// feature points or the other pupil on them, a skinned mesh, parts of other transforms, a
-/// `matrix` node) is not used: a warning says why, and its motion stays in morph targets.
+/// Nodes already showing a transform (`taken`) are left as they are. An eye node shows an
+/// eyeball when it moves that eyeball alone: a plain mesh under it, or a skinned mesh
+/// weighted to it (or the joints below it) by at least 95 % (the usual VRM, Mixamo or
+/// ReadyPlayerMe eye bone). An eye node whose meshes are not one eyeball turned alone by the
+/// FAT (no pupil 3.5/3.6 on them, other feature points or the other pupil on them, an
+/// eyeball partly weighted to it, skin weighted to it, parts of other transforms, an eyeball
+/// the FAT moves vertex by vertex, a `matrix` node) is not used: a warning says why, and its
+/// motion stays in morph targets.
 pub fn eye_transforms(
     face: &FaceModel,
     source: &GltfSource,
@@ -36,7 +50,6 @@ pub fn eye_transforms(
 ) -> Vec<(usize, usize)> {
     let (left, right) = eye_nodes(source, names);
     let json = &source.json;
-    let parents = node_parents(json);
     let mut out = Vec::new();
     for (node, pupil, other) in [
         (left, FeaturePointId::FP_3_5, FeaturePointId::FP_3_6),
@@ -55,24 +68,50 @@ pub fn eye_transforms(
                 source.path.display()
             ))
         };
-        // The face meshes this node carries: its own and its descendants'.
-        let under: Vec<usize> = face
+        // How much of each face mesh's vertices the node moves (its own meshes and its
+        // descendants', or skin weights on it and the joints below it).
+        let mut unreadable = None;
+        let shares: Vec<Vec<f32>> = face
             .meshes
             .iter()
-            .enumerate()
-            .filter(|(_, m)| {
-                source
-                    .part(&m.name)
-                    .and_then(|p| p.node)
-                    .is_some_and(|n| descends(&parents, n, node))
+            .map(|m| {
+                let n = m.mesh.vertex_count();
+                let Some(part) = source.part(&m.name) else {
+                    return vec![0.0; n];
+                };
+                match primitive_shares(source, part.node, part.mesh, part.primitive, node) {
+                    Some(s) => s.of(n),
+                    None => {
+                        unreadable.get_or_insert_with(|| m.name.clone());
+                        vec![0.0; n]
+                    }
+                }
             })
-            .map(|(i, _)| i)
+            .collect();
+        let under: Vec<usize> = (0..face.meshes.len())
+            .filter(|&m| shares[m].iter().any(|&s| s > STRAY_SHARE))
             .collect();
         if under.is_empty() {
-            // A bone skinned meshes follow, or an empty node: nothing of the face to turn.
+            if let Some(m) = unreadable {
+                warnings.push(refuse(format!(
+                    "the skin weights of mesh `{m}` cannot be read"
+                )));
+            }
+            // A bone no face vertex follows, or an empty node: nothing of the face to turn.
             continue;
         }
-        let Some(transform) = face.meshes[under[0]].transform else {
+        let pupil_mesh = face
+            .fp_vertex(pupil)
+            .map(|(m, _)| m)
+            .filter(|m| under.contains(m));
+        let Some(transform) = face.meshes[pupil_mesh.unwrap_or(under[0])].transform else {
+            if let Some(m) = pupil_mesh {
+                // A one-primitive eyes mesh cut apart and baked by the cloner.
+                warnings.push(refuse(format!(
+                    "its eyeball is vertices of mesh `{}`, which the FAT moves vertex by vertex",
+                    face.meshes[m].name
+                )));
+            }
             continue;
         };
         if !face
@@ -85,10 +124,7 @@ pub fn eye_transforms(
             // The FAT does not move it: nothing to animate.
             continue;
         }
-        let pupil_on = face
-            .fp_vertex(pupil)
-            .is_some_and(|(m, _)| under.contains(&m));
-        if !pupil_on {
+        if pupil_mesh.is_none() {
             warnings.push(refuse(format!("its mesh holds no pupil {pupil}")));
             continue;
         }
@@ -97,8 +133,9 @@ pub fn eye_transforms(
             .iter()
             .filter(|p| p.id != pupil)
             .find(|p| {
-                face.fp_vertex(p.id)
-                    .is_some_and(|(m, _)| under.contains(&m))
+                face.fp_vertex(p.id).is_some_and(|(m, v)| {
+                    shares[m].get(v as usize).is_some_and(|&s| s > STRAY_SHARE)
+                })
             });
         if let Some(p) = skin_on {
             let what = if p.id == other {
@@ -107,15 +144,6 @@ pub fn eye_transforms(
                 format!("its mesh carries skin: feature point {}", p.id)
             };
             warnings.push(refuse(what));
-            continue;
-        }
-        if under.iter().any(|&m| {
-            source
-                .part(&face.meshes[m].name)
-                .and_then(|p| p.node)
-                .is_some_and(|n| json["nodes"][n].get("skin").is_some())
-        }) {
-            warnings.push(refuse("its mesh is skinned".into()));
             continue;
         }
         // The transform turns exactly these meshes (none of another part or of the skin).
@@ -134,11 +162,39 @@ pub fn eye_transforms(
             }
             false
         };
-        let exact = (0..face.meshes.len()).all(|m| moved_by(m) == under.contains(&m));
-        if !exact {
-            warnings.push(refuse(
-                "its meshes and the eyeball the face turns are not the same".into(),
-            ));
+        if let Some(m) = (0..face.meshes.len()).find(|&m| !moved_by(m) && under.contains(&m)) {
+            let skinned = source
+                .part(&face.meshes[m].name)
+                .and_then(|p| p.node)
+                .is_some_and(|n| json["nodes"][n].get("skin").is_some());
+            warnings.push(refuse(if skinned {
+                format!(
+                    "mesh `{}` is weighted to it too, not only the eyeball",
+                    face.meshes[m].name
+                )
+            } else {
+                "its meshes and the eyeball the face turns are not the same".into()
+            }));
+            continue;
+        }
+        let partly = (0..face.meshes.len())
+            .filter(|&m| moved_by(m))
+            .find_map(|m| {
+                let s = &shares[m];
+                let mean = s.iter().sum::<f32>() / s.len().max(1) as f32;
+                (mean < EYEBALL_CARRIED).then_some((m, mean))
+            });
+        if let Some((m, mean)) = partly {
+            warnings.push(refuse(if mean <= STRAY_SHARE {
+                "its meshes and the eyeball the face turns are not the same".into()
+            } else {
+                format!(
+                    "mesh `{}` of the eyeball is weighted to it by {:.0} % only, not {:.0} %",
+                    face.meshes[m].name,
+                    mean * 100.0,
+                    EYEBALL_CARRIED * 100.0
+                )
+            }));
             continue;
         }
         if json["nodes"][node].get("matrix").is_some() {
@@ -206,6 +262,7 @@ pub fn world_delta(parent: Affine3A, rest: Affine3A, animated: Affine3A, unit: f
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::export::gltf_rotations::descends;
 
     /// A world-frame turn about a pivot off the node's origin, under a turned and scaled
     /// parent, comes back as the node's local rotation and translation: the node's world

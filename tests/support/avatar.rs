@@ -9,6 +9,9 @@
 //! lower row of teeth in one primitive behind the lips (the upper row on the head joint, the
 //! lower on the jaw), with feature points 9.8–9.11 on them ([`teeth_fp_lines`]).
 //!
+//! Other variants move the eyeballs onto nodes of their own ([`Options::eye_nodes`]) or skin
+//! them to eye joints ([`Options::skinned_eyes`]).
+//!
 //! The jaw's inverse bind matrix was taken half a centimetre higher than the jaw rests, so the
 //! mouth's vertices (weighted to jaw and head) are placed per vertex at rest; the other joints
 //! agree and place their vertices with the armature's one matrix.
@@ -84,6 +87,43 @@ pub struct Options {
     /// The eyeballs on their own nodes `LeftEye` and `RightEye` (nodes [`LEFT_EYE_NODE`] and
     /// [`RIGHT_EYE_NODE`], meshes 2 and 3) instead of `Body`'s `eyes` primitive.
     pub eye_nodes: bool,
+    /// The eyeballs as meshes of their own (`LeftEyeMesh`, `RightEyeMesh`: meshes 2 and 3 on
+    /// nodes [`LEFT_EYE_MESH_NODE`], [`RIGHT_EYE_MESH_NODE`]) skinned to eye joints
+    /// `LeftEye` and `RightEye` ([`LEFT_EYE_JOINT`], [`RIGHT_EYE_JOINT`], under `Head`, turned
+    /// rest frames, skin slots 4 and 5) instead of `Body`'s `eyes` primitive, as
+    /// ReadyPlayerMe and Mixamo avatars have them: `Some(share)` weights each eyeball vertex
+    /// to its eye joint by `share`, the rest to `Head`. Not with [`Options::eye_nodes`].
+    pub skinned_eyes: Option<f32>,
+}
+
+/// With [`Options::skinned_eyes`]: the eye joints and the nodes of the eye meshes (indices).
+pub const LEFT_EYE_JOINT: usize = 8;
+pub const RIGHT_EYE_JOINT: usize = 9;
+pub const LEFT_EYE_MESH_NODE: usize = 10;
+pub const RIGHT_EYE_MESH_NODE: usize = 11;
+
+/// Rest rotation of an eye joint in `Head`'s frame: a bone along the gaze (its +y forward),
+/// rolled differently on each side, as rigging tools leave them.
+fn eye_joint_rotation(left: bool) -> glam::Quat {
+    glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)
+        * glam::Quat::from_rotation_y(if left { 0.5 } else { -0.2 })
+}
+
+/// An eye joint's translation in `Head`'s frame (cm): the eyeball's centre, the right one
+/// 0.2 cm off it (a pivot an artist placed by eye).
+fn eye_joint_translation(left: bool) -> Vec3 {
+    eye_centre(left) - HEAD_CENTRE
+        + if left {
+            Vec3::ZERO
+        } else {
+            Vec3::new(0.0, 0.2, -0.2)
+        }
+}
+
+/// World matrix (file units: the armature's 0.01 applied) of an eye joint at rest.
+pub fn eye_joint_world(left: bool) -> Mat4 {
+    joint_worlds()[2]
+        * Mat4::from_rotation_translation(eye_joint_rotation(left), eye_joint_translation(left))
 }
 
 /// With [`Options::eye_nodes`]: the `Eyes` node and the eye nodes (indices).
@@ -397,7 +437,7 @@ pub fn build_with(opts: &Options) -> Avatar {
     let image_view = b.view(&png, None);
     let mut primitives = Vec::new();
     for (k, p) in prims.iter().enumerate() {
-        if opts.eye_nodes && p.name == "eyes" {
+        if (opts.eye_nodes || opts.skinned_eyes.is_some()) && p.name == "eyes" {
             continue;
         }
         let pos = b.vec3(&p.positions, true);
@@ -499,6 +539,45 @@ pub fn build_with(opts: &Options) -> Avatar {
             }));
         }
     }
+    // The eye meshes of `Options::skinned_eyes`: each sphere in the armature's centimetres
+    // like `Body`, weighted to its eye joint (slot 4 left, 5 right) and the head (slot 2).
+    if let Some(share) = opts.skinned_eyes {
+        assert!(!opts.eye_nodes, "eye nodes or skinned eyes, not both");
+        for (left, slot) in [(true, 4u8), (false, 5u8)] {
+            let (p, n, uv, t) = eyeball(left);
+            let pos = b.vec3(&p, true);
+            let nrm = b.vec3(&n, false);
+            let uv_bytes: Vec<u8> = uv
+                .iter()
+                .flat_map(|v| v.to_array())
+                .flat_map(f32::to_le_bytes)
+                .collect();
+            let uv_view = b.view(&uv_bytes, Some(34962));
+            let uv = b.acc(json!({"bufferView": uv_view, "componentType": 5126, "count": p.len(), "type": "VEC2"}));
+            let jb: Vec<u8> = p.iter().flat_map(|_| [slot, 2, 0, 0]).collect();
+            let jv = b.view(&jb, Some(34962));
+            let joints = b.acc(
+                json!({"bufferView": jv, "componentType": 5121, "count": p.len(), "type": "VEC4"}),
+            );
+            let wb: Vec<u8> = p
+                .iter()
+                .flat_map(|_| [share, 1.0 - share, 0.0, 0.0])
+                .flat_map(f32::to_le_bytes)
+                .collect();
+            let wv = b.view(&wb, Some(34962));
+            let weights = b.acc(
+                json!({"bufferView": wv, "componentType": 5126, "count": p.len(), "type": "VEC4"}),
+            );
+            let ib: Vec<u8> = t.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+            let iv = b.view(&ib, Some(34963));
+            let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": t.len() * 3, "type": "SCALAR"}));
+            eye_meshes.push(json!({
+                "name": if left { "LeftEyeMesh" } else { "RightEyeMesh" },
+                "primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv,
+                    "JOINTS_0": joints, "WEIGHTS_0": weights}, "indices": idx, "material": 2}]
+            }));
+        }
+    }
     // Inverse bind matrices: each joint's world inverse times the armature (the mesh's bind
     // frame); the jaw's bind half a centimetre above its rest.
     let worlds = joint_worlds();
@@ -511,6 +590,11 @@ pub fn build_with(opts: &Options) -> Avatar {
             *w
         };
         ibm.extend((bind.inverse() * armature).to_cols_array());
+    }
+    if opts.skinned_eyes.is_some() {
+        for left in [true, false] {
+            ibm.extend((eye_joint_world(left).inverse() * armature).to_cols_array());
+        }
     }
     let ibm = b.floats(&ibm, "MAT4", false);
     // The user's animation: the head nods, Blink closes and opens.
@@ -595,6 +679,20 @@ pub fn build_with(opts: &Options) -> Avatar {
             nodes.push(json!({"name": name, "mesh": mesh,
                 "translation": eye_node_translation(left).to_array(),
                 "rotation": q(eye_node_rotation(left))}));
+        }
+        json["meshes"].as_array_mut().unwrap().extend(eye_meshes);
+    } else if opts.skinned_eyes.is_some() {
+        json["nodes"][3]["children"] = json!([4, 6, LEFT_EYE_JOINT, RIGHT_EYE_JOINT]);
+        json["nodes"][0]["children"] = json!([1, 5, LEFT_EYE_MESH_NODE, RIGHT_EYE_MESH_NODE]);
+        json["skins"][0]["joints"] = json!([1, 2, 3, 4, LEFT_EYE_JOINT, RIGHT_EYE_JOINT]);
+        let nodes = json["nodes"].as_array_mut().unwrap();
+        for (left, name) in [(true, "LeftEye"), (false, "RightEye")] {
+            nodes.push(json!({"name": name,
+                "translation": eye_joint_translation(left).to_array(),
+                "rotation": eye_joint_rotation(left).to_array()}));
+        }
+        for (mesh, name) in [(2, "LeftEyeMesh"), (3, "RightEyeMesh")] {
+            nodes.push(json!({"name": name, "mesh": mesh, "skin": 0}));
         }
         json["meshes"].as_array_mut().unwrap().extend(eye_meshes);
     }
