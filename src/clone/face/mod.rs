@@ -432,6 +432,12 @@ pub fn clone_face(
         face = fold::fold_into_target(&face, &bare, v, &targets, &mut report)?;
         report.timings.push("fold", clock.elapsed().as_secs_f64());
     }
+    // A table left with nothing to move (pupil dilation onto eyes with no transform, tongue
+    // FAPs onto a face without a tongue) has nothing to write, so a written clone would read
+    // back without it.
+    face.fat
+        .tables
+        .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
     report.tables = face.fat.tables.len();
     report.source_parts = sparts;
     report.target_parts = tparts;
