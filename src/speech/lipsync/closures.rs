@@ -23,8 +23,8 @@
 //! the 60 p's, 32 of the 68 b's) are bright at the bottom: a silent gap filled by the
 //! recording's noise, which says nothing of the place.
 //! - Place from the formant transitions and the burst, read from the cepstral envelope:
-//!   for the 182 bright deep dips, the change of four band levels (< 0.8, 0.8–1.8, 1.8–3,
-//!   > 3 kHz, relative to their mean) into the gap and out of it and the levels of the first
+//!   for the 182 bright deep dips, the change of four band levels (below 0.8, 0.8–1.8, 1.8–3,
+//!   above 3 kHz, relative to their mean) into the gap and out of it and the levels of the first
 //!   frame after it (the burst) each told labial from other dips no better than chance (area
 //!   under the ROC curve 0.40–0.57; the best, less energy above 3 kHz in the burst, 0.60); a
 //!   logistic model over all of them with what the recogniser heard, fitted leaving out one
