@@ -338,7 +338,9 @@ fn lids_close_and_each_eyes_lashes_follow_their_own() {
         );
         let lash = own.clone().map(|v| n[v].y - p[lashes][v].y).sum::<f32>() / 8.0;
         eprintln!("FAP {fap}: lid {lid} down {down}, its lashes down {lash}");
-        assert!(lash > 0.1 * down, "FAP {fap}: lashes {lash}, lid {down}");
+        // They ride on their lid's margin: 86 % of the lid point's drop (12–28 % when tied
+        // to the closest skin point, the fold above the lid on this coarse skin).
+        assert!(lash > 0.8 * down, "FAP {fap}: lashes {lash}, lid {down}");
         assert!(
             max_move(n, &p[lashes], other.clone()) < 1e-6,
             "FAP {fap} moves the other eye's lashes"
