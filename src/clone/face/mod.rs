@@ -316,11 +316,14 @@ pub fn clone_face(
     let mut cloned_motions =
         clone_skin_motions(&ssurf, &tsurf, &motions, &alignment, opts, &mut report)?;
     // Lashes ride on their own lid's margin: rows that are pieces of the skin take its
-    // motion here, rows of their own mesh in step 8. A target one mesh with the source
-    // keeps the source's own lash motion, vertex to vertex.
+    // motion here, rows of their own mesh in step 8. A source with rows of lashes in its own
+    // skin has them mapped onto the target's by the surface method, like for like (and a
+    // target one mesh with the source keeps the source's lash motion vertex to vertex).
     let margins =
         lid_margin::LidMargins::of(&tsurf.surface).with_eyeballs(target, &tparts, &alignment);
-    if !whole {
+    let source_rows =
+        lid_margin::SkinRows::of(source, &ssurf, &lid_margin::LidMargins::of(&ssurf.surface));
+    if !whole && source_rows.is_empty() {
         lid_margin::SkinRows::of(target, &tsurf, &margins).carry(&mut cloned_motions);
     }
     let cloned: HashMap<(TableKey, u64), &SurfaceMotion> = cloned_motions
