@@ -214,7 +214,8 @@ fn max_motion(d: &[Vec<Vec3>], verts: &[(usize, usize)]) -> f32 {
 /// `assert!` that records the failure in `$fails` and goes on.
 macro_rules! expect {
     ($fails:expr, $cond:expr, $($msg:tt)+) => {
-        if !$cond {
+        let ok: bool = $cond;
+        if !ok {
             $fails.push(format!($($msg)+));
         }
     };

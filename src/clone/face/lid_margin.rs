@@ -107,7 +107,7 @@ impl Ball {
         }
         let r = rest + d - self.centre;
         let len = r.length();
-        if len >= self.radius || !(len > 0.0) {
+        if len >= self.radius || len.is_nan() || len <= 0.0 {
             return d;
         }
         self.centre + r * (self.radius / len) - rest
@@ -127,7 +127,7 @@ impl LidMargins {
             return LidMargins::default();
         };
         let es = pl.distance(pr);
-        if !(es > 0.0) {
+        if es.is_nan() || es <= 0.0 {
             return LidMargins::default();
         }
         let graph = EdgeGraph::of(surf);
