@@ -10,7 +10,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use fbakit::clone::face::{clone_face, CloneOptions, CloneOutcome, Method, Part};
+use fbakit::clone::face::{clone_face, CloneOptions, CloneOutcome, Part};
 use fbakit::face::{FaceModel, FaceReadOptions};
 use fbakit::fat::eval::Activation;
 use fbakit::fat::TableKey;
@@ -75,16 +75,7 @@ fn cloned() -> Option<&'static (FaceModel, CloneOutcome)> {
         let setup = setup()?;
         let head = head(setup);
         let alma = fbakit::face::read("alma").unwrap();
-        // fmc with the paper's projected correspondence: with the default dense one the
-        // upper lashes, which float in front of the lid, follow it by only 12 % of its peak
-        // (the lash check below asks 20 %); fit's correspondence around the lids is being
-        // reworked.
-        let mut opts = CloneOptions {
-            method: Method::Fmc,
-            ..CloneOptions::default()
-        };
-        opts.fmc.correspondence = fbakit::clone::fmc::FmcCorrespondence::Paper;
-        let out = clone_face(&alma, &head, &opts).unwrap();
+        let out = clone_face(&alma, &head, &CloneOptions::default()).unwrap();
         Some((head, out))
     })
     .as_ref()
@@ -190,7 +181,10 @@ fn the_jaw_carries_the_lower_teeth_and_lids_the_lashes() {
     eprintln!(
         "close_t_l_eyelid: lid peak {lid:.4}, upper left lashes mean {moved:.4}, down {down:.4}"
     );
-    assert!(moved > 0.2 * lid, "lashes {moved} vs lid {lid}");
+    // The lashes ride on the lid's margin: 72 % of the lid's peak on average (the peak is
+    // the margin's middle; the lashes towards the corners move less), 12 % when they were
+    // tied to the closest skin point (often the lid's fold).
+    assert!(moved > 0.65 * lid, "lashes {moved} vs lid {lid}");
     assert!(down < 0.0, "the lashes go up ({down})");
 }
 

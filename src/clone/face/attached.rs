@@ -9,12 +9,19 @@
 //! face's) and lies on the skin (every vertex within [`MAX_GAP`] of the face's size of the
 //! skin surface). A hat or hair cap is too large, a prop in front of the face too far; both
 //! stay rigid. Eyeballs, teeth and the tongue are parts, never attached.
+//!
+//! A connected piece of an attached mesh that is a row of lashes (near an eye, on one side
+//! of its corners, its root at the lid's margin: [`super::lid_margin`]) is tied to that
+//! lid's margin instead of the closest skin point: floating in front of the lid, its closest
+//! skin point is often the lid's fold, which hardly moves when the lid closes.
 
 use glam::{DMat3, DVec3, Vec3};
 use parry3d::math::Vector as PVec;
 use parry3d::shape::{CompositeShapeRef, TriMesh};
 
+use super::lid_margin::{Ball, LidMargins};
 use super::parts::face_diagonal;
+use super::split::mesh_pieces;
 use super::{FaceParts, Similarity, SkinSurface};
 use crate::clone::SurfaceMotion;
 use crate::face::{FaceFrames, FaceModel};
@@ -38,6 +45,9 @@ pub(super) struct AttachedMesh {
     pub corners: Vec<[u32; 3]>,
     /// Per vertex: the weights of those corners.
     pub weights: Vec<[f32; 3]>,
+    /// Per vertex of a row of lashes: the eyeball it stays out of and its rest position
+    /// (aligned frame).
+    pub outside: Vec<Option<(Ball, Vec3)>>,
 }
 
 /// The face's meshes of neither skin nor a part (`parts.other`) that ride on the skin surface
@@ -48,6 +58,7 @@ pub(super) fn attach_to_skin(
     parts: &FaceParts,
     skin: &SkinSurface,
     frame: &Similarity,
+    margins: &LidMargins,
 ) -> Vec<AttachedMesh> {
     if parts.other.is_empty() || skin.surface.triangles.is_empty() {
         return Vec::new();
@@ -92,7 +103,25 @@ pub(super) fn attach_to_skin(
             weights.push(barycentric(on, a, b, c));
         }
         if corners.len() == world.len() {
+            let (piece, count) = mesh_pieces(&face.meshes[mi].mesh, diag * 1e-6);
+            let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
+            for (v, &k) in piece.iter().enumerate() {
+                members[k].push(v);
+            }
+            let mut outside = vec![None; world.len()];
+            for vs in &members {
+                let pts: Vec<Vec3> = vs.iter().map(|&v| frame.point(world[v])).collect();
+                let Some(lid) = margins.row_lid(&pts) else {
+                    continue;
+                };
+                let ball = margins.ball(lid);
+                for (&v, &p) in vs.iter().zip(&pts) {
+                    (corners[v], weights[v]) = margins.tie(lid, p);
+                    outside[v] = ball.map(|b| (b, p));
+                }
+            }
             out.push(AttachedMesh {
+                outside,
                 mesh: mi,
                 corners,
                 weights,
@@ -126,10 +155,14 @@ pub(super) fn attached_motion(
         let inv: DMat3 = frames.meshes[a.mesh].matrix3.as_dmat3().inverse();
         let mut vertices = Vec::new();
         let mut offsets = Vec::new();
-        for (v, (c, w)) in a.corners.iter().zip(&a.weights).enumerate() {
+        for (v, ((c, w), out)) in a.corners.iter().zip(&a.weights).zip(&a.outside).enumerate() {
             let d: DVec3 = (0..3)
                 .map(|k| dense[c[k] as usize].as_dvec3() * f64::from(w[k]))
                 .sum();
+            let d = match out {
+                Some((ball, rest)) => ball.keep_out(*rest, d.as_vec3()).as_dvec3(),
+                None => d,
+            };
             if d == DVec3::ZERO {
                 continue;
             }

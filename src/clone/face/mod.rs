@@ -118,8 +118,11 @@
 //!    never take it.
 //! 8. **`fat`** — per target skin mesh the face-frame displacements go back to the mesh frame
 //!    (inverse world 3×3) and [`fat_from_morph_targets`] rebuilds the tables (multi-interval
-//!    tables keep their borders); transform entries are appended. Every output number must be
-//!    finite, or the clone fails.
+//!    tables keep their borders); transform entries are appended. Small meshes of neither
+//!    skin nor a part that lie on the skin (lashes, brow cards) ride on it (`attached`).
+//!    Rows of lashes — their own mesh or pieces of a one-mesh head's skin — ride on their own
+//!    lid's margin instead (`lid_margin`: the edge path corner → lid point → corner), never
+//!    entering the eyeball. Every output number must be finite, or the clone fails.
 //! 9. **`fold`** — a one-mesh target cut in step 1 comes back in its own layout: the cut is an
 //!    internal view only. Entries on the view's skin and part meshes go back to the target
 //!    mesh's own vertex numbers through the cut's index maps (a vertex on the cut along the
@@ -161,7 +164,7 @@
 //! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
 //! the surface (steps 4 and 8), `rescale` step 6, the guard and the gain, `smooth` the smooth
 //! step, `rigid`, `part_motion` and `jaw_follow`
-//! step 7, `assemble` step 8 and `fold` step 9. This file runs them in order.
+//! step 7, `assemble`, `attached` and `lid_margin` step 8 and `fold` step 9. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
 
@@ -170,6 +173,7 @@ mod assemble;
 mod attached;
 mod fold;
 mod jaw_follow;
+mod lid_margin;
 mod motions;
 mod options;
 mod part_deform;
@@ -309,8 +313,19 @@ pub fn clone_face(
         .timings
         .push("motions", clock.elapsed().as_secs_f64());
     // 5, 6. Surface method and FAPU rescale.
-    let cloned_motions =
+    let mut cloned_motions =
         clone_skin_motions(&ssurf, &tsurf, &motions, &alignment, opts, &mut report)?;
+    // Lashes ride on their own lid's margin: rows that are pieces of the skin take its
+    // motion here, rows of their own mesh in step 8. A source with rows of lashes in its own
+    // skin has them mapped onto the target's by the surface method, like for like (and a
+    // target one mesh with the source keeps the source's lash motion vertex to vertex).
+    let margins =
+        lid_margin::LidMargins::of(&tsurf.surface).with_eyeballs(target, &tparts, &alignment);
+    let source_rows =
+        lid_margin::SkinRows::of(source, &ssurf, &lid_margin::LidMargins::of(&ssurf.surface));
+    if !whole && source_rows.is_empty() {
+        lid_margin::SkinRows::of(target, &tsurf, &margins).carry(&mut cloned_motions);
+    }
     let cloned: HashMap<(TableKey, u64), &SurfaceMotion> = cloned_motions
         .iter()
         .map(|m| ((m.key, m.value.to_bits()), m))
@@ -379,7 +394,7 @@ pub fn clone_face(
     }
     // Small meshes on the skin (lashes as their own mesh or primitive) ride on it.
     let frames = face.frames();
-    let riders = attached::attach_to_skin(&face, &frames, &tparts, &tsurf, &alignment);
+    let riders = attached::attach_to_skin(&face, &frames, &tparts, &tsurf, &alignment, &margins);
     for m in &cloned_motions {
         let meshes = attached::attached_motion(&face, &frames, &riders, &tsurf, &alignment, m);
         if !meshes.is_empty() {

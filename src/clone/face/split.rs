@@ -1,7 +1,10 @@
 //! One-mesh heads: eyes, teeth and gums that are separate connected pieces of the skin mesh
 //! (the bundled `ict`) are split into part meshes before cloning, so the rigid-part step can
 //! move them (module docs of [`super`], step 1); so are part meshes holding several parts
-//! (both eyeballs in one mesh or glTF primitive, both rows of teeth). The split is an internal view: its index maps
+//! (both eyeballs in one mesh or glTF primitive, both rows of teeth), and a mesh holding both
+//! rows of teeth but no feature point (no 9.8–9.11, as iBUG-68 landmarks give): its pieces
+//! above the lip line (2.2/2.3) are the upper row, those below the lower
+//! ([`teeth_row_plans`]: the rule). The split is an internal view: its index maps
 //! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -204,6 +207,7 @@ pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
     let chin_mesh = chin.as_ref().map(|p| p.mesh);
     let mut plans: Vec<CutPlan> = chin.into_iter().collect();
     plans.extend(shared_part_plans(face, &frames, diag, chin_mesh));
+    plans.extend(teeth_row_plans(face, &frames, diag, chin_mesh));
     plans.retain(|p| !deformed.contains(face.meshes[p.mesh].name.as_str()));
     if plans.is_empty() {
         return None;
@@ -381,6 +385,97 @@ fn shared_part_plans(
             mesh: mi,
             dest,
             rest,
+            pieces,
+        });
+    }
+    plans
+}
+
+/// Largest overlap of a row of teeth across the lip line, in MNS0: lower incisors may reach
+/// above it behind the upper ones.
+const ROW_OVERLAP: f32 = 0.25;
+
+/// Meshes (or glTF primitives) holding both rows of teeth but no feature point at all (the
+/// face has no 9.8–9.11, as with iBUG-68 landmarks), recognised by place: the mesh lies in
+/// the mouth (centred between the lip corners, within 1.5 MNS0 of the lip line, behind the
+/// lips), and each of its connected pieces lies on one side of the lip line (the 2.2/2.3
+/// midline; its centroid there and at most [`ROW_OVERLAP`] MNS0 across), some above and
+/// some below. Pieces above are the upper row, below the lower; the upper row stays in the
+/// mesh. A piece reaching well across the lip line (a mouth interior, gums joined to a
+/// tongue) leaves the mesh uncut, as does a mesh of one row.
+fn teeth_row_plans(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    diag: f32,
+    skip: Option<usize>,
+) -> Vec<CutPlan> {
+    let Some(lm) = Landmarks::of(face) else {
+        return Vec::new();
+    };
+    let mut with_fp: BTreeSet<usize> = BTreeSet::new();
+    for fp in face.feature_points.iter() {
+        if let Some((mi, _)) = fp_mesh_vertex(face, frames, fp.id, diag * 1e-4) {
+            with_fp.insert(mi);
+        }
+    }
+    let mut plans = Vec::new();
+    for mi in 0..face.meshes.len() {
+        if Some(mi) == skip || with_fp.contains(&mi) {
+            continue;
+        }
+        let mesh = &face.meshes[mi].mesh;
+        let world = face.mesh_world(frames, mi);
+        if world.is_empty() || mesh.polygons.is_empty() {
+            continue;
+        }
+        let c = world.iter().copied().sum::<Vec3>() / world.len() as f32;
+        let in_mouth = (c.x - lm.mouth_x).abs() < 0.75 * lm.mw
+            && (c.y - lm.lip_y).abs() < 1.5 * lm.mns
+            && c.z < lm.lip_z;
+        if !in_mouth {
+            continue;
+        }
+        let (piece, count) = mesh_pieces(mesh, diag * 1e-6);
+        let mut stats = vec![(Vec3::ZERO, 0usize, f32::INFINITY, f32::NEG_INFINITY); count];
+        for (v, &k) in piece.iter().enumerate() {
+            let p = world[v];
+            let s = &mut stats[k];
+            s.0 += p;
+            s.1 += 1;
+            s.2 = s.2.min(p.y);
+            s.3 = s.3.max(p.y);
+        }
+        let overlap = ROW_OVERLAP * lm.mns;
+        let rows: Option<Vec<Part>> = stats
+            .iter()
+            .map(|&(sum, n, lo, hi)| {
+                let cy = sum.y / n.max(1) as f32;
+                if cy > lm.lip_y && lo > lm.lip_y - overlap {
+                    Some(Part::UpperTeeth)
+                } else if cy <= lm.lip_y && hi < lm.lip_y + overlap {
+                    Some(Part::LowerTeeth)
+                } else {
+                    None
+                }
+            })
+            .collect();
+        let Some(rows) = rows else { continue };
+        let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
+        let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
+        for (pi, poly) in mesh.polygons.iter().enumerate() {
+            let Some(&k) = poly.first().and_then(|&v| piece.get(v as usize)) else {
+                continue;
+            };
+            pieces.entry(rows[k]).or_default().insert(k);
+            dest.entry(Some(rows[k])).or_default().push(pi);
+        }
+        if dest.len() < 2 {
+            continue;
+        }
+        plans.push(CutPlan {
+            mesh: mi,
+            dest,
+            rest: Some(Part::UpperTeeth),
             pieces,
         });
     }
