@@ -25,17 +25,18 @@
 //!    sparse SPD system `(α(LᵀL+μL_g) + W + βB + εI) u = W(c−p) + βB(L−p)` in three
 //!    right-hand sides, solved by a sparse Cholesky factorisation (faer) whose pattern and
 //!    symbolic analysis are built once.
-//!    Defaults: `α` = 300, 300, 100, 10, 1 with two closest-point updates each, and `β` = 10
-//!    on a source whose median edge is at least [`DENSE_EDGE`] ES0, raised by that ratio on
-//!    a denser one (at most [`DENSE_GAIN`]×; ICT's edges are about 0.04 ES0: `β` = 100).
+//!    Defaults: `α` = 300, 300, 100, 10, 1 with two closest-point updates each, and `β` = 10,
+//!    or 100 on a dense source (median edge under [`DENSE_EDGE`] ES0; ICT's are 0.04).
 //!    Along the surface only the bending term and the landmarks hold the source, so it
 //!    slides into place slowly, and a landmark pins one vertex against the closest-point
 //!    matches of every vertex around it — more of them the denser the source. ICT onto a 4×
 //!    denser identity head, median error against its true FAT: 3.4 % with the old defaults
 //!    (`α` = 100, 30, 10, 3, 1; `β` = 10), 3.4 % with the new `α` alone, 3.1 % with `β` =
-//!    100 alone, 2.9 % with both (as many solves as before). A blanket `β` = 100 drew
+//!    100 alone, 2.9 % with both (as many solves as before). `β` = 100 on every source drew
 //!    CANDIDE-3's coarse lower lid across its slit (`close_b_l_eyelid` 30 % in a forced
-//!    registration), hence the scaling by density.
+//!    registration); `β` growing smoothly with density (10 × 0.4 ES0 / median edge) gave
+//!    the ICT rig, at a slightly lower `β`, a brow crease on alma (normal-turn ratio 4.2):
+//!    hence two settings, each measured on every suite.
 //! 3. **Correspondence** (`correspond.rs`): every target vertex takes its closest point on
 //!    the registered source (same side, compatible normal — either side's normal on a crease
 //!    such as a lid margin): a source triangle and barycentric weights. Target vertices far from the source (beyond what the source covers) fade out.
@@ -95,9 +96,9 @@ pub struct FitOptions {
     pub stiffness: Vec<f64>,
     /// Closest-point updates per stiffness value. Default 2.
     pub iterations: usize,
-    /// Weight `β` of the feature-point landmarks against one closest-point match, on a source
-    /// whose median edge is at least [`DENSE_EDGE`] ES0 long; a denser source's is raised by
-    /// that ratio, at most [`DENSE_GAIN`]× (module docs, step 2). Default 10.
+    /// Weight `β` of the feature-point landmarks against one closest-point match; a dense
+    /// source (median edge under [`DENSE_EDGE`] ES0) takes [`DENSE_GAIN`]× this (module docs,
+    /// step 2). Default 10.
     pub landmark_weight: f64,
     /// Membrane weight `μ` relative to bending. Default 0.01.
     pub membrane: f64,
@@ -148,15 +149,16 @@ impl Default for FitOptions {
     }
 }
 
-/// A source edge (median, in ES0) at least this long takes
-/// [`FitOptions::landmark_weight`] as it is; a shorter one raises it (module docs, step 2).
-pub const DENSE_EDGE: f64 = 0.4;
+/// A source whose median edge is shorter than this many ES0 is dense (a scanned or
+/// sculpted head: ICT's are 0.04; CANDIDE-3's, even subdivided once, are longer) and takes
+/// [`DENSE_GAIN`] × [`FitOptions::landmark_weight`] (module docs, step 2).
+pub const DENSE_EDGE: f64 = 0.08;
 
-/// The most the landmark weight is raised on a dense source.
+/// The landmark weight's factor on a dense source.
 pub const DENSE_GAIN: f64 = 10.0;
 
-/// The landmark weight `β` on `s` (module docs, step 2): `base` × `DENSE_EDGE` / the median
-/// edge length of `s` in units of `scale`, within `[1, DENSE_GAIN]` × `base`.
+/// The landmark weight `β` on `s` (module docs, step 2): `base`, times `DENSE_GAIN` when the
+/// median edge of `s` is shorter than `DENSE_EDGE` in units of `scale`.
 fn landmark_weight(s: &CloneSurface, scale: f32, base: f64) -> f64 {
     let mut edges: Vec<f32> = s
         .triangles
@@ -172,10 +174,11 @@ fn landmark_weight(s: &CloneSurface, scale: f32, base: f64) -> f64 {
     }
     let mid = edges.len() / 2;
     let median = *edges.select_nth_unstable_by(mid, f32::total_cmp).1 as f64 / scale as f64;
-    if !(median > 0.0) {
-        return base;
+    if median < DENSE_EDGE {
+        base * DENSE_GAIN
+    } else {
+        base
     }
-    base * (DENSE_EDGE / median).clamp(1.0, DENSE_GAIN)
 }
 
 /// Which vertices some triangle uses.
