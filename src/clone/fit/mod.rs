@@ -169,7 +169,7 @@ fn landmark_weight(s: &CloneSurface, scale: f32, base: f64) -> f64 {
             Some(pa.distance(*pb))
         })
         .collect();
-    if edges.is_empty() || !(scale > 0.0) {
+    if edges.is_empty() || scale.is_nan() || scale <= 0.0 {
         return base;
     }
     let mid = edges.len() / 2;
