@@ -467,11 +467,13 @@ fn candide_known_fat_cases() {
     }
 }
 
-/// Issue 21's real-head targets for `fit`, as far as they are met: no FAP over 6 % (the
-/// issue: 15 %; measured worst 4.8 %), the eyelids under 5 % (measured 0.0 % on the
-/// identities of the source's own mesh, matched vertex to vertex, 3.4–4.4 % on the denser
-/// ones), median ≤ 3.8 % (measured 0.0 % and 3.4–3.6 %; the issue asks 3 %: the denser
-/// heads go through the registration; before the split teeth and gums took the source's
+/// Issue 21's real-head targets for `fit`, as far as they are met: no FAP over 5 % (the
+/// issue: 15 %; measured worst 4.2 %, 4.8 % before the registration's stiffer start and
+/// denser landmark weight), the eyelids under 4 % (measured 0.0 % on the identities of the
+/// source's own mesh, matched vertex to vertex, 3.0–3.6 % on the denser ones, 3.4–4.4 %
+/// before), median ≤ 3.3 % (measured 0.0 % and 2.87–3.07 %, 3.4–3.6 % before; the issue
+/// asks 3 %, still missed by the sparser identity onto which the dense ICT is registered;
+/// the denser heads go through the registration; before the split teeth and gums took the source's
 /// motion vertex by vertex the jaw FAPs were 7–11 %), no FAP repaired or dropped by the
 /// guard, eyeballs still under every FAP, the target's own layout; the lids meet and the
 /// lips open as the truth's.
@@ -480,14 +482,14 @@ fn ict_identity_cases() {
     let cases = ict_cases();
     for c in cases {
         let r = &c.report;
-        assert!(r.median_all <= 3.8, "{}: median {}", c.name, r.median_all);
+        assert!(r.median_all <= 3.3, "{}: median {}", c.name, r.median_all);
         for k in &r.keys {
-            assert!(k.all <= 6.0, "{}: {} {:.1} %", c.name, k.key, k.all);
+            assert!(k.all <= 5.0, "{}: {} {:.1} %", c.name, k.key, k.all);
         }
         let lids = eyelid_errors(c);
         assert_eq!(lids.len(), 2, "{}", c.name);
         for (k, e) in lids {
-            assert!(e <= 5.0, "{}: {k} {e:.1} %", c.name);
+            assert!(e <= 4.0, "{}: {k} {e:.1} %", c.name);
         }
         assert!(
             c.outcome.report.failed_faps.is_empty(),

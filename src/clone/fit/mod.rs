@@ -25,6 +25,18 @@
 //!    sparse SPD system `(α(LᵀL+μL_g) + W + βB + εI) u = W(c−p) + βB(L−p)` in three
 //!    right-hand sides, solved by a sparse Cholesky factorisation (faer) whose pattern and
 //!    symbolic analysis are built once.
+//!    Defaults: `α` = 300, 300, 100, 10, 1 with two closest-point updates each, and `β` = 10,
+//!    or 100 on a dense source (median edge under [`DENSE_EDGE`] ES0; ICT's are 0.04).
+//!    Along the surface only the bending term and the landmarks hold the source, so it
+//!    slides into place slowly, and a landmark pins one vertex against the closest-point
+//!    matches of every vertex around it — more of them the denser the source. ICT onto a 4×
+//!    denser identity head, median error against its true FAT: 3.4 % with the old defaults
+//!    (`α` = 100, 30, 10, 3, 1; `β` = 10), 3.4 % with the new `α` alone, 3.1 % with `β` =
+//!    100 alone, 2.9 % with both (as many solves as before). `β` = 100 on every source drew
+//!    CANDIDE-3's coarse lower lid across its slit (`close_b_l_eyelid` 30 % in a forced
+//!    registration); `β` growing smoothly with density (10 × 0.4 ES0 / median edge) gave
+//!    the ICT rig, at a slightly lower `β`, a brow crease on alma (normal-turn ratio 4.2):
+//!    hence two settings, each measured on every suite.
 //! 3. **Correspondence** (`correspond.rs`): every target vertex takes its closest point on
 //!    the registered source (same side, compatible normal — either side's normal on a crease
 //!    such as a lid margin): a source triangle and barycentric weights. Target vertices far from the source (beyond what the source covers) fade out.
@@ -79,11 +91,14 @@ use surface::{adjacency, QuerySurface};
 pub struct FitOptions {
     /// Bending weights `α` of the registration, stiff to soft (each value runs
     /// [`iterations`](Self::iterations) closest-point updates). Default
-    /// `[100, 30, 10, 3, 1]`.
+    /// `[300, 300, 100, 10, 1]`: the stiff steps come twice, since a surface slides along
+    /// the other only slowly under them (module docs, step 2).
     pub stiffness: Vec<f64>,
     /// Closest-point updates per stiffness value. Default 2.
     pub iterations: usize,
-    /// Weight `β` of the feature-point landmarks against one closest-point match. Default 10.
+    /// Weight `β` of the feature-point landmarks against one closest-point match; a dense
+    /// source (median edge under [`DENSE_EDGE`] ES0) takes [`DENSE_GAIN`]× this (module docs,
+    /// step 2). Default 10.
     pub landmark_weight: f64,
     /// Membrane weight `μ` relative to bending. Default 0.01.
     pub membrane: f64,
@@ -120,7 +135,7 @@ pub enum FitTransfer {
 impl Default for FitOptions {
     fn default() -> Self {
         FitOptions {
-            stiffness: vec![100.0, 30.0, 10.0, 3.0, 1.0],
+            stiffness: vec![300.0, 300.0, 100.0, 10.0, 1.0],
             iterations: 2,
             landmark_weight: 10.0,
             membrane: 0.01,
@@ -131,6 +146,38 @@ impl Default for FitOptions {
             shared_topology: true,
             transfer: FitTransfer::Barycentric,
         }
+    }
+}
+
+/// A source whose median edge is shorter than this many ES0 is dense (a scanned or
+/// sculpted head: ICT's are 0.04; CANDIDE-3's, even subdivided once, are longer) and takes
+/// [`DENSE_GAIN`] × [`FitOptions::landmark_weight`] (module docs, step 2).
+pub const DENSE_EDGE: f64 = 0.08;
+
+/// The landmark weight's factor on a dense source.
+pub const DENSE_GAIN: f64 = 10.0;
+
+/// The landmark weight `β` on `s` (module docs, step 2): `base`, times `DENSE_GAIN` when the
+/// median edge of `s` is shorter than `DENSE_EDGE` in units of `scale`.
+fn landmark_weight(s: &CloneSurface, scale: f32, base: f64) -> f64 {
+    let mut edges: Vec<f32> = s
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .filter_map(|(a, b)| {
+            let (pa, pb) = (s.positions.get(a as usize)?, s.positions.get(b as usize)?);
+            Some(pa.distance(*pb))
+        })
+        .collect();
+    if edges.is_empty() || scale.is_nan() || scale <= 0.0 {
+        return base;
+    }
+    let mid = edges.len() / 2;
+    let median = *edges.select_nth_unstable_by(mid, f32::total_cmp).1 as f64 / scale as f64;
+    if median < DENSE_EDGE {
+        base * DENSE_GAIN
+    } else {
+        base
     }
 }
 
@@ -351,7 +398,16 @@ fn register_and_correspond(
         landmarks: &landmarks,
         scale,
     };
-    let reg = register(&moving, fixed, opts)?;
+    let beta = landmark_weight(source, scale, opts.landmark_weight);
+    stats.insert("fit_landmark_weight".into(), beta);
+    let reg = register(
+        &moving,
+        fixed,
+        &FitOptions {
+            landmark_weight: beta,
+            ..opts.clone()
+        },
+    )?;
     stats.insert("fit_solves".into(), reg.solves as f64);
     stats.insert("fit_matched".into(), reg.matched);
     stats.insert("fit_gap_es0".into(), reg.mean_gap);
