@@ -171,6 +171,7 @@ mod attached;
 mod fold;
 mod jaw_follow;
 mod motions;
+mod mouth_fill;
 mod options;
 mod part_deform;
 mod part_motion;
@@ -185,6 +186,8 @@ mod target_check;
 
 use std::collections::HashMap;
 use std::time::Instant;
+
+use rayon::prelude::*;
 
 pub use align::Similarity;
 pub use options::{face_fmc_options, face_rbf_options, CloneOptions, Method};
@@ -525,6 +528,16 @@ fn clone_skin_motions(
         );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
+    // The hidden mouth interior: a smooth extension of the lips into the jaw's motion.
+    let clock = Instant::now();
+    if let Some(interior) = mouth_fill::MouthInterior::new(tsurf) {
+        report.mouth_interior = interior.vertices();
+        result
+            .motions
+            .par_iter_mut()
+            .for_each(|m| interior.fill(tsurf, m));
+    }
+    report.timings.push("mouth", clock.elapsed().as_secs_f64());
     Ok(result.motions)
 }
 
