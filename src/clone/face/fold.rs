@@ -100,7 +100,11 @@ pub(super) fn fold_into_target(
                 }
             }
         }
-        let band = CutBand::new(target, target_mesh, &multiplicity);
+        // Only where the mouth step ran: a source with a mouth of its own lends its gums'
+        // real stretch (`part_motion`).
+        let band = (report.mouth_interior > 0)
+            .then(|| CutBand::new(target, target_mesh, &multiplicity))
+            .flatten();
         cuts.push(CutMeshes {
             target: target_mesh,
             name: &cut.mesh,
