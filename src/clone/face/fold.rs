@@ -12,8 +12,9 @@ use std::collections::{BTreeSet, HashMap};
 
 use glam::{Affine3A, Vec3};
 
+use super::mouth_fill::HarmonicFill;
 use super::rigid::hierarchy_ancestors;
-use super::split::SplitView;
+use super::split::{mesh_pieces, SplitView};
 use super::{CloneReport, Part};
 use crate::error::{Diagnostic, Result};
 use crate::face::{FaceFrames, FaceModel};
@@ -21,6 +22,8 @@ use crate::fat::bake::{bake_motion, on_borders, part_size, BakeRequest};
 use crate::fat::eval::{Activation, FatEvaluator};
 use crate::fat::morph::MorphTarget;
 use crate::fat::{FaceDefMesh, FaceDefTable, Fat, TableKey};
+use crate::mesh::geometry::{adjacency, triangulate};
+use crate::mesh::VertexIndex;
 use crate::spec::Directionality;
 
 /// Share of a part's size a baked motion may be off by.
@@ -48,6 +51,8 @@ struct CutMeshes<'a> {
     multiplicity: Vec<u8>,
     /// The view transform its vertices are expressed in, in the output (see [`home`]).
     home: Option<usize>,
+    /// The band across the lip line of its pieces cut there (the gums), if any.
+    band: Option<CutBand>,
 }
 
 /// The cloned view `cloned` folded back into `target`'s layout (module docs). `targets` are the
@@ -95,12 +100,18 @@ pub(super) fn fold_into_target(
                 }
             }
         }
+        // Only where the mouth step ran: a source with a mouth of its own lends its gums'
+        // real stretch (`part_motion`).
+        let band = (report.mouth_interior > 0)
+            .then(|| CutBand::new(target, target_mesh, &multiplicity))
+            .flatten();
         cuts.push(CutMeshes {
             target: target_mesh,
             name: &cut.mesh,
             meshes,
             multiplicity,
             home: home(cloned, rest, &baked),
+            band,
         });
     }
     let ranges = covered_ranges(targets);
@@ -192,7 +203,11 @@ pub(super) fn fold_into_target(
                     }
                 }
             }
-            merged.extend(merge_entries(entries, &cut.multiplicity));
+            let entry = merge_entries(entries, &cut.multiplicity);
+            merged.extend(match (entry, &cut.band) {
+                (Some(e), Some(band)) => Some(band.smooth(e)),
+                (e, _) => e,
+            });
         }
         out.meshes = merged;
         out.meshes.extend(rest.into_iter().cloned());
@@ -209,6 +224,116 @@ pub(super) fn fold_into_target(
     let face = layout_face(cloned, target, &baked, fat);
     correct_report(report, &baked);
     Ok(face)
+}
+
+/// Half the width of the band across a lip-line cut, in MNS0 ([`CutBand`]).
+const CUT_BAND: f32 = 0.5;
+
+/// The vertices of a target mesh's pieces cut along the lip line (ICT's gums, tongue and
+/// mouth socket: one piece reaching into both jaws) that lie within [`CUT_BAND`] × MNS0 of
+/// the cut, and the harmonic fill over them. Each side of the cut takes its own jaw's motion
+/// (the upper still, the lower with the jaw), so the cut was a step: its vertices took the
+/// mean of both sides, and the band of triangles beside it creased and folded (CANDIDE →
+/// ict `open_jaw`: 151°). In the band, every table's motion is instead the harmonic blend of
+/// the two sides' motions around it: a smooth stretch from the upper jaw's motion to the
+/// lower's.
+struct CutBand {
+    fill: HarmonicFill,
+}
+
+impl CutBand {
+    /// The band of target mesh `mesh` whose vertices on a cut have `multiplicity` 2;
+    /// `None` when nothing was cut along the lip line.
+    fn new(target: &FaceModel, mesh: usize, multiplicity: &[u8]) -> Option<CutBand> {
+        let m = &target.meshes.get(mesh)?.mesh;
+        let on_cut: Vec<u32> = (0..m.positions.len() as u32)
+            .filter(|&v| multiplicity.get(v as usize).is_some_and(|&k| k > 1))
+            .collect();
+        if on_cut.is_empty() {
+            return None;
+        }
+        let reach = CUT_BAND * target.fapu().ok()?.distances.mns0 as f32;
+        let world = target.mesh_world(&target.frames(), mesh);
+        let index = VertexIndex::new(
+            &on_cut
+                .iter()
+                .map(|&v| world[v as usize])
+                .collect::<Vec<_>>(),
+        );
+        let (piece, count) = mesh_pieces(m, 1e-6 * part_size(&world).max(f32::MIN_POSITIVE));
+        let mut cut_piece = vec![false; count];
+        for &v in &on_cut {
+            cut_piece[piece[v as usize]] = true;
+        }
+        let inside: Vec<bool> = (0..m.positions.len())
+            .map(|v| {
+                cut_piece[piece[v]]
+                    && index
+                        .nearest_vertex(world[v])
+                        .is_some_and(|(_, d)| d <= reach)
+            })
+            .collect();
+        let (triangles, _) = triangulate(&m.positions, &m.polygons);
+        let fill = HarmonicFill::new(&adjacency(m.positions.len(), &triangles), &world, &inside)?;
+        Some(CutBand { fill })
+    }
+
+    /// `entry` (one table's entry on the cut mesh) with its rates in the band re-solved.
+    fn smooth(&self, entry: FaceDefMesh) -> FaceDefMesh {
+        let n = entry.interval_count();
+        if n == 0 {
+            return entry;
+        }
+        let slot: HashMap<u32, usize> = entry
+            .coord_index
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| (v, k))
+            .collect();
+        let filled = self.fill.solve(3 * n, |w, c| {
+            slot.get(&w).map_or(0.0, |&k| {
+                f64::from(entry.displacements[k * n + c / 3][c % 3])
+            })
+        });
+        // Vertices of the band the entry did not list join it.
+        let mut rows: Vec<(u32, Vec<Vec3>)> = entry
+            .coord_index
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| (v, entry.displacements[k * n..(k + 1) * n].to_vec()))
+            .collect();
+        let mut at: HashMap<u32, usize> = slot;
+        for (k, &v) in self.fill.free().iter().enumerate() {
+            let rates: Vec<Vec3> = (0..n)
+                .map(|j| {
+                    Vec3::new(
+                        filled[(k, 3 * j)] as f32,
+                        filled[(k, 3 * j + 1)] as f32,
+                        filled[(k, 3 * j + 2)] as f32,
+                    )
+                })
+                .collect();
+            if !rates.iter().all(|r| r.is_finite()) {
+                continue;
+            }
+            match at.get(&v) {
+                Some(&r) => rows[r].1 = rates,
+                None => {
+                    if rates.iter().any(|r| *r != Vec3::ZERO) {
+                        at.insert(v, rows.len());
+                        rows.push((v, rates));
+                    }
+                }
+            }
+        }
+        rows.sort_by_key(|r| r.0);
+        FaceDefMesh {
+            mesh: entry.mesh,
+            interval_borders: entry.interval_borders,
+            coord_index: rows.iter().map(|r| r.0).collect(),
+            displacements: rows.into_iter().flat_map(|r| r.1).collect(),
+        }
+    }
 }
 
 /// The transform view mesh `mesh`'s vertices are expressed in once the baked transforms are

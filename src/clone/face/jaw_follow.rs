@@ -48,7 +48,7 @@ const ROTATION_DAMPING: f64 = 0.1;
 const JAW_FAPS: [u8; 3] = [3, 14, 15];
 
 /// Whether the table `key` moves the jaw (module docs).
-fn moves_jaw(key: TableKey) -> bool {
+pub(super) fn moves_jaw(key: TableKey) -> bool {
     match key {
         TableKey::LowLevel(f) => JAW_FAPS.contains(&f.number()),
         TableKey::Viseme(_) | TableKey::Expression(_) => true,
@@ -105,14 +105,14 @@ fn chin_vertex(tsurf: &SkinSurface) -> Option<u32> {
 
 /// A small rigid motion: displacement `t + ω × (q − c)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct SmallRigid {
+pub(super) struct SmallRigid {
     c: DVec3,
     t: DVec3,
     omega: DVec3,
 }
 
 impl SmallRigid {
-    fn at(&self, q: DVec3) -> DVec3 {
+    pub(super) fn at(&self, q: DVec3) -> DVec3 {
         self.t + self.omega.cross(q - self.c)
     }
 }
@@ -146,6 +146,43 @@ fn fit_small_rigid(p: &[DVec3], d: &[DVec3]) -> SmallRigid {
             DVec3::ZERO
         },
     }
+}
+
+/// The chin's small rigid motion under the cloned skin motion `m` (module docs), `None` when
+/// the target has no chin region or the region does not move.
+pub(super) fn chin_rigid(tsurf: &SkinSurface, m: &SurfaceMotion) -> Option<SmallRigid> {
+    let region = chin_region(tsurf);
+    let pos: Vec<DVec3> = region
+        .iter()
+        .map(|&v| tsurf.surface.positions[v as usize].as_dvec3())
+        .collect();
+    rigid_of(tsurf, &region, &pos, m)
+}
+
+/// [`chin_rigid`] on the chin region `region` (positions `pos`) found once.
+fn rigid_of(
+    tsurf: &SkinSurface,
+    region: &[u32],
+    pos: &[DVec3],
+    m: &SurfaceMotion,
+) -> Option<SmallRigid> {
+    if region.is_empty() {
+        return None;
+    }
+    let chin = chin_vertex(tsurf)?;
+    let d: Vec<DVec3> = region.iter().map(|&v| m.offset_at(v).as_dvec3()).collect();
+    if d.iter().all(|x| *x == DVec3::ZERO) {
+        return None;
+    }
+    // The turn from the region, the translation from the chin itself: the region's mean is
+    // less than the chin's (its upper part and sides move less), and the teeth should move
+    // like the chin.
+    let fitted = fit_small_rigid(pos, &d);
+    Some(SmallRigid {
+        c: tsurf.surface.positions[chin as usize].as_dvec3(),
+        t: m.offset_at(chin).as_dvec3(),
+        omega: fitted.omega,
+    })
 }
 
 /// Per cloned skin motion (key, value bits), the displacements of the target meshes `meshes`
@@ -183,23 +220,9 @@ pub(super) fn jaw_motions(
             Some((mi, q, world.matrix3.as_dmat3().inverse()))
         })
         .collect();
-    let Some(chin) = chin_vertex(tsurf) else {
-        return out;
-    };
-    let chin_at = tsurf.surface.positions[chin as usize].as_dvec3();
     for m in cloned.iter().filter(|m| moves_jaw(m.key)) {
-        let d: Vec<DVec3> = region.iter().map(|&v| m.offset_at(v).as_dvec3()).collect();
-        if d.iter().all(|x| *x == DVec3::ZERO) {
+        let Some(rigid) = rigid_of(tsurf, &region, &pos, m) else {
             continue;
-        }
-        // The turn from the region, the translation from the chin itself: the region's mean
-        // is less than the chin's (its upper part and sides move less), and the teeth should
-        // move like the chin.
-        let fitted = fit_small_rigid(&pos, &d);
-        let rigid = SmallRigid {
-            c: chin_at,
-            t: m.offset_at(chin).as_dvec3(),
-            omega: fitted.omega,
         };
         for (mi, q, inv) in &parts {
             let offsets: Vec<DVec3> = q

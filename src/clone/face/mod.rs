@@ -83,6 +83,13 @@
 //!    feature point off the source's peak (a stylised brow onto a real one) no longer leaves
 //!    the FAP half as strong. Not with FAPU scaling off
 //!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
+//!    **`mouth`** (every method, `mouth_fill.rs`): the target's hidden mouth interior
+//!    (skin behind the lips' front and hidden from the front, reached from the inner lip
+//!    contour) takes a harmonic extension (edges weighed by inverse length) of the lips'
+//!    motion that fades into the chin's small rigid motion below the lip line and into
+//!    stillness above it, not the surface method's per-vertex motion, which read unrelated
+//!    source places there. A face without such an interior is not changed, nor is any
+//!    target of a source with a mouth interior of its own (a rig head hands on its motion).
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
@@ -126,7 +133,9 @@
 //! 9. **`fold`** — a one-mesh target cut in step 1 comes back in its own layout: the cut is an
 //!    internal view only. Entries on the view's skin and part meshes go back to the target
 //!    mesh's own vertex numbers through the cut's index maps (a vertex on the cut along the
-//!    lip line, in both jaws, takes the mean of both), and transforms created in step 7 for
+//!    lip line, in both jaws, takes the mean of both, and — when the `mouth` step ran —
+//!    within ½ MNS0 of that cut every table's motion is the harmonic blend of both sides':
+//!    no step), and transforms created in step 7 for
 //!    cut parts alone are baked into per-vertex displacements of those vertices
 //!    ([`crate::fat::bake`]: piecewise linear over the table's intervals, borders added until
 //!    within 1 % of the part's size at every FAP value the source's table covers, both signs
@@ -175,6 +184,7 @@ mod fold;
 mod jaw_follow;
 mod lid_margin;
 mod motions;
+mod mouth_fill;
 mod options;
 mod part_deform;
 mod part_motion;
@@ -189,6 +199,8 @@ mod target_check;
 
 use std::collections::HashMap;
 use std::time::Instant;
+
+use rayon::prelude::*;
 
 pub use align::Similarity;
 pub use options::{face_fmc_options, face_rbf_options, CloneOptions, Method};
@@ -546,6 +558,21 @@ fn clone_skin_motions(
         );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
+    // The hidden mouth interior: a smooth extension of the lips into the jaw's motion.
+    let clock = Instant::now();
+    // A source with a mouth interior of its own (a rig head) hands on its real motion there.
+    let own = mouth_fill::MouthInterior::new(ssurf).is_some();
+    if let Some(interior) = (!own)
+        .then(|| mouth_fill::MouthInterior::new(tsurf))
+        .flatten()
+    {
+        report.mouth_interior = interior.vertices();
+        result
+            .motions
+            .par_iter_mut()
+            .for_each(|m| interior.fill(tsurf, m));
+    }
+    report.timings.push("mouth", clock.elapsed().as_secs_f64());
     Ok(result.motions)
 }
 

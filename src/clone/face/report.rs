@@ -62,6 +62,8 @@ pub struct CloneReport {
     /// Motions the `smooth` step re-solved, per FAP name and value: how many target surface
     /// vertices.
     pub smoothed: BTreeMap<String, usize>,
+    /// Target surface vertices of the hidden mouth interior the `mouth` step fills (0: none).
+    pub mouth_interior: usize,
     /// Rigid-part handling.
     pub rigid: RigidReport,
     /// Part meshes cut out of a one-mesh target (step 1).
