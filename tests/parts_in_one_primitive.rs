@@ -36,11 +36,17 @@ fn key(fap: u8) -> TableKey {
 
 /// The avatar with its teeth primitive as `avatar.glb` in `dir`, and its feature points.
 fn write_avatar(dir: &Path, source: &FaceModel) -> (PathBuf, PathBuf) {
+    write_avatar_with(dir, source, false)
+}
+
+/// [`write_avatar`], with a tongue in the teeth primitive when `tongue`.
+fn write_avatar_with(dir: &Path, source: &FaceModel, tongue: bool) -> (PathBuf, PathBuf) {
     let glb = dir.join("avatar.glb");
     std::fs::write(
         &glb,
         avatar::build_with(&Options {
             teeth: true,
+            tongue,
             ..Options::default()
         })
         .to_glb(),
@@ -358,6 +364,97 @@ fn teeth_rows_are_found_without_teeth_points() {
         assert_eq!(m.mesh.polygons, t.mesh.polygons, "{}", m.name);
     }
     check_teeth(face);
+}
+
+/// A tongue in the teeth primitive (as ReadyPlayerMe's `Wolf3D_Teeth` has it), with and
+/// without teeth feature points: the jaw carries it under `open_jaw` as it carries the lower
+/// row (rigidly, dropping as far as the row's middle within a third), lip, eyeball and lid
+/// FAPs leave it still, and the primitive keeps its vertices in order.
+#[test]
+fn a_tongue_in_the_teeth_primitive_rides_the_jaw() {
+    let source = fbakit::face::read("alma").unwrap();
+    for teeth_points in [true, false] {
+        let dir = tempfile::tempdir().unwrap();
+        let (glb, with_points) = write_avatar_with(dir.path(), &source, true);
+        let csv = if teeth_points {
+            with_points
+        } else {
+            avatar::fp_csv(&source, dir.path(), "")
+        };
+        let target = read(&glb, &csv);
+        let out = clone_face(&source, &target, &CloneOptions::default()).unwrap();
+        let face = &out.face;
+        let teeth = face.mesh_index(TEETH).unwrap();
+        assert_eq!(
+            face.meshes[teeth].mesh.positions.len(),
+            avatar::TONGUE.end,
+            "{teeth_points}"
+        );
+        assert_eq!(
+            face.meshes[teeth].mesh.polygons,
+            target.meshes[teeth].mesh.polygons
+        );
+        let neutral = face.neutral_world_positions();
+        let n = &neutral[teeth];
+        let (cm, cv) = face.fp_vertex(FeaturePointId::FP_2_1).unwrap();
+        let tongue_size = size(&n[avatar::TONGUE]);
+        // The dome's pole vertex 0 is in no triangle (the sphere's pole fan starts at 1):
+        // drawn by nothing, it keeps its place.
+        let drawn: std::collections::BTreeSet<usize> = face.meshes[teeth]
+            .mesh
+            .polygons
+            .iter()
+            .flatten()
+            .map(|&v| v as usize)
+            .collect();
+        let tongue_vertices: Vec<usize> = avatar::TONGUE.filter(|v| drawn.contains(v)).collect();
+        assert_eq!(tongue_vertices.len(), avatar::TONGUE.len() - 1);
+        let mut opened = 0;
+        for value in sample_values(face, 3, TEETH)
+            .into_iter()
+            .filter(|v| *v > 0.0)
+        {
+            let p = posed(face, 3, value);
+            let chin = neutral[cm][cv as usize].y - p[cm][cv as usize].y;
+            let row = LOWER.map(|v| n[v].y - p[teeth][v].y).sum::<f32>() / LOWER.len() as f32;
+            let tongue = tongue_vertices
+                .iter()
+                .map(|&v| n[v].y - p[teeth][v].y)
+                .sum::<f32>()
+                / tongue_vertices.len() as f32;
+            eprintln!(
+                "teeth points {teeth_points}, open_jaw {value}: chin {chin}, lower row {row}, tongue {tongue}"
+            );
+            assert!(chin > 0.0 && row > 0.0);
+            // The tongue sits further back than the row, nearer the hinge: it drops less.
+            assert!(
+                tongue > 0.3 * row && tongue < 1.1 * row,
+                "teeth points {teeth_points}, open_jaw {value}: tongue {tongue}, row {row}"
+            );
+            let stretch = tongue_vertices
+                .iter()
+                .flat_map(|&a| tongue_vertices.iter().map(move |&b| (a, b)))
+                .map(|(a, b)| (n[a].distance(n[b]) - p[teeth][a].distance(p[teeth][b])).abs())
+                .fold(0.0, f32::max);
+            assert!(
+                stretch < 0.01 * tongue_size,
+                "tongue stretched by {stretch} (size {tongue_size})"
+            );
+            assert!(max_move(n, &p[teeth], UPPER) < 1e-6);
+            opened += 1;
+        }
+        assert!(opened > 0, "no open_jaw sample");
+        // raise_b_midlip, stretch_l_cornerlip, eyeball yaw, upper lid.
+        for fap in [5u8, 6, 19, 23] {
+            if face.fat.tables.iter().any(|t| t.key == key(fap)) {
+                let p = posed(face, fap, 500.0);
+                assert!(
+                    max_move(n, &p[teeth], avatar::TONGUE) < 1e-6,
+                    "teeth points {teeth_points}: FAP {fap} moves the tongue"
+                );
+            }
+        }
+    }
 }
 
 /// The lids close although the avatar's coarse skin holds each upper lid point on the same

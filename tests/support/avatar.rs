@@ -7,7 +7,8 @@
 //!
 //! A variant ([`build_with`], [`Options::teeth`]) adds a fifth primitive `teeth`: an upper and a
 //! lower row of teeth in one primitive behind the lips (the upper row on the head joint, the
-//! lower on the jaw), with feature points 9.8–9.11 on them ([`teeth_fp_lines`]).
+//! lower on the jaw), with feature points 9.8–9.11 on them ([`teeth_fp_lines`]), and
+//! optionally a tongue after the rows ([`Options::tongue`]).
 //!
 //! Other variants move the eyeballs onto nodes of their own ([`Options::eye_nodes`]) or skin
 //! them to eye joints ([`Options::skinned_eyes`]).
@@ -84,6 +85,10 @@ fn sphere(
 pub struct Options {
     /// A fifth primitive `teeth`: both rows of teeth in one primitive.
     pub teeth: bool,
+    /// With [`Options::teeth`]: a tongue in the `teeth` primitive too, after the rows
+    /// ([`TONGUE`]), on the jaw joint: ReadyPlayerMe's `Wolf3D_Teeth` holds both rows and the
+    /// tongue so.
+    pub tongue: bool,
     /// The eyeballs on their own nodes `LeftEye` and `RightEye` (nodes [`LEFT_EYE_NODE`] and
     /// [`RIGHT_EYE_NODE`], meshes 2 and 3) instead of `Body`'s `eyes` primitive.
     pub eye_nodes: bool,
@@ -231,6 +236,32 @@ pub fn teeth_prim() -> Prim {
     prim
 }
 
+/// The tongue's vertices in the `teeth` primitive of [`Options::tongue`].
+pub const TONGUE: std::ops::Range<usize> = 28..28 + 5 * 9;
+
+/// [`teeth_prim`] with a tongue after the rows: a flattened dome on the floor of the mouth
+/// behind the lower row, below the lip line, skinned to the jaw.
+pub fn teeth_prim_with_tongue() -> Prim {
+    let mut prim = teeth_prim();
+    let centre = Vec3::new(0.0, LIP_Y - 0.55, HEAD_CENTRE.z + TEETH_Z - 1.4);
+    let (p, n, uv, t) = sphere(Vec3::ZERO, 1.0, 4, 8, std::f32::consts::FRAC_PI_2);
+    let scale = Vec3::new(1.1, 0.35, 1.2);
+    // The dome's pole points forward (+z); lay it down so it bulges up.
+    let lay = glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2);
+    let base = prim.positions.len() as u16;
+    assert_eq!(base as usize, TONGUE.start);
+    prim.triangles
+        .extend(t.iter().map(|tr| tr.map(|i| i + base)));
+    prim.joints
+        .extend(std::iter::repeat_n([(3u8, 1.0), (0, 0.0)], p.len()));
+    prim.normals.extend(n.iter().map(|d| lay * *d));
+    prim.positions
+        .extend(p.iter().map(|q| centre + lay * (*q * scale)));
+    prim.uvs.extend(uv);
+    assert_eq!(prim.positions.len(), TONGUE.end);
+    prim
+}
+
 /// Feature points 9.8–9.11 on the [`teeth_prim`] rows, as `fp,x,y,z` lines in the file's
 /// world frame (metres, at rest): 9.8 and 9.10 on the upper row's lower and upper middle, 9.9 and 9.11
 /// on the lower row's upper and lower middle.
@@ -251,7 +282,11 @@ pub fn teeth_fp_lines() -> String {
 pub fn body_prims_with(opts: &Options) -> Vec<Prim> {
     let mut prims = body_prims();
     if opts.teeth {
-        prims.push(teeth_prim());
+        prims.push(if opts.tongue {
+            teeth_prim_with_tongue()
+        } else {
+            teeth_prim()
+        });
     }
     prims
 }
