@@ -235,6 +235,25 @@ fn across_styles_compliant_and_smooth() {
     }
 }
 
+/// No pair loses a FAP: a feature point the surface method and the nearest-vertex repair
+/// both leave still is moved with its surroundings by the guard's last repair (the ICT
+/// heads onto CANDIDE-3 dropped `close_t_r_eyelid`: its lid point lies beyond the head's
+/// surface, nearest a still vertex, and that eye never blinked).
+#[test]
+fn no_fap_is_dropped() {
+    for p in pairs() {
+        let dropped: Vec<_> = p
+            .outcome
+            .report
+            .failed_faps
+            .iter()
+            .filter(|f| !f.repaired)
+            .map(|f| (&f.fap, f.value))
+            .collect();
+        assert!(dropped.is_empty(), "{}→{}: {dropped:?}", p.source, p.target);
+    }
+}
+
 /// The eyelids of a stylised face move the real head's lids by the cloned motion itself, not
 /// by the guard's nearest-vertex repair (they did not move at all before: the lid margin's
 /// normals matched no source triangle).

@@ -349,13 +349,15 @@ pub(super) fn guard_motions(
     failures
 }
 
-/// The last repair, for a feature point that shares its target vertex with another one: a
-/// coarse target can hold a lid point and an eye corner on one vertex (a sphere's few
-/// vertices around the eye), which the method and the direct transfer keep still. The FAP's
-/// feature point moves by the source's displacement there times the FAPU ratio, the target
-/// vertices around it with it by [`bump`] out to half the distance to the nearest other vertex
-/// holding a feature point (at most [`GAIN_REACH_ES0`] ES0): the lid still closes where its
-/// point is. `None` for a point alone on its vertex or still in the source.
+/// The last repair, for a feature point that the method and the direct transfer both keep
+/// still: a coarse target can hold a lid point and an eye corner on one vertex (a sphere's
+/// few vertices around the eye), or its lid point can lie beyond the source's surface and
+/// nearest a still source vertex (CANDIDE-3's right upper lid under the ICT head: its
+/// `close_t_r_eyelid` was dropped, so that eye never blinked). The FAP's feature point moves
+/// by the source's displacement there times the FAPU ratio, the target vertices around it
+/// with it by [`bump`] out to half the distance to the nearest other vertex holding a feature
+/// point (at most [`GAIN_REACH_ES0`] ES0: short of the other lid across the slit): the lid
+/// still closes where its point is. `None` for a point still in the source.
 fn feature_point_transfer(
     source: &CloneSurface,
     src: &SurfaceMotion,
@@ -365,11 +367,7 @@ fn feature_point_transfer(
     let (sv, tv) = (source.fp_vertices[&fp], target.fp_vertices[&fp]);
     let want = src.offset_at(sv) * fapu_ratio(source, target, kind) as f32;
     let centre = *target.positions.get(tv as usize)?;
-    let shared = target
-        .fp_vertices
-        .iter()
-        .any(|(&id, &v)| v == tv && id != fp);
-    if !shared || want == Vec3::ZERO || !want.is_finite() {
+    if want == Vec3::ZERO || !want.is_finite() {
         return None;
     }
     let reach = target
@@ -484,16 +482,29 @@ mod tests {
     }
 
     #[test]
-    fn an_unrepairable_fap_is_dropped() {
+    fn a_feature_point_alone_on_a_still_source_vertex_is_moved_with_its_surroundings() {
         let s = surface(vec![Vec3::ZERO, Vec3::X, Vec3::Y], 1.0);
-        // The target's 2.5 sits on the source's still vertex 1: a direct transfer fails too.
-        let t = surface(vec![Vec3::X, Vec3::ZERO, Vec3::Y], 1.0);
+        // The target's 2.5 (vertex 0) and its surroundings lie by the source's still vertex
+        // 1: the method and a direct transfer leave them still.
+        let at = |dx: f32, dy: f32| Vec3::X + Vec3::new(dx, dy, 0.0);
+        let mut t = surface(
+            vec![at(0.0, 0.0), at(0.0, 0.1), at(0.0, 0.3), at(0.2, 0.0)],
+            1.0,
+        );
+        t.triangles = vec![[0, 1, 3], [1, 2, 3]];
+        // Another feature point (2.3) 0.3 up, across a slit: the repair reaches half way.
+        t.fp_vertices.insert(FeaturePointId::new(2, 3).unwrap(), 2);
         let src = vec![motion(vec![(0, Vec3::new(0.0, 0.1, 0.0))])];
-        let mut out = vec![motion(vec![(1, Vec3::new(0.0, 0.1, 0.0))])];
+        let mut out = vec![motion(vec![(3, Vec3::new(0.0, 1e-4, 0.0))])];
         let f = guard_motions(&s, &src, &t, &mut out, false);
-        assert_eq!(f.len(), 1);
-        assert!(!f[0].repaired);
-        assert!(out[0].offsets.is_empty());
+        assert!(f.len() == 1 && f[0].repaired, "{f:?}");
+        // 2.5 takes its source motion, vertex 1 (0.1 away, reach 0.15) part of it, 2.3 and
+        // vertex 3 (0.2 away) nothing.
+        assert_eq!(out[0].offset_at(0), Vec3::new(0.0, 0.1, 0.0));
+        let part = out[0].offset_at(1).y;
+        assert!(part > 0.0 && part < 0.1, "{part}");
+        assert_eq!(out[0].offset_at(2), Vec3::ZERO);
+        assert_eq!(out[0].offset_at(3), Vec3::ZERO);
     }
 
     #[test]
