@@ -192,16 +192,19 @@ fn print(p: &Pair) {
 /// whose triangles are a tenth of a millimetre wide, under the visemes, and CANDIDE's chin
 /// under `open_jaw`. ict → bruno is 1.95 (a lip corner under `stretch_l_cornerlip_o`), the
 /// ICT heads onto CANDIDE 10.7 (CANDIDE's coarse brows under the ICT heads' brow FAPs; see
-/// `print` for where).
+/// `print` for where). Since `smooth` runs again after the gain (whose bump had put a crease
+/// back at ICT's lip corner under `viseme_1`): bruno → ict 12.1 → 8.4 (now `viseme_2` at
+/// the same corner), candide → ict and → ict-rig 12.8 → 12.6 (`open_jaw` at the chin),
+/// ict → candide 10.7 → 10.5, ict-rig → candide 10.6 → 10.7, the rest within 0.01.
 const BOUNDS: [(&str, &str, f64, f64); 10] = [
     ("alma", "ict", 0.015, 7.2),
-    ("bruno", "ict", 0.015, 12.3),
-    ("candide", "ict", 0.015, 13.3),
+    ("bruno", "ict", 0.015, 8.8),
+    ("candide", "ict", 0.015, 13.0),
     ("ict", "alma", 0.015, 1.55),
     ("ict", "bruno", 0.01, 2.05),
     ("ict", "candide", 0.01, 11.0),
     ("alma", "ict-rig", 0.015, 7.2),
-    ("candide", "ict-rig", 0.015, 13.3),
+    ("candide", "ict-rig", 0.015, 13.0),
     ("ict-rig", "alma", 0.015, 1.45),
     ("ict-rig", "candide", 0.01, 11.0),
 ];

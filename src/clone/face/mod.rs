@@ -74,7 +74,8 @@
 //!    (the FAP's own feature point held) until none is rough, at most 40 rounds. Such defects
 //!    come from cloning across styles: target vertices reading unrelated parts of the source
 //!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
-//!    changed. Smoothed motions are listed in [`CloneReport::smoothed`].
+//!    changed. Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more
+//!    after `gain`, whose bump can crease a motion again (bruno → ict's lip corner).
 //!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
 //!    the FAPU-scaled source motion, turned by the alignment's rotation into the target's own
 //!    axes, by a smooth gain and turn field around it (Wendland C² bump over half an ES0,
@@ -558,6 +559,17 @@ fn clone_skin_motions(
         );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
+    // The gain's bump changes the motion after `smooth` looked at it (bruno → ict's lip
+    // corner under `viseme_1` turned 12× the source's): the same rule once more. A smooth
+    // motion is not changed. Not after the mouth fill: smoothing the uniform-Laplacian way
+    // there undid it (alma → ict 6.9 → 15.5).
+    let clock = Instant::now();
+    for (k, n) in smooth_motions(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions) {
+        *report.smoothed.entry(k).or_default() += n;
+    }
+    report
+        .timings
+        .push("smooth2", clock.elapsed().as_secs_f64());
     // The hidden mouth interior: a smooth extension of the lips into the jaw's motion.
     let clock = Instant::now();
     // A source with a mouth interior of its own (a rig head) hands on its real motion there.
