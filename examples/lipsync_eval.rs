@@ -433,6 +433,10 @@ impl Totals {
     }
 
     fn print(&self, name: &str, recognise: bool) {
+        if self.aligned.speech_frames == 0 {
+            println!("{name}: none run");
+            return;
+        }
         println!("{name}");
         line("aligned", &self.aligned);
         line("stretched", &self.stretched);
