@@ -6,17 +6,27 @@
 //! (PocketSphinx phone recognition, when installed), and the real-time factor. One
 //! condition is the recording encoded as MP3 at 64 kbit/s (with ffmpeg, when installed).
 //!
+//! espeak-ng's formant voices sound unlike people. So that the figures are not only theirs,
+//! more conditions are "recorded" by Festival's voices built from real speakers' recordings
+//! (a diphone voice concatenates a speaker's recorded diphones, an HTS voice is a statistical
+//! model trained on a speaker's hours of speech); Festival reports the times of the phones
+//! it says. Festival is for this evaluation only: the conditions are skipped, with a note,
+//! when it or a voice is not installed.
+//!
 //! Run: `cargo run --release --example lipsync_eval` (needs espeak-ng; ffmpeg and
-//! pocketsphinx + pocketsphinx-en-us for the MP3 condition and the recognition figures).
+//! pocketsphinx + pocketsphinx-en-us for the MP3 condition and the recognition figures;
+//! festival festvox-kallpc16k festvox-kdlpc16k festvox-us-slt-hts for the Festival ones).
 #![allow(dead_code)] // Also included as a module by the tests, which do not call `main`.
 
 use std::time::Instant;
 
 use fbakit::fap::VisemeParams;
-use fbakit::speech::espeak::{speak_at, TimedPhoneme};
+use fbakit::speech::espeak::{speak_at, TimedPhoneme, Utterance};
 use fbakit::speech::lipsync::coarticulation::lipsync_keys;
 use fbakit::speech::lipsync::evaluation::{degrade, score, Degradation, LipsyncScore};
-use fbakit::speech::lipsync::recognition::{recognise_file, recognition_available};
+use fbakit::speech::lipsync::recognition::{
+    arpabet_to_espeak, recognise_file, recognition_available,
+};
 use fbakit::speech::lipsync::{
     analyse_file, lipsync_recognised, lipsync_transcript_at, render_transcript, LipsyncOptions,
 };
@@ -34,13 +44,24 @@ pub const SENTENCES: [&str; 8] = [
     "Thomas wrote a book about the moon and the sun.",
 ];
 
+/// The synthesiser that "records" a condition.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Synth {
+    /// espeak-ng (formant voices).
+    Espeak,
+    /// Festival (voices built from a speaker's recordings).
+    Festival,
+}
+
 /// One recording condition: the voice that "records", its rate, and the degradation.
 pub struct Condition {
     /// A name for the report.
     pub name: &'static str,
-    /// espeak-ng voice of the recording.
+    /// Which synthesiser speaks.
+    pub synth: Synth,
+    /// Its voice: espeak-ng's name, or the Festival voice (`voice_NAME` selects it).
     pub voice: &'static str,
-    /// Its rate, words per minute.
+    /// espeak-ng's rate, words per minute (Festival's voices keep their own).
     pub rate: u32,
     /// What is done to the audio.
     pub degradation: Degradation,
@@ -53,6 +74,7 @@ pub fn conditions() -> Vec<Condition> {
     vec![
         Condition {
             name: "en-us, 140 wpm, 44.1 kHz stereo, 20 dB SNR",
+            synth: Synth::Espeak,
             voice: "en-us",
             rate: 140,
             degradation: Degradation::default(),
@@ -60,6 +82,7 @@ pub fn conditions() -> Vec<Condition> {
         },
         Condition {
             name: "en-us+f3, 200 wpm, 48 kHz, 15 dB SNR",
+            synth: Synth::Espeak,
             voice: "en-us+f3",
             rate: 200,
             degradation: Degradation {
@@ -73,6 +96,7 @@ pub fn conditions() -> Vec<Condition> {
         },
         Condition {
             name: "en-gb-x-rp+m3, 120 wpm, 8 kHz, 25 dB SNR",
+            synth: Synth::Espeak,
             voice: "en-gb-x-rp+m3",
             rate: 120,
             degradation: Degradation {
@@ -86,6 +110,7 @@ pub fn conditions() -> Vec<Condition> {
         },
         Condition {
             name: "en-us+m2, 160 wpm, 44.1 kHz stereo, 20 dB SNR, MP3 64 kbit/s",
+            synth: Synth::Espeak,
             voice: "en-us+m2",
             rate: 160,
             degradation: Degradation {
@@ -97,7 +122,140 @@ pub fn conditions() -> Vec<Condition> {
             },
             mp3: true,
         },
+        Condition {
+            name: "Festival kal (diphone), 44.1 kHz stereo, 20 dB SNR",
+            synth: Synth::Festival,
+            voice: "kal_diphone",
+            rate: 0,
+            degradation: Degradation::default(),
+            mp3: false,
+        },
+        Condition {
+            name: "Festival slt (HTS), 48 kHz, 15 dB SNR",
+            synth: Synth::Festival,
+            voice: "cmu_us_slt_arctic_hts",
+            rate: 0,
+            degradation: Degradation {
+                sample_rate: 48_000,
+                channels: 1,
+                snr_db: Some(15.0),
+                lead_in: 0.5,
+                seed: 12,
+            },
+            mp3: false,
+        },
+        Condition {
+            name: "Festival ked (diphone), 8 kHz, 25 dB SNR",
+            synth: Synth::Festival,
+            voice: "ked_diphone",
+            rate: 0,
+            degradation: Degradation {
+                sample_rate: 8_000,
+                channels: 1,
+                snr_db: Some(25.0),
+                lead_in: 0.2,
+                seed: 13,
+            },
+            mp3: false,
+        },
+        Condition {
+            name: "Festival slt (HTS), 44.1 kHz stereo, 20 dB SNR, MP3 64 kbit/s",
+            synth: Synth::Festival,
+            voice: "cmu_us_slt_arctic_hts",
+            rate: 0,
+            degradation: Degradation {
+                sample_rate: 44_100,
+                channels: 2,
+                snr_db: Some(20.0),
+                lead_in: 0.4,
+                seed: 14,
+            },
+            mp3: true,
+        },
     ]
+}
+
+/// Whether Festival and its voice `voice` are installed.
+pub fn festival_voice_available(voice: &str) -> bool {
+    festival_run(&format!("(voice_{voice})\n(format t \"ready\\n\")\n"))
+        .is_ok_and(|out| out.contains("ready"))
+}
+
+/// Festival's output for the Scheme `script`, run in batch mode.
+fn festival_run(script: &str) -> fbakit::error::Result<String> {
+    let dir = tempfile::tempdir().map_err(|e| fbakit::error::Error::io("tempdir", e))?;
+    let path = dir.path().join("script.scm");
+    std::fs::write(&path, script).map_err(|e| fbakit::error::Error::io(&path, e))?;
+    let out = std::process::Command::new("festival")
+        .arg("--batch")
+        .arg(&path)
+        .output()
+        .map_err(|e| fbakit::error::Error::MissingTool(format!("festival: {e}")))?;
+    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// `text` spoken by Festival's `voice`, with the times of its phones (mapped to espeak-ng's
+/// mnemonics, which the scoring knows).
+pub fn festival_speak(text: &str, voice: &str) -> fbakit::error::Result<Utterance> {
+    let dir = tempfile::tempdir().map_err(|e| fbakit::error::Error::io("tempdir", e))?;
+    let wav = dir.path().join("festival.wav");
+    let quoted: String = text.chars().filter(|c| !matches!(c, '"' | '\\')).collect();
+    // Each segment is printed as its name and end time; it starts where the last ended.
+    let out = festival_run(&format!(
+        "(voice_{voice})\n\
+         (set! utt (utt.synth (eval (list 'Utterance 'Text \"{quoted}\"))))\n\
+         (utt.save.wave utt \"{}\" 'riff)\n\
+         (mapcar (lambda (s) (format t \"seg %s %f\\n\" (item.name s) (item.feat s \"end\"))) \
+         (utt.relation.items utt 'Segment))\n",
+        wav.display()
+    ))?;
+    let failed = || {
+        fbakit::error::Error::MissingTool(format!("festival could not say {text:?} with {voice}"))
+    };
+    let mut phonemes: Vec<TimedPhoneme> = Vec::new();
+    for l in out.lines() {
+        let f: Vec<&str> = l.split_whitespace().collect();
+        if let ["seg", name, end] = f.as_slice() {
+            let end: f64 = end.parse().map_err(|_| failed())?;
+            let start = phonemes.last().map_or(0.0, |p| p.end);
+            phonemes.push(TimedPhoneme {
+                symbol: festival_to_espeak(name).to_string(),
+                start,
+                end: end.max(start),
+            });
+        }
+    }
+    let mut reader = hound::WavReader::open(&wav).map_err(|_| failed())?;
+    let spec = reader.spec();
+    let samples: Vec<i16> = reader
+        .samples::<i16>()
+        .step_by(usize::from(spec.channels.max(1)))
+        .collect::<Result<_, _>>()
+        .map_err(|_| failed())?;
+    if phonemes.is_empty() || samples.is_empty() {
+        return Err(failed());
+    }
+    Ok(Utterance {
+        sample_rate: spec.sample_rate,
+        samples,
+        phonemes,
+    })
+}
+
+/// The espeak-ng mnemonic of a phone of Festival's English voices (the "radio" phone set:
+/// ARPAbet in lower case, with a few more).
+pub fn festival_to_espeak(phone: &str) -> &'static str {
+    match phone {
+        "ax" => "@",
+        "axr" => "3",
+        "ix" => "I",
+        "dx" => "t",
+        "el" => "@L",
+        "em" => "m",
+        "en" | "nx" => "n",
+        "hv" => "h",
+        p => arpabet_to_espeak(&p.to_ascii_uppercase()),
+    }
 }
 
 /// Scores of one case: the aligner's and the stretched rendition's; and seconds of audio and
@@ -145,7 +303,10 @@ pub fn make_recording(
     text: &str,
     c: &Condition,
 ) -> fbakit::error::Result<(tempfile::TempDir, std::path::PathBuf, Vec<TimedPhoneme>)> {
-    let recording = speak_at(text, c.voice, c.rate)?;
+    let recording = match c.synth {
+        Synth::Espeak => speak_at(text, c.voice, c.rate)?,
+        Synth::Festival => festival_speak(text, c.voice)?,
+    };
     let (wav, truth) = degrade(&recording, &c.degradation)?;
     let dir = tempfile::tempdir().map_err(|e| fbakit::error::Error::io("tempdir", e))?;
     let mut path = dir.path().join("case.wav");
@@ -250,68 +411,111 @@ fn line(name: &str, s: &LipsyncScore) {
     );
 }
 
+/// Running totals of a group of conditions.
+#[derive(Default)]
+struct Totals {
+    aligned: LipsyncScore,
+    stretched: LipsyncScore,
+    recognised: LipsyncScore,
+    audio: f64,
+    work: f64,
+    work_recognised: f64,
+}
+
+impl Totals {
+    fn add(&mut self, o: &Totals) {
+        self.aligned.add(&o.aligned);
+        self.stretched.add(&o.stretched);
+        self.recognised.add(&o.recognised);
+        self.audio += o.audio;
+        self.work += o.work;
+        self.work_recognised += o.work_recognised;
+    }
+
+    fn print(&self, name: &str, recognise: bool) {
+        if self.aligned.speech_frames == 0 {
+            println!("{name}: none run");
+            return;
+        }
+        println!("{name}");
+        line("aligned", &self.aligned);
+        line("stretched", &self.stretched);
+        if recognise {
+            line("recognised", &self.recognised);
+        }
+    }
+}
+
 fn main() {
     if !fbakit::speech::espeak_available() {
         eprintln!("espeak-ng is not installed (apt-get install espeak-ng)");
         std::process::exit(1);
     }
-    let (mut audio, mut work, mut work_recognised) = (0.0, 0.0, 0.0);
-    let mut all = (LipsyncScore::default(), LipsyncScore::default());
-    let mut all_recognised = LipsyncScore::default();
     let recognise = recognition_available();
     if !recognise {
         println!("(PocketSphinx is not installed: no figures without a transcript)");
     }
     let have_ffmpeg = ffmpeg_available();
+    let (mut espeak, mut festival) = (Totals::default(), Totals::default());
     for c in conditions() {
         if c.mp3 && !have_ffmpeg {
             println!("{}: skipped (ffmpeg is not installed)", c.name);
             continue;
         }
-        let mut sum = (LipsyncScore::default(), LipsyncScore::default());
-        let mut recognised = LipsyncScore::default();
+        if c.synth == Synth::Festival && !festival_voice_available(c.voice) {
+            println!(
+                "{}: skipped (Festival or its voice {} is not installed: apt-get install \
+                 festival festvox-kallpc16k festvox-kdlpc16k festvox-us-slt-hts)",
+                c.name, c.voice
+            );
+            continue;
+        }
+        let mut sum = Totals::default();
         let mut conf = Vec::new();
         for text in SENTENCES {
             match run_case_with(text, &c, 25.0, recognise) {
                 Ok(r) => {
-                    sum.0.add(&r.aligned);
-                    sum.1.add(&r.stretched);
+                    sum.aligned.add(&r.aligned);
+                    sum.stretched.add(&r.stretched);
                     if let Some(s) = &r.recognised {
-                        recognised.add(s);
+                        sum.recognised.add(s);
                     }
-                    audio += r.audio_seconds;
-                    work += r.work_seconds;
-                    work_recognised += r.recognised_seconds;
+                    sum.audio += r.audio_seconds;
+                    sum.work += r.work_seconds;
+                    sum.work_recognised += r.recognised_seconds;
                     conf.push(r.confidence);
                     if std::env::var_os("VERBOSE").is_some() {
                         println!("    {text}: conf {:.2}", r.confidence);
                         line("aligned", &r.aligned);
+                        if let Some(s) = &r.recognised {
+                            line("recognised", s);
+                        }
                     }
                 }
                 Err(e) => println!("  {text}: {e}"),
             }
         }
-        println!(
-            "{} (confidence {:.2}..{:.2})",
-            c.name,
-            conf.iter().cloned().fold(1.0, f64::min),
-            conf.iter().cloned().fold(0.0, f64::max)
+        sum.print(
+            &format!(
+                "{} (confidence {:.2}..{:.2})",
+                c.name,
+                conf.iter().cloned().fold(1.0, f64::min),
+                conf.iter().cloned().fold(0.0, f64::max)
+            ),
+            recognise,
         );
-        line("aligned", &sum.0);
-        line("stretched", &sum.1);
-        if recognise {
-            line("recognised", &recognised);
+        match c.synth {
+            Synth::Espeak => espeak.add(&sum),
+            Synth::Festival => festival.add(&sum),
         }
-        all.0.add(&sum.0);
-        all.1.add(&sum.1);
-        all_recognised.add(&recognised);
     }
-    println!("all conditions");
-    line("aligned", &all.0);
-    line("stretched", &all.1);
-    if recognise {
-        line("recognised", &all_recognised);
-    }
+    espeak.print("all espeak-ng conditions", recognise);
+    festival.print("all Festival conditions", recognise);
+    let mut all = Totals::default();
+    all.add(&espeak);
+    all.add(&festival);
+    all.print("all conditions", recognise);
+    let (audio, work, work_recognised) = (all.audio, all.work, all.work_recognised);
     println!(
         "{audio:.1} s of audio analysed and aligned in {work:.2} s: {:.0}x real time",
         audio / work.max(1e-9)

@@ -227,17 +227,19 @@ fn without_a_transcript_english_phones_are_recognised() {
 
 /// The figures without a transcript on part of the evaluation (`examples/lipsync_eval.rs`
 /// has them all), pinned as regression bounds a little below what was measured: PocketSphinx
-/// phones plus the closures found in the sound (`speech::lipsync::closures`). The closures and
-/// the agreement are below the targets (80 %, 70 %) on these espeak-ng voices.
-// Measured on this subset (3 conditions × 4 sentences): closures 0.410 (32/78), agreement
-// 0.600, false closures 0.027, PP on other consonants 0.091 when the test runs alone; 0.359,
-// 0.580, 0.027, 0.092 beside the other tests of this file (espeak-ng's renditions then
-// differ a little: its engine is shared). On the whole evaluation the closures shown went
-// from 26 % with PocketSphinx's phones alone to 53 %.
+/// phones plus the closures found in the sound and in the f's and v's it heard on deep gaps
+/// (`speech::lipsync::closures`). The closures and the agreement are below the issue's
+/// targets (80 %, 70 %) on these espeak-ng voices.
+// Measured on this subset (3 espeak-ng conditions × 4 sentences): closures 0.487 (38/78),
+// agreement 0.598, false closures 0.028, PP on other consonants 0.122 when the test runs
+// alone; 0.410, 0.583, 0.027, 0.112 beside the other tests of this file (espeak-ng's
+// renditions then differ a little: its engine is shared). Before the heard f's and v's:
+// 0.410, 0.600, 0.027, 0.091 alone. On the whole evaluation the closures shown went from 26 %
+// with PocketSphinx's phones alone to 53 %, and 58 % with the f's and v's.
 const BOUND_CLOSURES: f64 = 0.33;
 const BOUND_AGREEMENT: f64 = 0.55;
 const BOUND_FALSE: f64 = 0.035;
-const BOUND_CONSONANT: f64 = 0.11;
+const BOUND_CONSONANT: f64 = 0.14;
 
 #[test]
 fn without_a_transcript_the_figures_hold() {
@@ -252,7 +254,10 @@ fn without_a_transcript_the_figures_hold() {
         return;
     }
     let mut total = LipsyncScore::default();
-    for c in lipsync_eval::conditions().iter().filter(|c| !c.mp3) {
+    for c in lipsync_eval::conditions()
+        .iter()
+        .filter(|c| !c.mp3 && c.synth == lipsync_eval::Synth::Espeak)
+    {
         for text in &lipsync_eval::SENTENCES[..4] {
             total.add(&lipsync_eval::run_recognised(text, c, 25.0).unwrap());
         }

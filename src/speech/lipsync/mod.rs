@@ -302,8 +302,8 @@ pub fn lipsync_transcript_at(
 }
 
 /// Phones recognised in the recording (ARPAbet, [`recognition`]) to a lip sync at `fps`;
-/// lip closures the recogniser missed are found in the sound ([`closures`]) and added as
-/// short `B` phones.
+/// lip closures the recogniser missed are found in the sound, or in an f or v it heard on a
+/// deep gap ([`closures`]), and added as short `B` phones.
 pub fn lipsync_recognised(
     rec: &RecordingAnalysis,
     phones: Vec<AlignedPhone>,
@@ -329,7 +329,10 @@ pub fn lipsync_recognised(
         .into());
     }
     let confidence = spoken.iter().map(|p| p.confidence).sum::<f64>() / spoken.len() as f64;
-    let found = closures::acoustic_closures(&rec.frames, &phones);
+    let mut found = closures::acoustic_closures(&rec.frames, &phones);
+    let heard = closures::fricative_closures(&rec.frames, &phones, &rec.activity.silences, &found);
+    found.extend(heard);
+    found.sort_by(f64::total_cmp);
     let phones = closures::with_closures(phones, &found);
     Ok(finish(
         rec,

@@ -18,6 +18,16 @@
 //! the phones' own figures by a few points at most, none better on every condition. Word
 //! recognition (`-lm en-us.lm.bin -dict cmudict-en-us.dict`) to feed the transcript path was
 //! tried: on these voices it heard nonsense words, at about 3× real time.
+//!
+//! On Festival's voices built from real speakers (`examples/lipsync_eval.rs`), clean, the
+//! phones include most m, b and p; with the evaluation's noise they mostly turn into f, v or
+//! th ([`super::closures::fricative_closures`] takes the f's and v's). Word recognition
+//! there heard "my mother bought a map of bombay" word for word (HTS voice slt, clean) and
+//! "my mother bought 'em up of bombay" (diphone voice kal), but at 3–4× real time on this
+//! machine (0.25 s of it loading the dictionary and language model); with settings fast
+//! enough (`-fwdflat no -bestpath no -maxhmmpf 3000 -topn 2`, 6× real time) the words were
+//! wrong. The phone lattice (for phone posteriors) is not available: `pocketsphinx_batch
+//! -outlatdir` gives none for the phone-loop search (`-allphone`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
