@@ -64,9 +64,9 @@
 //!    It is repaired by a direct transfer (nearest source vertex in the aligned frame, times
 //!    r), else by moving its feature point alone (the source's displacement there times r,
 //!    fading out before the nearest other feature point: a coarse target's lid point may share
-//!    its vertex with an eye corner, or lie beyond the source's surface by a still vertex), and re-checked; if that fails too the FAP's table is
-//!    dropped. Either way it is
-//!    listed in [`CloneReport::failed_faps`] and warned about.
+//!    its vertex with an eye corner, or lie beyond the source's surface by a still vertex),
+//!    and re-checked; if that fails too the FAP's table is dropped. Either way it is listed
+//!    in [`CloneReport::failed_faps`] and warned about.
 //!    **`smooth`** (every method, `smooth.rs`): a motion must not crease, fold or spike where
 //!    its source does not. Target triangles whose normal turns more than 1.25× the source
 //!    motion's largest turn ([`crate::clone::quality::max_normal_turn`], at least 1°) are

@@ -96,6 +96,22 @@ pub struct Dip {
     pub depth: f32,
 }
 
+/// How far `level[k]` lies below the lower of the peaks on either side of it (within
+/// `REACH` frames).
+fn gap_depth(level: &[f32], k: usize) -> f32 {
+    let peak = |r: &[f32]| r.iter().copied().fold(f32::MIN, f32::max);
+    let left = peak(&level[k.saturating_sub(REACH)..k]);
+    let right = peak(&level[k + 1..(k + 1 + REACH).min(level.len())]);
+    left.min(right) - level[k]
+}
+
+/// Whether the recogniser heard a phone of `set` overlapping `from..to` (seconds).
+fn heard(phones: &[AlignedPhone], set: &[&str], from: f64, to: f64) -> bool {
+    phones
+        .iter()
+        .any(|p| p.end > from && p.start < to && set.contains(&p.symbol.as_str()))
+}
+
 /// The dips at least `min_depth` dB deep in `frames`' high-frequency energy.
 pub fn dips(frames: &[FeatureFrame], min_depth: f32) -> Vec<Dip> {
     let n = frames.len();
@@ -114,10 +130,7 @@ pub fn dips(frames: &[FeatureFrame], min_depth: f32) -> Vec<Dip> {
         if !(high[i] <= high[i - 1] && high[i] < high[i + 1]) {
             continue;
         }
-        let peak = |r: &[f32]| r.iter().copied().fold(f32::MIN, f32::max);
-        let left = peak(&high[i.saturating_sub(REACH)..i]);
-        let right = peak(&high[i + 1..(i + 1 + REACH).min(n)]);
-        let depth = left.min(right) - high[i];
+        let depth = gap_depth(&high, i);
         if depth < min_depth {
             continue;
         }
@@ -160,16 +173,12 @@ pub fn acoustic_closures(frames: &[FeatureFrame], phones: &[AlignedPhone]) -> Ve
             continue;
         }
         let (start, end, bottom) = (frame_time(d.first), frame_time(d.last), frame_time(i));
-        let heard = |set: &[&str], from: f64, to: f64| {
-            phones
-                .iter()
-                .any(|p| p.end > from && p.start < to && set.contains(&p.symbol.as_str()))
-        };
         // A closure the recogniser heard in the dip is shown at its bottom too (the
         // recogniser's times are rough); otherwise the dip is a closure when nothing heard
         // there explains it with open lips.
-        if heard(&CLOSURES, start, end)
-            || !(heard(&PLACED, start, end) || heard(&ROUNDED, bottom, bottom + 1e-6))
+        if heard(phones, &CLOSURES, start, end)
+            || !(heard(phones, &PLACED, start, end)
+                || heard(phones, &ROUNDED, bottom, bottom + 1e-6))
         {
             out.push(bottom);
         }
@@ -202,35 +211,21 @@ pub fn fricative_closures(
     if n == 0 {
         return out;
     }
-    let peak = |r: std::ops::Range<usize>| {
-        frames[r]
-            .iter()
-            .map(|f| f.energy_db)
-            .fold(f32::MIN, f32::max)
-    };
+    let energy: Vec<f32> = frames.iter().map(|f| f.energy_db).collect();
     for p in phones
         .iter()
         .filter(|p| FRICATIVE_LABIALS.contains(&p.symbol.as_str()))
     {
         let first = frame_at(p.start, n);
         let last = frame_at(p.end, n).max(first);
-        let Some(k) =
-            (first..=last).min_by(|&i, &j| frames[i].energy_db.total_cmp(&frames[j].energy_db))
-        else {
+        let Some(k) = (first..=last).min_by(|&i, &j| energy[i].total_cmp(&energy[j])) else {
             continue;
         };
-        let depth = peak(k.saturating_sub(REACH)..k).min(peak(k + 1..(k + 1 + REACH).min(n)))
-            - frames[k].energy_db;
         let t = frame_time(k);
-        let near = |q: &AlignedPhone| {
-            CLOSURES.contains(&q.symbol.as_str())
-                && q.end > t - SAME_CLOSURE
-                && q.start < t + SAME_CLOSURE
-        };
-        if depth < FRICATIVE_GAP_DB
+        if gap_depth(&energy, k) < FRICATIVE_GAP_DB
             || silences.iter().any(|&(a, b)| a <= t && t < b)
             || known.iter().any(|&c| (c - t).abs() < SAME_CLOSURE)
-            || phones.iter().any(near)
+            || heard(phones, &CLOSURES, t - SAME_CLOSURE, t + SAME_CLOSURE)
         {
             continue;
         }
