@@ -36,6 +36,19 @@ pub struct FapFailure {
     /// `true`: replaced by a direct transfer (nearest vertex, else the feature point's own
     /// move) that passed the check; `false`: the FAP's table was dropped.
     pub repaired: bool,
+    /// Which repair passed (`None`: dropped).
+    pub repair: Option<FapRepair>,
+}
+
+/// The repair that passed the guard's check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FapRepair {
+    /// Each target vertex takes the displacement of its nearest source vertex.
+    DirectTransfer,
+    /// The FAP's feature point moves by the source's displacement there, its surroundings
+    /// with it.
+    FeaturePoint,
 }
 
 /// The feature point a low-level translation FAP is measured at, if both surfaces have it.
@@ -318,9 +331,11 @@ pub(super) fn guard_motions(
                 .is_some_and(|(ds2, dt2, r2)| check(ds2, dt2, r2, None).is_none())
         };
         let mut repaired = direct_transfer(src, map, r as f32);
+        let mut repair = FapRepair::DirectTransfer;
         if !passes(&repaired) {
             if let Some(m) = feature_point_transfer(source, src, target) {
                 repaired = m;
+                repair = FapRepair::FeaturePoint;
             }
         }
         let ok = passes(&repaired);
@@ -338,6 +353,7 @@ pub(super) fn guard_motions(
             reason,
             factor: k,
             repaired: ok,
+            repair: ok.then_some(repair),
         });
     }
     // A dropped FAP loses every interval, not only the failing one.
