@@ -492,6 +492,7 @@ mod tests {
         let f = guard_motions(&s, &src, &t, &mut out, true);
         assert_eq!(f.len(), 1);
         assert!(f[0].repaired && f[0].factor > 1e5, "{f:?}");
+        assert_eq!(f[0].repair, Some(FapRepair::DirectTransfer));
         // Direct transfer: 2.5 takes its own source motion × the MNS ratio 2.
         assert!(out[0].offset_at(0).distance(Vec3::new(0.0, 0.2, 0.0)) < 1e-6);
         assert_eq!(out[0].offset_at(1), Vec3::ZERO);
@@ -514,6 +515,7 @@ mod tests {
         let mut out = vec![motion(vec![(3, Vec3::new(0.0, 1e-4, 0.0))])];
         let f = guard_motions(&s, &src, &t, &mut out, false);
         assert!(f.len() == 1 && f[0].repaired, "{f:?}");
+        assert_eq!(f[0].repair, Some(FapRepair::FeaturePoint));
         // 2.5 takes its source motion, vertex 1 (0.1 away, reach 0.15) part of it, 2.3 and
         // vertex 3 (0.2 away) nothing.
         assert_eq!(out[0].offset_at(0), Vec3::new(0.0, 0.1, 0.0));
@@ -534,6 +536,7 @@ mod tests {
         let mut out = vec![motion(vec![(1, Vec3::new(0.0, 0.1, 0.0))])];
         let f = guard_motions(&s, &src, &t, &mut out, false);
         assert!(f.len() == 1 && f[0].repaired, "{f:?}");
+        assert_eq!(f[0].repair, Some(FapRepair::FeaturePoint));
         // 2.5 takes its source motion; the others, a unit away (beyond half an ES0), stay.
         assert_eq!(out[0].offset_at(0), Vec3::new(0.0, 0.1, 0.0));
         assert_eq!(out[0].offsets.len(), 1);
