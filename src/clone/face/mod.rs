@@ -495,7 +495,7 @@ fn clone_skin_motions(
         || clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts),
         || {
             rayon::join(
-                || SmoothTopology::new(&ssurf.surface, &tsurf.surface),
+                || SmoothTopology::new(&ssurf.surface, &moving, &tsurf.surface),
                 || {
                     // A source with a mouth interior of its own (a rig head) hands on its
                     // real motion there.

@@ -114,8 +114,9 @@ fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u32> {
     tris
 }
 
-/// What [`smooth_motions`] reads of the two surfaces' neutral shapes, built once for both
-/// passes (before and after the gain): the same surfaces give the same tables.
+/// What `smooth_motions` reads of the two surfaces' neutral shapes and of the source
+/// motions, built once for both passes (before and after the gain): the same surfaces and
+/// source motions give the same tables.
 pub(super) struct SmoothTopology {
     /// Target vertex adjacency.
     adj: Vec<Vec<u32>>,
@@ -125,19 +126,48 @@ pub(super) struct SmoothTopology {
     source_incident: Vec<Vec<u32>>,
     /// Target triangles' neutral unit normals.
     tn: Vec<Vec3>,
+    /// The largest normal turn of each source motion (`source_turn`), in the order of the
+    /// motions both passes get.
+    source_turns: Vec<f64>,
 }
 
 impl SmoothTopology {
-    /// The tables of `source` and `target`.
-    pub(super) fn new(source: &CloneSurface, target: &CloneSurface) -> Self {
+    /// The tables of `source` and `target`, and the turns of the source `motions`.
+    pub(super) fn new(
+        source: &CloneSurface,
+        motions: &[SurfaceMotion],
+        target: &CloneSurface,
+    ) -> Self {
         let n = target.positions.len();
+        let source_incident = incident_triangles(source.positions.len(), &source.triangles);
+        let source_turns = motions
+            .par_iter()
+            .map(|m| source_turn(source, &source_incident, m))
+            .collect();
         SmoothTopology {
             adj: adjacency(n, &target.triangles),
             incident: incident_triangles(n, &target.triangles),
-            source_incident: incident_triangles(source.positions.len(), &source.triangles),
+            source_incident,
             tn: normals(&target.positions, &target.triangles),
+            source_turns,
         }
     }
+}
+
+/// The largest normal turn of source motion `src` ([`max_normal_turn`], radians).
+fn source_turn(source: &CloneSurface, source_incident: &[Vec<u32>], src: &SurfaceMotion) -> f64 {
+    let mut sd = source.positions.clone();
+    for &(v, o) in &src.offsets {
+        if let Some(p) = sd.get_mut(v as usize) {
+            *p += o;
+        }
+    }
+    // Only a triangle with a moved corner turns.
+    let moved: Vec<[u32; 3]> = touching(source_incident, &src.offsets)
+        .into_iter()
+        .map(|i| source.triangles[i as usize])
+        .collect();
+    max_normal_turn(&source.positions, &sd, &moved).angle
 }
 
 /// The smoothing of every cloned motion (module docs), on the `topology` of `source` and
@@ -156,26 +186,20 @@ pub(super) fn smooth_motions(
         incident,
         source_incident,
         tn,
+        source_turns,
     } = topology;
     let results: Vec<Option<(String, usize)>> = motions
         .par_iter()
         .zip(out.par_iter_mut())
-        .map(|(src, dst)| {
+        .enumerate()
+        .map(|(k, (src, dst))| {
             if dst.offsets.is_empty() {
                 return None;
             }
-            let mut sd = source.positions.clone();
-            for &(v, o) in &src.offsets {
-                if let Some(p) = sd.get_mut(v as usize) {
-                    *p += o;
-                }
-            }
-            // Only a triangle with a moved corner turns.
-            let moved: Vec<[u32; 3]> = touching(source_incident, &src.offsets)
-                .into_iter()
-                .map(|i| source.triangles[i as usize])
-                .collect();
-            let theta = max_normal_turn(&source.positions, &sd, &moved).angle;
+            let theta = source_turns
+                .get(k)
+                .copied()
+                .unwrap_or_else(|| source_turn(source, source_incident, src));
             let tau = SLACK * theta.max(NORMAL_TURN_FLOOR);
             if tau >= std::f64::consts::PI {
                 return None;
@@ -338,7 +362,9 @@ mod tests {
         let src = vec![motion(bump(&s, 1.0))];
         // The same smooth motion on the target: nothing to do.
         let mut out = src.clone();
-        assert!(smooth_motions(&SmoothTopology::new(&s, &s), &s, &src, &s, &mut out).is_empty());
+        // Built once, as the pipeline does for its two passes.
+        let topology = SmoothTopology::new(&s, &src, &s);
+        assert!(smooth_motions(&topology, &s, &src, &s, &mut out).is_empty());
         assert_eq!(out, src);
         // One vertex left still inside the bump (a hole in the correspondence) is a spike.
         let centre = 5 * 11 + 5;
@@ -353,7 +379,7 @@ mod tests {
                 .collect::<Vec<_>>(),
             &s.triangles,
         );
-        let done = smooth_motions(&SmoothTopology::new(&s, &s), &s, &src, &s, &mut holed);
+        let done = smooth_motions(&topology, &s, &src, &s, &mut holed);
         assert_eq!(done.len(), 1, "{done:?}");
         let d = crate::clone::quality::dense(&holed[0], 121);
         let posed: Vec<Vec3> = s.positions.iter().zip(&d).map(|(p, o)| *p + *o).collect();
@@ -375,7 +401,7 @@ mod tests {
         assert_eq!(d[0], Vec3::ZERO);
         // The pipeline runs the step again after the gain: a motion it settled is left as it is.
         let settled = holed.clone();
-        assert!(smooth_motions(&SmoothTopology::new(&s, &s), &s, &src, &s, &mut holed).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, &mut holed).is_empty());
         assert_eq!(holed, settled);
     }
 }
