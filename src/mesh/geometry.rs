@@ -318,15 +318,24 @@ pub fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
 /// Sorted, de-duplicated neighbours of every vertex (the edges of `triangles`; indices out of
 /// range are skipped).
 pub fn adjacency(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut adj = vec![Vec::new(); vertex_count];
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a != b && (a as usize) < vertex_count && (b as usize) < vertex_count {
-                adj[a as usize].push(b);
-                adj[b as usize].push(a);
-            }
-        }
+    let edges = || {
+        triangles.iter().flat_map(|t| {
+            (0..3).map(|k| (t[k], t[(k + 1) % 3])).filter(|&(a, b)| {
+                a != b && (a as usize) < vertex_count && (b as usize) < vertex_count
+            })
+        })
+    };
+    // Each list allocated once, with room for every edge end before de-duplication: growing
+    // tens of thousands of small lists cost more than filling them.
+    let mut degree = vec![0usize; vertex_count];
+    for (a, b) in edges() {
+        degree[a as usize] += 1;
+        degree[b as usize] += 1;
+    }
+    let mut adj: Vec<Vec<u32>> = degree.into_iter().map(Vec::with_capacity).collect();
+    for (a, b) in edges() {
+        adj[a as usize].push(b);
+        adj[b as usize].push(a);
     }
     for n in &mut adj {
         n.sort_unstable();

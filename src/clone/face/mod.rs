@@ -207,7 +207,7 @@ pub use align::Similarity;
 pub use options::{face_fmc_options, face_rbf_options, CloneOptions, Method};
 pub use parts::{identify_parts, FaceParts, Part};
 pub use report::{CloneOutcome, CloneReport, RigidReport};
-pub use rescale::FapFailure;
+pub use rescale::{FapFailure, FapRepair};
 pub use rigid::install_center;
 pub use skin_surface::{build_skin_surface, build_skin_surface_like, SkinSurface};
 pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
@@ -225,7 +225,7 @@ use assemble::{assemble_fat, ClonedMotions, SourceMotions};
 use motions::surface_motions;
 use rescale::{gain_to_fapu, guard_motions, rescale_to_fapu};
 use rigid::RigidPlan;
-use smooth::smooth_motions;
+use smooth::{smooth_motions, SmoothTopology};
 
 /// Motions of the surface method on already built surfaces.
 pub fn clone_surface(
@@ -489,7 +489,25 @@ fn clone_skin_motions(
         .filter(|m| !m.offsets.is_empty())
         .cloned()
         .collect();
-    let mut result = clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts)?;
+    // What `smooth` and `mouth` read of the neutral surfaces is built while the surface
+    // method runs: its sequential steps (`fit`'s factorisations) leave a core free.
+    let (result, (topology, interior)) = rayon::join(
+        || clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts),
+        || {
+            rayon::join(
+                || SmoothTopology::new(&ssurf.surface, &moving, &tsurf.surface),
+                || {
+                    // A source with a mouth interior of its own (a rig head) hands on its
+                    // real motion there.
+                    let own = mouth_fill::MouthInterior::new(ssurf).is_some();
+                    (!own)
+                        .then(|| mouth_fill::MouthInterior::new(tsurf))
+                        .flatten()
+                },
+            )
+        },
+    );
+    let mut result = result?;
     for (name, s) in &result.timings.steps {
         report
             .timings
@@ -524,10 +542,10 @@ fn clone_skin_motions(
             f.value,
             f.reason,
             f.factor,
-            if f.repaired {
-                "repaired by a direct transfer"
-            } else {
-                "its table is dropped"
+            match f.repair {
+                Some(FapRepair::DirectTransfer) => "repaired by a direct transfer",
+                Some(FapRepair::FeaturePoint) => "repaired by moving its feature point",
+                None => "its table is dropped",
             }
         )));
     }
@@ -535,7 +553,13 @@ fn clone_skin_motions(
     // No crease, fold or spike the source does not have; then each feature point moves by
     // its FAPU.
     let clock = Instant::now();
-    report.smoothed = smooth_motions(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions);
+    report.smoothed = smooth_motions(
+        &topology,
+        &ssurf.surface,
+        &moving,
+        &tsurf.surface,
+        &mut result.motions,
+    );
     report.timings.push("smooth", clock.elapsed().as_secs_f64());
     // Not when FAPU scaling is turned off (the RBF paper's mode, fit without it).
     let scaled = match opts.method {
@@ -564,7 +588,13 @@ fn clone_skin_motions(
     // motion is not changed. Not after the mouth fill: smoothing the uniform-Laplacian way
     // there undid it (alma → ict 6.9 → 15.5).
     let clock = Instant::now();
-    for (k, n) in smooth_motions(&ssurf.surface, &moving, &tsurf.surface, &mut result.motions) {
+    for (k, n) in smooth_motions(
+        &topology,
+        &ssurf.surface,
+        &moving,
+        &tsurf.surface,
+        &mut result.motions,
+    ) {
         *report.smoothed.entry(k).or_default() += n;
     }
     report
@@ -572,12 +602,7 @@ fn clone_skin_motions(
         .push("smooth2", clock.elapsed().as_secs_f64());
     // The hidden mouth interior: a smooth extension of the lips into the jaw's motion.
     let clock = Instant::now();
-    // A source with a mouth interior of its own (a rig head) hands on its real motion there.
-    let own = mouth_fill::MouthInterior::new(ssurf).is_some();
-    if let Some(interior) = (!own)
-        .then(|| mouth_fill::MouthInterior::new(tsurf))
-        .flatten()
-    {
+    if let Some(interior) = interior {
         report.mouth_interior = interior.vertices();
         result
             .motions

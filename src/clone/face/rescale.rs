@@ -36,6 +36,19 @@ pub struct FapFailure {
     /// `true`: replaced by a direct transfer (nearest vertex, else the feature point's own
     /// move) that passed the check; `false`: the FAP's table was dropped.
     pub repaired: bool,
+    /// Which repair passed (`None`: dropped).
+    pub repair: Option<FapRepair>,
+}
+
+/// The repair that passed the guard's check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FapRepair {
+    /// Each target vertex takes the displacement of its nearest source vertex.
+    DirectTransfer,
+    /// The FAP's feature point moves by the source's displacement there, its surroundings
+    /// with it.
+    FeaturePoint,
 }
 
 /// The feature point a low-level translation FAP is measured at, if both surfaces have it.
@@ -318,9 +331,11 @@ pub(super) fn guard_motions(
                 .is_some_and(|(ds2, dt2, r2)| check(ds2, dt2, r2, None).is_none())
         };
         let mut repaired = direct_transfer(src, map, r as f32);
+        let mut repair = FapRepair::DirectTransfer;
         if !passes(&repaired) {
             if let Some(m) = feature_point_transfer(source, src, target) {
                 repaired = m;
+                repair = FapRepair::FeaturePoint;
             }
         }
         let ok = passes(&repaired);
@@ -338,6 +353,7 @@ pub(super) fn guard_motions(
             reason,
             factor: k,
             repaired: ok,
+            repair: ok.then_some(repair),
         });
     }
     // A dropped FAP loses every interval, not only the failing one.
@@ -476,6 +492,7 @@ mod tests {
         let f = guard_motions(&s, &src, &t, &mut out, true);
         assert_eq!(f.len(), 1);
         assert!(f[0].repaired && f[0].factor > 1e5, "{f:?}");
+        assert_eq!(f[0].repair, Some(FapRepair::DirectTransfer));
         // Direct transfer: 2.5 takes its own source motion × the MNS ratio 2.
         assert!(out[0].offset_at(0).distance(Vec3::new(0.0, 0.2, 0.0)) < 1e-6);
         assert_eq!(out[0].offset_at(1), Vec3::ZERO);
@@ -498,6 +515,7 @@ mod tests {
         let mut out = vec![motion(vec![(3, Vec3::new(0.0, 1e-4, 0.0))])];
         let f = guard_motions(&s, &src, &t, &mut out, false);
         assert!(f.len() == 1 && f[0].repaired, "{f:?}");
+        assert_eq!(f[0].repair, Some(FapRepair::FeaturePoint));
         // 2.5 takes its source motion, vertex 1 (0.1 away, reach 0.15) part of it, 2.3 and
         // vertex 3 (0.2 away) nothing.
         assert_eq!(out[0].offset_at(0), Vec3::new(0.0, 0.1, 0.0));
@@ -518,6 +536,7 @@ mod tests {
         let mut out = vec![motion(vec![(1, Vec3::new(0.0, 0.1, 0.0))])];
         let f = guard_motions(&s, &src, &t, &mut out, false);
         assert!(f.len() == 1 && f[0].repaired, "{f:?}");
+        assert_eq!(f[0].repair, Some(FapRepair::FeaturePoint));
         // 2.5 takes its source motion; the others, a unit away (beyond half an ES0), stay.
         assert_eq!(out[0].offset_at(0), Vec3::new(0.0, 0.1, 0.0));
         assert_eq!(out[0].offsets.len(), 1);

@@ -114,38 +114,92 @@ fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u32> {
     tris
 }
 
-/// The smoothing of every cloned motion (module docs). Returns, per smoothed motion
-/// (`name@value`), how many target vertices were re-solved.
+/// What `smooth_motions` reads of the two surfaces' neutral shapes and of the source
+/// motions, built once for both passes (before and after the gain): the same surfaces and
+/// source motions give the same tables.
+pub(super) struct SmoothTopology {
+    /// Target vertex adjacency.
+    adj: Vec<Vec<u32>>,
+    /// Target triangles of each target vertex.
+    incident: Vec<Vec<u32>>,
+    /// Source triangles of each source vertex.
+    source_incident: Vec<Vec<u32>>,
+    /// Target triangles' neutral unit normals.
+    tn: Vec<Vec3>,
+    /// The largest normal turn of each source motion (`source_turn`), in the order of the
+    /// motions both passes get.
+    source_turns: Vec<f64>,
+}
+
+impl SmoothTopology {
+    /// The tables of `source` and `target`, and the turns of the source `motions`.
+    pub(super) fn new(
+        source: &CloneSurface,
+        motions: &[SurfaceMotion],
+        target: &CloneSurface,
+    ) -> Self {
+        let n = target.positions.len();
+        let source_incident = incident_triangles(source.positions.len(), &source.triangles);
+        let source_turns = motions
+            .par_iter()
+            .map(|m| source_turn(source, &source_incident, m))
+            .collect();
+        SmoothTopology {
+            adj: adjacency(n, &target.triangles),
+            incident: incident_triangles(n, &target.triangles),
+            source_incident,
+            tn: normals(&target.positions, &target.triangles),
+            source_turns,
+        }
+    }
+}
+
+/// The largest normal turn of source motion `src` ([`max_normal_turn`], radians).
+fn source_turn(source: &CloneSurface, source_incident: &[Vec<u32>], src: &SurfaceMotion) -> f64 {
+    let mut sd = source.positions.clone();
+    for &(v, o) in &src.offsets {
+        if let Some(p) = sd.get_mut(v as usize) {
+            *p += o;
+        }
+    }
+    // Only a triangle with a moved corner turns.
+    let moved: Vec<[u32; 3]> = touching(source_incident, &src.offsets)
+        .into_iter()
+        .map(|i| source.triangles[i as usize])
+        .collect();
+    max_normal_turn(&source.positions, &sd, &moved).angle
+}
+
+/// The smoothing of every cloned motion (module docs), on the `topology` of `source` and
+/// `target`. Returns, per smoothed motion (`name@value`), how many target vertices were
+/// re-solved.
 pub(super) fn smooth_motions(
+    topology: &SmoothTopology,
     source: &CloneSurface,
     motions: &[SurfaceMotion],
     target: &CloneSurface,
     out: &mut [SurfaceMotion],
 ) -> BTreeMap<String, usize> {
     let n = target.positions.len();
-    let adj = adjacency(n, &target.triangles);
-    let incident = incident_triangles(n, &target.triangles);
-    let source_incident = incident_triangles(source.positions.len(), &source.triangles);
-    let tn = normals(&target.positions, &target.triangles);
+    let SmoothTopology {
+        adj,
+        incident,
+        source_incident,
+        tn,
+        source_turns,
+    } = topology;
     let results: Vec<Option<(String, usize)>> = motions
         .par_iter()
         .zip(out.par_iter_mut())
-        .map(|(src, dst)| {
+        .enumerate()
+        .map(|(k, (src, dst))| {
             if dst.offsets.is_empty() {
                 return None;
             }
-            let mut sd = source.positions.clone();
-            for &(v, o) in &src.offsets {
-                if let Some(p) = sd.get_mut(v as usize) {
-                    *p += o;
-                }
-            }
-            // Only a triangle with a moved corner turns.
-            let moved: Vec<[u32; 3]> = touching(&source_incident, &src.offsets)
-                .into_iter()
-                .map(|i| source.triangles[i as usize])
-                .collect();
-            let theta = max_normal_turn(&source.positions, &sd, &moved).angle;
+            let theta = source_turns
+                .get(k)
+                .copied()
+                .unwrap_or_else(|| source_turn(source, source_incident, src));
             let tau = SLACK * theta.max(NORMAL_TURN_FLOOR);
             if tau >= std::f64::consts::PI {
                 return None;
@@ -159,7 +213,7 @@ pub(super) fn smooth_motions(
             }
             let pos = &target.positions;
             let tris = &target.triangles;
-            let mut bad: Vec<u32> = touching(&incident, &dst.offsets)
+            let mut bad: Vec<u32> = touching(incident, &dst.offsets)
                 .into_iter()
                 .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
                 .collect();
@@ -176,6 +230,8 @@ pub(super) fn smooth_motions(
             let mut touched = vec![false; n];
             let mut count = 0usize;
             let mut next = d.clone();
+            let mut seen = vec![false; tris.len()];
+            let mut listed: Vec<u32> = Vec::new();
             for _ in 0..ROUNDS {
                 // The corners of the rough triangles and one ring around them.
                 let mut region: Vec<u32> = Vec::new();
@@ -209,11 +265,23 @@ pub(super) fn smooth_motions(
                         count += 1;
                     }
                 }
-                let mut seen = std::collections::HashSet::new();
-                bad = region
+                // Each triangle around the region once, in order of first sight (a mark per
+                // triangle, cleared after: hashing them cost more than the checks).
+                listed.clear();
+                for &v in &region {
+                    for &i in &incident[v as usize] {
+                        if !seen[i as usize] {
+                            seen[i as usize] = true;
+                            listed.push(i);
+                        }
+                    }
+                }
+                for &i in &listed {
+                    seen[i as usize] = false;
+                }
+                bad = listed
                     .iter()
-                    .flat_map(|&v| incident[v as usize].iter().copied())
-                    .filter(|&i| seen.insert(i))
+                    .copied()
                     .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
                     .collect();
                 if bad.is_empty() {
@@ -294,7 +362,9 @@ mod tests {
         let src = vec![motion(bump(&s, 1.0))];
         // The same smooth motion on the target: nothing to do.
         let mut out = src.clone();
-        assert!(smooth_motions(&s, &src, &s, &mut out).is_empty());
+        // Built once, as the pipeline does for its two passes.
+        let topology = SmoothTopology::new(&s, &src, &s);
+        assert!(smooth_motions(&topology, &s, &src, &s, &mut out).is_empty());
         assert_eq!(out, src);
         // One vertex left still inside the bump (a hole in the correspondence) is a spike.
         let centre = 5 * 11 + 5;
@@ -309,7 +379,7 @@ mod tests {
                 .collect::<Vec<_>>(),
             &s.triangles,
         );
-        let done = smooth_motions(&s, &src, &s, &mut holed);
+        let done = smooth_motions(&topology, &s, &src, &s, &mut holed);
         assert_eq!(done.len(), 1, "{done:?}");
         let d = crate::clone::quality::dense(&holed[0], 121);
         let posed: Vec<Vec3> = s.positions.iter().zip(&d).map(|(p, o)| *p + *o).collect();
@@ -331,7 +401,7 @@ mod tests {
         assert_eq!(d[0], Vec3::ZERO);
         // The pipeline runs the step again after the gain: a motion it settled is left as it is.
         let settled = holed.clone();
-        assert!(smooth_motions(&s, &src, &s, &mut holed).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, &mut holed).is_empty());
         assert_eq!(holed, settled);
     }
 }
