@@ -930,7 +930,12 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
     assert!(!stderr.contains("eye node"), "{stderr}");
     let (patched, _) = glb_parts(&out);
     // No target for the turns (23–26); the thrusts (27, 28) stay targets.
-    let turns = ["yaw_l_eyeball", "yaw_r_eyeball", "pitch_l_eyeball", "pitch_r_eyeball"];
+    let turns = [
+        "yaw_l_eyeball",
+        "yaw_r_eyeball",
+        "pitch_l_eyeball",
+        "pitch_r_eyeball",
+    ];
     let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
     assert!(!turns.iter().any(|t| names.contains(t)), "{names}");
     let record = &patched["scenes"][0]["extras"]["fbakit"];
@@ -969,7 +974,12 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
     let gaze = write_gaze(d);
     let played = d.join("played.glb");
     let o = support::cli::command()
-        .args(["play".as_ref(), out.as_os_str(), gaze.as_os_str(), "-o".as_ref()])
+        .args([
+            "play".as_ref(),
+            out.as_os_str(),
+            gaze.as_os_str(),
+            "-o".as_ref(),
+        ])
         .arg(&played)
         .output()
         .unwrap();
@@ -1009,7 +1019,9 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
             .map(|v| v.as_u64().unwrap() as usize)
             .collect();
         let rest: Vec<Vec3> = vertices.iter().map(|&v| neutral[mesh][v]).collect();
-        let lo = rest.iter().fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
+        let lo = rest
+            .iter()
+            .fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
         let hi = rest
             .iter()
             .fold(Vec3::splat(f32::NEG_INFINITY), |a, &b| a.max(b));
@@ -1034,10 +1046,16 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
             }
             eprintln!("joint {node} frame {k}: FAT moves the eyeball {moved}, worst {worst}");
             if v.iter().any(|&x| x != 0) {
-                assert!(moved > 0.02 * size, "frame {k}: the FAT does not turn the eye");
+                assert!(
+                    moved > 0.02 * size,
+                    "frame {k}: the FAT does not turn the eye"
+                );
             }
         }
-        assert!(worst <= 0.01, "joint {node}: off by {worst} of the eyeball's size");
+        assert!(
+            worst <= 0.01,
+            "joint {node}: off by {worst} of the eyeball's size"
+        );
     }
     // No turn weights are keyed: the played `Body` has no target for them at all.
     assert!(channel(LEFT_EYE_JOINT, "weights").is_none());
@@ -1067,7 +1085,10 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
             .iter()
             .find(|a| a["name"] == "play")
             .unwrap_or_else(|| panic!("no play clip: {r}"));
-        assert!(clip["tracks"].as_array().is_some_and(|t| !t.is_empty()), "{clip}");
+        assert!(
+            clip["tracks"].as_array().is_some_and(|t| !t.is_empty()),
+            "{clip}"
+        );
     }
     if let Some(r) = support::blender::import_in_blender(&[&played]) {
         let actions = r[0]["actions"].to_string();

@@ -289,13 +289,17 @@ pub fn eye_parts(
         let rest: Vec<DVec3> = vertices
             .iter()
             .map(|&v| {
-                let p = fm.mesh.positions.get(v as usize).copied().unwrap_or(Vec3::ZERO);
+                let p = fm
+                    .mesh
+                    .positions
+                    .get(v as usize)
+                    .copied()
+                    .unwrap_or(Vec3::ZERO);
                 frame.transform_point3(p).as_dvec3()
             })
             .collect();
-        let size = crate::fat::bake::part_size(
-            &rest.iter().map(|p| p.as_vec3()).collect::<Vec<_>>(),
-        );
+        let size =
+            crate::fat::bake::part_size(&rest.iter().map(|p| p.as_vec3()).collect::<Vec<_>>());
         match fit_turns(&entries, &vertices, &rest, frame, f64::from(size)) {
             Ok((center, turns)) => out.push(EyePart {
                 node,
@@ -343,7 +347,8 @@ fn fit_turns(
                     let d = s.map_or(DVec3::ZERO, |i| {
                         (0..k)
                             .map(|j| {
-                                e.displacements[i * k + j].as_dvec3() * weights.get(j).copied().unwrap_or(0.0)
+                                e.displacements[i * k + j].as_dvec3()
+                                    * weights.get(j).copied().unwrap_or(0.0)
                             })
                             .sum::<DVec3>()
                     });
@@ -384,12 +389,14 @@ fn fit_turns(
             for (x, y) in rest.iter().zip(moved) {
                 worst = worst.max((*r * (*x - center) + center).distance(*y));
             }
-            rotations.push(Quat::from_mat3(&glam::Mat3::from_cols(
-                r.x_axis.as_vec3(),
-                r.y_axis.as_vec3(),
-                r.z_axis.as_vec3(),
-            ))
-            .normalize());
+            rotations.push(
+                Quat::from_mat3(&glam::Mat3::from_cols(
+                    r.x_axis.as_vec3(),
+                    r.y_axis.as_vec3(),
+                    r.z_axis.as_vec3(),
+                ))
+                .normalize(),
+            );
         }
         turns.push(PartTurn {
             key,
@@ -411,7 +418,8 @@ fn kabsch(from: &[DVec3], to: &[DVec3], mean: DVec3) -> DMat3 {
     let mut h = nalgebra::Matrix3::<f64>::zeros();
     for (x, y) in from.iter().zip(to) {
         let (p, q) = (*x - mean, *y - tm);
-        h += nalgebra::Vector3::new(q.x, q.y, q.z) * nalgebra::Vector3::new(p.x, p.y, p.z).transpose();
+        h += nalgebra::Vector3::new(q.x, q.y, q.z)
+            * nalgebra::Vector3::new(p.x, p.y, p.z).transpose();
     }
     let svd = h.svd(true, true);
     let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {

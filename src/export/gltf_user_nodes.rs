@@ -54,8 +54,18 @@ pub fn eye_transforms(
     let reader = ShareReader::new(source);
     let mut out = Vec::new();
     for (node, pupil, other, faps) in [
-        (left, FeaturePointId::FP_3_5, FeaturePointId::FP_3_6, [23, 25, 27]),
-        (right, FeaturePointId::FP_3_6, FeaturePointId::FP_3_5, [24, 26, 28]),
+        (
+            left,
+            FeaturePointId::FP_3_5,
+            FeaturePointId::FP_3_6,
+            [23, 25, 27],
+        ),
+        (
+            right,
+            FeaturePointId::FP_3_6,
+            FeaturePointId::FP_3_5,
+            [24, 26, 28],
+        ),
     ] {
         let Some(node) = node.filter(|n| !taken.contains(&Some(*n))) else {
             continue;
@@ -112,20 +122,27 @@ pub fn eye_transforms(
             // `gltf_eye_parts`.
             continue;
         };
-        if !face
-            .fat
-            .tables
-            .iter()
-            .filter(|t| matches!(t.key, TableKey::LowLevel(f) if faps.contains(&f.number())))
-            .flat_map(|t| &t.transforms)
-            .any(|x| face.transform_index(&x.transform) == Some(transform))
-        {
-            // The eye's FAPs do not move it (nothing to animate, or the mesh hangs under the
-            // head's transform and its eyeball is vertices of it: `gltf_eye_parts`).
+        let moves = |eye: bool| {
+            face.fat
+                .tables
+                .iter()
+                .filter(|t| {
+                    !eye || matches!(t.key, TableKey::LowLevel(f) if faps.contains(&f.number()))
+                })
+                .flat_map(|t| &t.transforms)
+                .any(|x| face.transform_index(&x.transform) == Some(transform))
+        };
+        if !moves(false) {
+            // The FAT does not move it: nothing to animate.
             continue;
         }
         if pupil_mesh.is_none() {
             warnings.push(refuse(format!("its mesh holds no pupil {pupil}")));
+            continue;
+        }
+        if !moves(true) {
+            // Not the eye's own transform (the mesh hangs under the head's): its eyeball is
+            // vertices of the mesh, left to `gltf_eye_parts`.
             continue;
         }
         let skin_on = face

@@ -735,7 +735,9 @@ fn read_node_parts(
                 .iter()
                 .map(|q| {
                     let r = q.as_dquat();
-                    rest.iter().map(|&x| r * (x - center) + center - x).collect()
+                    rest.iter()
+                        .map(|&x| r * (x - center) + center - x)
+                        .collect()
                 })
                 .collect();
             let unit = f64::from(face_unit);
@@ -785,7 +787,11 @@ fn joined(a: &FaceDefMesh, b: &FaceDefMesh) -> FaceDefMesh {
         for (i, &v) in e.coord_index.iter().enumerate() {
             let row = rows.entry(v).or_insert_with(|| vec![Vec3::ZERO; n]);
             for (k, r) in row.iter_mut().enumerate() {
-                *r += e.displacements.get(i * n + k).copied().unwrap_or(Vec3::ZERO);
+                *r += e
+                    .displacements
+                    .get(i * n + k)
+                    .copied()
+                    .unwrap_or(Vec3::ZERO);
             }
         }
     }
