@@ -175,10 +175,7 @@ impl<'a> ShareReader<'a> {
             data.check(&acc, "skin", want, None).ok()?;
         }
         // Which joint slots `node` moves.
-        let on_node: Vec<bool> = joints
-            .iter()
-            .map(|&n| descends(&parents, n, node))
-            .collect();
+        let on_node: Vec<bool> = joints.iter().map(|&n| descends(parents, n, node)).collect();
         let reader = prim.reader(|b| source.buffers.get(b.index()).map(Vec::as_slice));
         let js = reader.read_joints(0)?.into_u16();
         let ws = reader.read_weights(0)?.into_f32();

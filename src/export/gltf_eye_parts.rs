@@ -330,7 +330,8 @@ fn fit_turns(
     let mean = rest.iter().copied().sum::<DVec3>() / n;
     let mut weights = Vec::new();
     // Per entry, per border: (rotation, moved positions).
-    let mut fitted: Vec<(TableKey, Vec<f64>, Vec<(DMat3, Vec<DVec3>)>)> = Vec::new();
+    type Fits = Vec<(DMat3, Vec<DVec3>)>;
+    let mut fitted: Vec<(TableKey, Vec<f64>, Fits)> = Vec::new();
     for &(key, e) in entries {
         let k = e.interval_count();
         let slot: Vec<Option<usize>> = vertices
@@ -441,4 +442,87 @@ fn kabsch(from: &[DVec3], to: &[DVec3], mean: DVec3) -> DMat3 {
         r[(1, 2)],
         r[(2, 2)],
     ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fat::bake::{bake_motion, BakeRequest};
+
+    /// An eyeball turned about its centre by two tables (yaw about y, pitch about x), baked
+    /// into per-vertex rows as the cloner bakes them: the fit finds the centre and each
+    /// border's rotation, and the turn between borders stays on the baked rows within the
+    /// bake's tolerance.
+    #[test]
+    fn baked_turns_are_fitted_back_with_their_pivot() {
+        let centre = Vec3::new(0.03, 1.62, 0.08);
+        let rest: Vec<Vec3> = (0..40)
+            .map(|i| {
+                let (a, b) = (i as f32 * 0.7, i as f32 * 1.3);
+                centre + 0.012 * Vec3::new(a.sin() * b.cos(), a.sin() * b.sin(), a.cos())
+            })
+            .collect();
+        let vertices: Vec<u32> = (0..rest.len() as u32).collect();
+        let yaw = TableKey::LowLevel(FapId::new(23).unwrap());
+        let pitch = TableKey::LowLevel(FapId::new(25).unwrap());
+        let turn = |axis: Vec3| {
+            move |p: f64| {
+                Affine3A::from_translation(centre)
+                    * Affine3A::from_axis_angle(axis, (p * 1e-5) as f32)
+                    * Affine3A::from_translation(-centre)
+            }
+        };
+        let bake = |axis: Vec3| {
+            bake_motion(
+                &BakeRequest {
+                    mesh: "eyes",
+                    vertices: &vertices,
+                    neutral: &rest,
+                    range: (-40000.0, 40000.0),
+                    borders: &[],
+                    tolerance: 0.01 * 0.024,
+                },
+                turn(axis),
+            )
+            .entry
+        };
+        let (ey, ep) = (bake(Vec3::Y), bake(Vec3::X));
+        let entries = [(yaw, &ey), (pitch, &ep)];
+        let rest64: Vec<DVec3> = rest.iter().map(|p| p.as_dvec3()).collect();
+        let (c, turns) =
+            fit_turns(&entries, &vertices, &rest64, Affine3A::IDENTITY, 0.024).unwrap();
+        assert!(c.distance(centre) < 1e-5, "{c} vs {centre}");
+        for (t, axis) in turns.iter().zip([Vec3::Y, Vec3::X]) {
+            for (b, q) in t.borders.iter().zip(&t.rotations) {
+                let want = Quat::from_axis_angle(axis, (*b * 1e-5) as f32);
+                assert!(q.angle_between(want) < 1e-4, "{b}: {q} vs {want}");
+            }
+            // Between borders: the played turn against the true one.
+            let part = EyePart {
+                node: 0,
+                mesh: 0,
+                vertices: vertices.clone(),
+                center: c,
+                turns: vec![t.clone()],
+            };
+            for p in [-33333.0, -1234.0, 5000.0, 27000.0] {
+                let a = [Activation {
+                    key: t.key,
+                    value: p,
+                }];
+                let (got, want) = (part.motion(&a), turn(axis)(p));
+                for x in &rest {
+                    let d = got.transform_point3(*x).distance(want.transform_point3(*x));
+                    assert!(d < 1e-4, "{p}: off by {d}");
+                }
+            }
+        }
+        // Rows that are not one turn (every vertex pushed forward) are refused.
+        let mut bent = ey.clone();
+        for (i, d) in bent.displacements.iter_mut().enumerate() {
+            *d += Vec3::Z * 1e-7 * (i % 7) as f32;
+        }
+        let entries = [(yaw, &bent)];
+        assert!(fit_turns(&entries, &vertices, &rest64, Affine3A::IDENTITY, 0.024).is_err());
+    }
 }
