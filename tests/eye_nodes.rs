@@ -4,7 +4,10 @@
 //! of those nodes, reads back with the same FAT, and `play` turns the nodes — never a
 //! rotation and a morph for one motion. Eyeballs skinned to eye joints (`LeftEye`,
 //! `RightEye` under `Head`, ReadyPlayerMe style) turn those joints the same way; a partly
-//! weighted eyeball stays in morph targets with a warning. The head rotations are recorded on
+//! weighted eyeball stays in morph targets with a warning. Both eyeballs in one primitive of
+//! the skinned body (VRM / VRoid), each on its own eye joint, turn those joints by the turn
+//! fitted to the cloner's per-vertex rows (`nodeParts`); partly weighted, they stay baked
+//! with a warning. The head rotations are recorded on
 //! the `Head` joint and read back. The jaw joint takes `open_jaw` in play with every
 //! `open_jaw` target held at zero. VRML and new-document outputs keep the eye motion.
 

@@ -39,9 +39,10 @@ const STRAY_SHARE: f32 = 1e-3;
 /// weighted to it (or the joints below it) by at least 95 % (the usual VRM, Mixamo or
 /// ReadyPlayerMe eye bone). An eye node whose meshes are not one eyeball turned alone by the
 /// FAT (no pupil 3.5/3.6 on them, other feature points or the other pupil on them, an
-/// eyeball partly weighted to it, skin weighted to it, parts of other transforms, an eyeball
-/// the FAT moves vertex by vertex, a `matrix` node) is not used: a warning says why, and its
-/// motion stays in morph targets.
+/// eyeball partly weighted to it, skin weighted to it, parts of other transforms, a `matrix`
+/// node) is not used: a warning says why, and its motion stays in morph targets. An eyeball
+/// that is vertices of a bigger mesh (no transform of its own: the FAT moves it vertex by
+/// vertex) is left to [`super::gltf_eye_parts::eye_parts`].
 pub fn eye_transforms(
     face: &FaceModel,
     source: &GltfSource,
