@@ -61,7 +61,11 @@ impl PartTurn {
             .unwrap_or(n - 2);
         let (a, b) = (self.borders[j], self.borders[j + 1]);
         let t = ((p - a) / (b - a)) as f32;
-        let (qa, qb) = (self.rotations[j], self.rotations[j + 1]);
+        let (qa, mut qb) = (self.rotations[j], self.rotations[j + 1]);
+        // The short way between the two (a fitted quaternion's sign is arbitrary).
+        if qa.dot(qb) < 0.0 {
+            qb = -qb;
+        }
         let (axis, angle) = (qa.inverse() * qb).to_axis_angle();
         (qa * Quat::from_axis_angle(axis, angle * t)).normalize()
     }
@@ -497,6 +501,11 @@ mod tests {
                 let want = Quat::from_axis_angle(axis, (*b * 1e-5) as f32);
                 assert!(q.angle_between(want) < 1e-4, "{b}: {q} vs {want}");
             }
+            // A border's quaternion of the other sign is the same turn.
+            let mut flipped = t.clone();
+            flipped.rotations[1] = -flipped.rotations[1];
+            let mid = (t.borders[1] + t.borders[2]) / 2.0;
+            assert!(flipped.at(mid).angle_between(t.at(mid)) < 1e-5);
             // Between borders: the played turn against the true one.
             let part = EyePart {
                 node: 0,
