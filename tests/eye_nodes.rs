@@ -4,7 +4,10 @@
 //! of those nodes, reads back with the same FAT, and `play` turns the nodes — never a
 //! rotation and a morph for one motion. Eyeballs skinned to eye joints (`LeftEye`,
 //! `RightEye` under `Head`, ReadyPlayerMe style) turn those joints the same way; a partly
-//! weighted eyeball stays in morph targets with a warning. The head rotations are recorded on
+//! weighted eyeball stays in morph targets with a warning. Both eyeballs in one primitive of
+//! the skinned body (VRM / VRoid), each on its own eye joint, turn those joints by the turn
+//! fitted to the cloner's per-vertex rows (`nodeParts`); partly weighted, they stay baked
+//! with a warning. The head rotations are recorded on
 //! the `Head` joint and read back. The jaw joint takes `open_jaw` in play with every
 //! `open_jaw` target held at zero. VRML and new-document outputs keep the eye motion.
 
@@ -889,4 +892,233 @@ fn an_eye_joint_that_moves_skin_too_is_not_used() {
             .any(|t| t["node"] == RIGHT_EYE_JOINT && t["userNode"] == true),
         "{transforms}"
     );
+}
+
+/// The avatar's `Body` with both eyeballs in its `eyes` primitive, skinned to the eye joints
+/// by `share` (the VRM / VRoid layout), cloned from alma into `d`: the glb and csv written,
+/// the output path and the clone's stderr.
+fn clone_vrm_eyes(d: &Path, source: &FaceModel, share: f32) -> (PathBuf, PathBuf, PathBuf, String) {
+    let opts = Options {
+        vrm_eyes: Some(share),
+        ..Options::default()
+    };
+    let (glb, csv) = write_avatar_with(d, source, &opts);
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str(), "-o".as_ref()])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    (glb, csv, out, stderr)
+}
+
+/// Both eyeballs in one primitive of the skinned `Body`, each weighted wholly to its eye joint
+/// (VRM / VRoid): the joints show the eyes' turns. No eyeball target is written, the scene
+/// record lists each eyeball as a part its joint turns (`nodeParts`), the glb reads back with
+/// the clone's FAT (`face diff` equal), and `play` turns the joints so that the eyeballs
+/// posed by them (joint world × inverse bind, i.e. the joint's motion applied to the rest
+/// vertices) land where the FAT read back puts them within 1 % of the eyeball's size (2.4 cm
+/// across: the joint composes yaw and pitch where the FAT adds their displacements, 0.5 %
+/// at the stream's 0.13 rad mixed frame). The files add no validator issue, and three.js and
+/// Blender load the played one with its `play` clip.
+#[test]
+fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (glb, csv, out, stderr) = clone_vrm_eyes(d, &source, 1.0);
+    assert!(!stderr.contains("eye node"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    // No target for the turns (23–26); the thrusts (27, 28) stay targets.
+    let turns = [
+        "yaw_l_eyeball",
+        "yaw_r_eyeball",
+        "pitch_l_eyeball",
+        "pitch_r_eyeball",
+    ];
+    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
+    assert!(!turns.iter().any(|t| names.contains(t)), "{names}");
+    let record = &patched["scenes"][0]["extras"]["fbakit"];
+    let parts = record["nodeParts"].as_array().expect("nodeParts");
+    assert_eq!(parts.len(), 2, "{}", record["nodeParts"]);
+    let part_of = |node: usize| {
+        parts
+            .iter()
+            .find(|p| p["node"] == node)
+            .unwrap_or_else(|| panic!("no part on joint {node}"))
+    };
+    for (node, keys) in [
+        (LEFT_EYE_JOINT, ["yaw_l_eyeball", "pitch_l_eyeball"]),
+        (RIGHT_EYE_JOINT, ["yaw_r_eyeball", "pitch_r_eyeball"]),
+    ] {
+        let p = part_of(node);
+        assert_eq!(p["userNode"], true);
+        let tables = p["tables"].to_string();
+        for k in keys {
+            assert!(tables.contains(k), "{k}: {tables}");
+        }
+    }
+
+    // Read back: the clone's FAT.
+    let target = fbakit::face::read_with(&glb, &FaceReadOptions::with_feature_points(Some(&csv)))
+        .unwrap()
+        .0;
+    let cloned = clone_face(&source, &target, &CloneOptions::default())
+        .unwrap()
+        .face;
+    let back = fbakit::face::read(&out).unwrap();
+    let report = diff(&cloned, &back, &DiffOptions::default());
+    assert!(report.equal, "{report}");
+
+    // Play a gaze stream: the joints turn the eyeballs where the FAT puts them.
+    let gaze = write_gaze(d);
+    let played = d.join("played.glb");
+    let o = support::cli::command()
+        .args([
+            "play".as_ref(),
+            out.as_os_str(),
+            gaze.as_os_str(),
+            "-o".as_ref(),
+        ])
+        .arg(&played)
+        .output()
+        .unwrap();
+    let play_err = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{play_err}");
+    assert!(!play_err.contains("eye node"), "{play_err}");
+    let (pj, bin) = glb_parts(&played);
+    let names = pj["meshes"][0]["extras"]["targetNames"].to_string();
+    assert!(!turns.iter().any(|t| names.contains(t)), "{names}");
+    let play = pj["animations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "play")
+        .unwrap()
+        .clone();
+    let channel = |node: usize, path: &str| {
+        play["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["target"]["node"] == node && c["target"]["path"] == path)
+            .map(|c| {
+                let s = &play["samplers"][c["sampler"].as_u64().unwrap() as usize];
+                floats(&pj, &bin, s["output"].as_u64().unwrap() as usize)
+            })
+    };
+    // Both pupils on the one eyes mesh.
+    let (mesh, _) = back.fp_vertex(FeaturePointId::FP_3_5).unwrap();
+    assert_eq!(back.fp_vertex(FeaturePointId::FP_3_6).unwrap().0, mesh);
+    let neutral = back.neutral_world_positions();
+    for node in [LEFT_EYE_JOINT, RIGHT_EYE_JOINT] {
+        let vertices: Vec<usize> = part_of(node)["vertices"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_u64().unwrap() as usize)
+            .collect();
+        let rest: Vec<Vec3> = vertices.iter().map(|&v| neutral[mesh][v]).collect();
+        let lo = rest
+            .iter()
+            .fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
+        let hi = rest
+            .iter()
+            .fold(Vec3::splat(f32::NEG_INFINITY), |a, &b| a.max(b));
+        let size = (hi - lo).max_element();
+        let rot = channel(node, "rotation").unwrap_or_else(|| panic!("joint {node} not turned"));
+        let tr = channel(node, "translation");
+        assert!(rot.len() >= 4 * GAZE.len());
+        let rest_world = node_world(&pj, node, &|_| None);
+        let mut worst = 0.0f32;
+        for (k, v) in GAZE.iter().enumerate() {
+            let q = Quat::from_slice(&rot[4 * k..4 * k + 4]);
+            let t = tr.as_ref().map(|t| Vec3::from_slice(&t[3 * k..3 * k + 3]));
+            let world = node_world(&pj, node, &|i| (i == node).then_some((q, t)));
+            let motion = world * rest_world.inverse();
+            let posed = back.pose(&gaze_activations(v)).unwrap();
+            let mut moved = 0.0f32;
+            for (&vi, &p) in vertices.iter().zip(&rest) {
+                let got = motion.transform_point3(p);
+                let want = posed[mesh][vi];
+                moved = moved.max(want.distance(p));
+                worst = worst.max(got.distance(want) / size);
+            }
+            eprintln!("joint {node} frame {k}: FAT moves the eyeball {moved}, worst {worst}");
+            if v.iter().any(|&x| x != 0) {
+                assert!(
+                    moved > 0.02 * size,
+                    "frame {k}: the FAT does not turn the eye"
+                );
+            }
+        }
+        assert!(
+            worst <= 0.01,
+            "joint {node}: off by {worst} of the eyeball's size"
+        );
+    }
+    // No turn weights are keyed: the played `Body` has no target for them at all.
+    assert!(channel(LEFT_EYE_JOINT, "weights").is_none());
+
+    let files = [glb.clone(), out.clone(), played.clone()];
+    if let Some(reports) = support::validator::validate(&files) {
+        let issues = |r: &Value| (r["errors"].clone(), r["warnings"].clone());
+        assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
+        assert_eq!(issues(&reports[0]), issues(&reports[2]), "{}", reports[2]);
+    }
+    if let Some(text) = support::node_check::run_node_check(
+        "gltf-loaders-check.mjs",
+        [&played],
+        &[
+            ("THREE_DIR", "target/gltf-loaders"),
+            ("VIEWER_BROWSER_DIR", "target/viewer-browser"),
+        ],
+        "GLTF_LOADERS_REQUIRED",
+        "three.js loader",
+    ) {
+        let r: Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+        assert!(r.get("loadError").is_none(), "{}", r["loadError"]);
+        assert_eq!(r["pageErrors"], Value::Array(vec![]), "{r}");
+        let clip = r["animations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|a| a["name"] == "play")
+            .unwrap_or_else(|| panic!("no play clip: {r}"));
+        assert!(
+            clip["tracks"].as_array().is_some_and(|t| !t.is_empty()),
+            "{clip}"
+        );
+    }
+    if let Some(r) = support::blender::import_in_blender(&[&played]) {
+        let actions = r[0]["actions"].to_string();
+        assert!(actions.contains("play"), "{actions}");
+    }
+}
+
+/// Both eyeballs in one primitive weighted to their eye joints by 60 % only: the joints
+/// cannot turn them; the eye motion stays baked in morph targets, with one warning per joint
+/// saying why.
+#[test]
+fn eyeballs_in_one_primitive_partly_weighted_stay_baked_and_are_said_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let (_, _, out, stderr) = clone_vrm_eyes(d, &source, 0.6);
+    for joint in ["LeftEye", "RightEye"] {
+        let said = format!("eye node `{joint}` is not turned (the eyeball in mesh ");
+        assert_eq!(stderr.matches(&said).count(), 1, "{joint}: {stderr}");
+    }
+    assert!(stderr.contains("by 60 % only"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
+    for name in ["yaw_l_eyeball", "yaw_r_eyeball", "pitch_l_eyeball"] {
+        assert!(names.contains(name), "{name}: {names}");
+    }
+    assert!(patched["scenes"][0]["extras"]["fbakit"]
+        .get("nodeParts")
+        .is_none());
 }

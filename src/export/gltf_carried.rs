@@ -100,6 +100,7 @@ impl Shares {
 /// The share (0–1) of every vertex of the document's `mesh`/`primitive`, instanced by
 /// `mesh_node`, that `node` moves: its skin weight on `node` and the joints below it, or all
 /// or nothing for a plain mesh; `None` when the document cannot say (unreadable weights).
+/// One look-up: [`ShareReader`] answers many from one parse of the document.
 pub fn primitive_shares(
     source: &GltfSource,
     mesh_node: Option<usize>,
@@ -107,66 +108,100 @@ pub fn primitive_shares(
     primitive: usize,
     node: usize,
 ) -> Option<Shares> {
-    let json = &source.json;
-    let parents = node_parents(json);
-    let Some(mesh_node) = mesh_node else {
-        return Some(Shares::All(0.0));
-    };
-    let Some(skin) = json["nodes"][mesh_node]["skin"].as_u64() else {
-        let carried = descends(&parents, mesh_node, node);
-        return Some(Shares::All(if carried { 1.0 } else { 0.0 }));
-    };
-    let joints: Vec<usize> = json["skins"][skin as usize]["joints"]
-        .as_array()?
-        .iter()
-        .filter_map(|j| j.as_u64().map(|j| j as usize))
-        .collect();
-    let root = gltf::json::Root::deserialize(json).ok()?;
-    let doc = gltf::Document::from_json_without_validation(root);
-    let prim = doc.meshes().nth(mesh)?.primitives().nth(primitive)?;
-    // The skin's accessors checked before the reader trusts them (a short or mistyped one
-    // would make it stop or panic).
-    let data = AccessorData {
-        file: &source.path,
-        buffers: &source.buffers,
-    };
-    for (semantic, want) in [
-        (Semantic::Joints(0), Want::Joints),
-        (Semantic::Weights(0), Want::Weights),
-    ] {
-        let acc = prim.get(&semantic)?;
-        data.check(&acc, "skin", want, None).ok()?;
+    ShareReader::new(source).shares(mesh_node, mesh, primitive, node)
+}
+
+/// [`primitive_shares`] for many primitives and nodes of one document: the node tree is read
+/// once, and the document parsed for its accessors once, when a skinned primitive first asks
+/// (a plain mesh needs only the tree).
+pub struct ShareReader<'a> {
+    source: &'a GltfSource,
+    parents: Vec<Option<usize>>,
+    doc: std::cell::OnceCell<Option<gltf::Document>>,
+}
+
+impl<'a> ShareReader<'a> {
+    /// A reader of `source`'s shares.
+    pub fn new(source: &'a GltfSource) -> ShareReader<'a> {
+        ShareReader {
+            source,
+            parents: node_parents(&source.json),
+            doc: std::cell::OnceCell::new(),
+        }
     }
-    // Which joint slots `node` moves.
-    let on_node: Vec<bool> = joints
-        .iter()
-        .map(|&n| descends(&parents, n, node))
-        .collect();
-    let reader = prim.reader(|b| source.buffers.get(b.index()).map(Vec::as_slice));
-    let js = reader.read_joints(0)?.into_u16();
-    let ws = reader.read_weights(0)?.into_f32();
-    let shares = js
-        .zip(ws)
-        .map(|(js, ws)| {
-            // fold from +0: an empty f32 `sum` is −0, which prints as "-0 %".
-            let total = ws
-                .iter()
-                .filter(|w| w.is_finite())
-                .fold(0.0f32, |a, w| a + w);
-            if total <= 0.0 {
-                return 0.0;
-            }
-            let on = js
-                .iter()
-                .zip(ws)
-                .filter(|(j, w)| {
-                    w.is_finite() && on_node.get(usize::from(**j)).copied().unwrap_or(false)
-                })
-                .fold(0.0f32, |a, (_, w)| a + w);
-            on / total
-        })
-        .collect();
-    Some(Shares::PerVertex(shares))
+
+    /// [`primitive_shares`] of this document.
+    pub fn shares(
+        &self,
+        mesh_node: Option<usize>,
+        mesh: usize,
+        primitive: usize,
+        node: usize,
+    ) -> Option<Shares> {
+        let source = self.source;
+        let json = &source.json;
+        let parents = &self.parents;
+        let Some(mesh_node) = mesh_node else {
+            return Some(Shares::All(0.0));
+        };
+        let Some(skin) = json["nodes"][mesh_node]["skin"].as_u64() else {
+            let carried = descends(parents, mesh_node, node);
+            return Some(Shares::All(if carried { 1.0 } else { 0.0 }));
+        };
+        let joints: Vec<usize> = json["skins"][skin as usize]["joints"]
+            .as_array()?
+            .iter()
+            .filter_map(|j| j.as_u64().map(|j| j as usize))
+            .collect();
+        let doc = self
+            .doc
+            .get_or_init(|| {
+                let root = gltf::json::Root::deserialize(json).ok()?;
+                Some(gltf::Document::from_json_without_validation(root))
+            })
+            .as_ref()?;
+        let prim = doc.meshes().nth(mesh)?.primitives().nth(primitive)?;
+        // The skin's accessors checked before the reader trusts them (a short or mistyped one
+        // would make it stop or panic).
+        let data = AccessorData {
+            file: &source.path,
+            buffers: &source.buffers,
+        };
+        for (semantic, want) in [
+            (Semantic::Joints(0), Want::Joints),
+            (Semantic::Weights(0), Want::Weights),
+        ] {
+            let acc = prim.get(&semantic)?;
+            data.check(&acc, "skin", want, None).ok()?;
+        }
+        // Which joint slots `node` moves.
+        let on_node: Vec<bool> = joints.iter().map(|&n| descends(parents, n, node)).collect();
+        let reader = prim.reader(|b| source.buffers.get(b.index()).map(Vec::as_slice));
+        let js = reader.read_joints(0)?.into_u16();
+        let ws = reader.read_weights(0)?.into_f32();
+        let shares = js
+            .zip(ws)
+            .map(|(js, ws)| {
+                // fold from +0: an empty f32 `sum` is −0, which prints as "-0 %".
+                let total = ws
+                    .iter()
+                    .filter(|w| w.is_finite())
+                    .fold(0.0f32, |a, w| a + w);
+                if total <= 0.0 {
+                    return 0.0;
+                }
+                let on = js
+                    .iter()
+                    .zip(ws)
+                    .filter(|(j, w)| {
+                        w.is_finite() && on_node.get(usize::from(**j)).copied().unwrap_or(false)
+                    })
+                    .fold(0.0f32, |a, (_, w)| a + w);
+                on / total
+            })
+            .collect();
+        Some(Shares::PerVertex(shares))
+    }
 }
 
 #[cfg(test)]

@@ -11,7 +11,10 @@
 //! FAT motion of transforms (rigid parts turned by the cloner) is shown by the user's own
 //! node where the document has one for it — an eyeball alone under an eye node or skinned to
 //! an eye joint ([`super::gltf_user_nodes`]), the head rotations' transform on the head
-//! node: animated on that node and recorded, not baked. Otherwise it
+//! node: animated on that node and recorded, not baked. Eyeballs that are vertices of a bigger
+//! mesh (VRM: both in one primitive), which the cloner baked into per-vertex rows, are shown
+//! by the eye joints that carry them alone the same way ([`super::gltf_eye_parts`]): their
+//! rows under the eye's yaw and pitch leave the targets. Otherwise transform motion
 //! has no node of its own in the user's document: it is baked into per-vertex targets,
 //! piecewise linear over
 //! `±2 V` in 8 intervals for rotations (`V` the key's reference value), one interval for
@@ -25,10 +28,11 @@
 use std::collections::BTreeMap;
 
 use glam::{Affine3A, Quat, Vec3};
-use serde_json::Map;
+use serde_json::{Map, Value};
 
 use super::gltf::FaceMorphs;
 use super::gltf_carried::carries_point;
+use super::gltf_eye_parts::{eye_parts, EyePart};
 use super::gltf_rotations::{
     head_node, jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes, HEAD_FAPS,
 };
@@ -210,6 +214,17 @@ pub fn patch_face(
         transform_nodes[t] = Some(n);
         user_nodes[t] = true;
     }
+    // Eyeballs that are vertices of a bigger mesh, turned by the eye joints carrying them:
+    // their rows under the eye's tables leave the targets (never a rotation and a morph).
+    let shown: Vec<usize> = transform_nodes.iter().flatten().copied().collect();
+    let parts = eye_parts(face, source, nodes, &shown, &mut warnings);
+    let parted;
+    let face = if parts.is_empty() {
+        face
+    } else {
+        parted = without_parts(face, &parts);
+        &parted
+    };
     // A head node of the user's (named, or found by its usual names and carrying the nose
     // tip) turns the head: the head rotations (48–50) are left to it, not baked into morph
     // targets (never a rotation and a morph for one motion). A face without a nose tip or
@@ -402,10 +417,21 @@ pub fn patch_face(
     }
     patch.scene_extras = gltf_fat::scene_record(face, unit, &transform_nodes);
     gltf_fat::mark_user_nodes(&mut patch.scene_extras, &user_nodes);
+    if !parts.is_empty() {
+        if let Some(Value::Object(record)) = patch.scene_extras.get_mut(gltf_fat::KEY) {
+            let list = parts.iter().map(|p| p.record(face, unit)).collect();
+            record.insert("nodeParts".into(), Value::Array(list));
+        }
+    }
     if let Some(frames) = frames.filter(|f| !f.is_empty()) {
         // The jaw joint, when there is one, takes open_jaw, thrust_jaw and shift_jaw over
         // from the targets (never a joint and a morph for one motion).
-        let driven: Vec<usize> = transform_nodes.iter().flatten().copied().collect();
+        let driven: Vec<usize> = transform_nodes
+            .iter()
+            .flatten()
+            .copied()
+            .chain(parts.iter().map(|p| p.node))
+            .collect();
         let jaw = match jaw_node(source, face, nodes.jaw.as_deref(), unit, &driven) {
             Ok(Some(jaw)) => node_takes(
                 NodeCheck {
@@ -445,7 +471,9 @@ pub fn patch_face(
             frames
         };
         patch.animation = animation(source, &meshes, &layouts, weight_frames);
-        let turned = rotated_nodes(source, &face.fat, nodes);
+        let mut turned = rotated_nodes(source, &face.fat, nodes);
+        // Eye joints turning eyeball parts take the eye FAPs by the parts' fitted turns.
+        turned.retain(|n| !parts.iter().any(|p| p.node == n.node));
         if !turned.is_empty() {
             let anim = patch
                 .animation
@@ -467,6 +495,7 @@ pub fn patch_face(
             frames,
             &mut patch.animation,
         );
+        part_channels(&parts, source, unit, frames, &mut patch.animation);
         if let Some(jaw) = &jaw {
             let anim = patch
                 .animation
@@ -492,6 +521,68 @@ pub fn patch_face(
         morph_targets,
         warnings,
     })
+}
+
+/// `face` without the rows of `parts` (vertices a user's node turns) in the tables they take;
+/// the tables stay, so nothing else takes their FAPs for those nodes.
+fn without_parts(face: &FaceModel, parts: &[EyePart]) -> FaceModel {
+    let mut out = face.clone();
+    for table in &mut out.fat.tables {
+        for p in parts.iter().filter(|p| p.takes(table.key)) {
+            let name = &face.meshes[p.mesh].name;
+            for e in table.meshes.iter_mut().filter(|e| &e.mesh == name) {
+                let k = e.interval_count();
+                let mut coord = Vec::with_capacity(e.coord_index.len());
+                let mut rows = Vec::with_capacity(e.displacements.len());
+                for (i, &v) in e.coord_index.iter().enumerate() {
+                    if p.vertices.binary_search(&v).is_err() {
+                        coord.push(v);
+                        rows.extend_from_slice(&e.displacements[i * k..(i + 1) * k]);
+                    }
+                }
+                e.coord_index = coord;
+                e.displacements = rows;
+            }
+            table.meshes.retain(|e| !e.coord_index.is_empty());
+        }
+    }
+    out
+}
+
+/// Rotation (and, for a pivot off the node's origin, translation) channels on the nodes
+/// turning `parts`: each part's motion in the face frame carried onto its node's rest pose
+/// ([`UserNode`]), lengths × `unit`.
+fn part_channels(
+    parts: &[EyePart],
+    source: &GltfSource,
+    unit: f32,
+    frames: &[AnimationFrame],
+    animation: &mut Option<PatchAnimation>,
+) {
+    let keyed = keyed_frames(frames);
+    let s = Affine3A::from_scale(Vec3::splat(unit));
+    for p in parts {
+        let Some(frame) = UserNode::new(&source.json, p.node) else {
+            continue;
+        };
+        let anim = animation.get_or_insert_with(|| empty_animation(frames));
+        if anim.rotations.iter().any(|(n, _)| *n == p.node) {
+            continue;
+        }
+        let keys: Vec<(Quat, Vec3)> = keyed
+            .iter()
+            .map(|f| frame.local(s * p.motion(&f.activations) * s.inverse()))
+            .collect();
+        let mut values: Vec<Quat> = keys.iter().map(|k| k.0).collect();
+        same_hemisphere(&mut values);
+        anim.rotations.push((p.node, values));
+        let t0 = frame.rest_translation();
+        let reach = 1e-6 * (t0.length() + unit);
+        if keys.iter().any(|k| k.1.distance(t0) > reach) {
+            anim.translations
+                .push((p.node, keys.iter().map(|k| k.1).collect()));
+        }
+    }
 }
 
 /// `face` without the transform entries of its head rotation tables (48–50) on transforms

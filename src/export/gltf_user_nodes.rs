@@ -18,10 +18,11 @@
 use glam::{Affine3A, Mat4, Quat, Vec3};
 use serde_json::Value;
 
-use super::gltf_carried::primitive_shares;
+use super::gltf_carried::ShareReader;
 use super::gltf_rotations::{eye_nodes, world_matrices, RotationNodes};
 use crate::error::Diagnostic;
 use crate::face::FaceModel;
+use crate::fat::TableKey;
 use crate::gltf::source::GltfSource;
 use crate::spec::FeaturePointId;
 
@@ -38,9 +39,10 @@ const STRAY_SHARE: f32 = 1e-3;
 /// weighted to it (or the joints below it) by at least 95 % (the usual VRM, Mixamo or
 /// ReadyPlayerMe eye bone). An eye node whose meshes are not one eyeball turned alone by the
 /// FAT (no pupil 3.5/3.6 on them, other feature points or the other pupil on them, an
-/// eyeball partly weighted to it, skin weighted to it, parts of other transforms, an eyeball
-/// the FAT moves vertex by vertex, a `matrix` node) is not used: a warning says why, and its
-/// motion stays in morph targets.
+/// eyeball partly weighted to it, skin weighted to it, parts of other transforms, a `matrix`
+/// node) is not used: a warning says why, and its motion stays in morph targets. An eyeball
+/// that is vertices of a bigger mesh (no transform of its own: the FAT moves it vertex by
+/// vertex) is left to [`super::gltf_eye_parts::eye_parts`].
 pub fn eye_transforms(
     face: &FaceModel,
     source: &GltfSource,
@@ -50,10 +52,21 @@ pub fn eye_transforms(
 ) -> Vec<(usize, usize)> {
     let (left, right) = eye_nodes(source, names);
     let json = &source.json;
+    let reader = ShareReader::new(source);
     let mut out = Vec::new();
-    for (node, pupil, other) in [
-        (left, FeaturePointId::FP_3_5, FeaturePointId::FP_3_6),
-        (right, FeaturePointId::FP_3_6, FeaturePointId::FP_3_5),
+    for (node, pupil, other, faps) in [
+        (
+            left,
+            FeaturePointId::FP_3_5,
+            FeaturePointId::FP_3_6,
+            [23, 25, 27],
+        ),
+        (
+            right,
+            FeaturePointId::FP_3_6,
+            FeaturePointId::FP_3_5,
+            [24, 26, 28],
+        ),
     ] {
         let Some(node) = node.filter(|n| !taken.contains(&Some(*n))) else {
             continue;
@@ -79,7 +92,7 @@ pub fn eye_transforms(
                 let Some(part) = source.part(&m.name) else {
                     return vec![0.0; n];
                 };
-                match primitive_shares(source, part.node, part.mesh, part.primitive, node) {
+                match reader.shares(part.node, part.mesh, part.primitive, node) {
                     Some(s) => s.of(n),
                     None => {
                         unreadable.get_or_insert_with(|| m.name.clone());
@@ -105,27 +118,32 @@ pub fn eye_transforms(
             .map(|(m, _)| m)
             .filter(|m| under.contains(m));
         let Some(transform) = face.meshes[pupil_mesh.unwrap_or(under[0])].transform else {
-            if let Some(m) = pupil_mesh {
-                // A one-primitive eyes mesh cut apart and baked by the cloner.
-                warnings.push(refuse(format!(
-                    "its eyeball is vertices of mesh `{}`, which the FAT moves vertex by vertex",
-                    face.meshes[m].name
-                )));
-            }
+            // No transform of its own: an eyeball that is vertices of a bigger mesh (a
+            // one-primitive eyes mesh cut apart and baked by the cloner) is left to
+            // `gltf_eye_parts`.
             continue;
         };
-        if !face
-            .fat
-            .tables
-            .iter()
-            .flat_map(|t| &t.transforms)
-            .any(|x| face.transform_index(&x.transform) == Some(transform))
-        {
+        let moves = |eye: bool| {
+            face.fat
+                .tables
+                .iter()
+                .filter(|t| {
+                    !eye || matches!(t.key, TableKey::LowLevel(f) if faps.contains(&f.number()))
+                })
+                .flat_map(|t| &t.transforms)
+                .any(|x| face.transform_index(&x.transform) == Some(transform))
+        };
+        if !moves(false) {
             // The FAT does not move it: nothing to animate.
             continue;
         }
         if pupil_mesh.is_none() {
             warnings.push(refuse(format!("its mesh holds no pupil {pupil}")));
+            continue;
+        }
+        if !moves(true) {
+            // Not the eye's own transform (the mesh hangs under the head's): its eyeball is
+            // vertices of the mesh, left to `gltf_eye_parts`.
             continue;
         }
         let skin_on = face

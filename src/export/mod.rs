@@ -23,6 +23,7 @@ pub mod budget;
 mod error;
 pub mod gltf;
 pub mod gltf_carried;
+pub mod gltf_eye_parts;
 pub mod gltf_patch;
 pub mod gltf_rotations;
 pub mod gltf_user_nodes;

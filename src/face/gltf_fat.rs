@@ -7,18 +7,21 @@
 //! - `scene.extras.fbakit`: `version`, `featurePoints` (label, position in the file's world
 //!   frame, and the face mesh and vertices it is bound to) and `fapu` (the five distances);
 //!   for faces with transforms or polygons other than triangles also `faceUnit`,
-//!   `transforms`, `meshes` (order, transform, polygon run lengths) and `transformTables`.
+//!   `transforms`, `meshes` (order, transform, polygon run lengths) and `transformTables`;
+//!   `nodeParts` for mesh parts a user's node turns (eyeballs in one primitive on the VRM
+//!   eye joints), whose rows are rebuilt from the recorded rotations.
 //!
 //! Reading back: a target's offsets divided by its span are the rates of its interval; the
 //! targets of one `(key, borders)` on one primitive make one `FaceDefMesh`.
 
 use std::collections::BTreeMap;
 
-use glam::{Quat, Vec3};
+use glam::{DVec3, Quat, Vec3};
 use serde_json::{json, Map, Value};
 
 use super::{FaceModel, FaceTransform};
 use crate::error::Result;
+use crate::fat::bake::on_borders;
 use crate::fat::{FaceDefMesh, FaceDefTable, FaceDefTransform, Fat, TableKey, TransformField};
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
 use crate::gltf::source::RestPose;
@@ -607,6 +610,7 @@ pub fn read_records(rig: &Rig) -> Result<Option<FaceRecords>> {
             }
         }
     }
+    read_node_parts(rig, scene, &scene_at, face_unit, &mut by_key)?;
     let (transforms, meshes) = read_structure(rig, scene, &scene_at)?;
     for (i, t) in scene["transformTables"]
         .as_array()
@@ -643,6 +647,160 @@ pub fn read_records(rig: &Rig) -> Result<Option<FaceRecords>> {
         transforms,
         meshes,
     }))
+}
+
+/// The per-vertex rows of the recorded `nodeParts` (mesh parts a user's node turns: eyeballs
+/// in one primitive on the VRM eye joints), added to `by_key`: each vertex's displacement at
+/// each border is the recorded rotation about the recorded centre applied to its rest
+/// position (file world frame), and the rates between borders are in face units like the
+/// targets' rows.
+fn read_node_parts(
+    rig: &Rig,
+    scene: &Value,
+    scene_at: &str,
+    face_unit: f32,
+    by_key: &mut BTreeMap<TableKey, FaceDefTable>,
+) -> Result<()> {
+    for (i, p) in scene["nodeParts"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
+        let at = format!("{scene_at}.nodeParts[{i}]");
+        let mesh = p["mesh"]
+            .as_str()
+            .and_then(|n| rig.meshes.iter().find(|m| m.name == n))
+            .ok_or_else(|| bad(rig, &format!("{at}.mesh"), "must name a face mesh"))?;
+        let count = mesh.mesh.positions.len();
+        let vertices: Vec<u32> = p["vertices"]
+            .as_array()
+            .and_then(|a| {
+                a.iter()
+                    .map(|x| {
+                        x.as_u64()
+                            .filter(|&v| (v as usize) < count)
+                            .map(|v| v as u32)
+                    })
+                    .collect::<Option<Vec<u32>>>()
+            })
+            .ok_or_else(|| {
+                bad(
+                    rig,
+                    &format!("{at}.vertices"),
+                    "must be vertex indices of the mesh",
+                )
+            })?;
+        let center = vec3_field(rig, p, &at, "center")?.as_dvec3();
+        let rest: Vec<DVec3> = vertices
+            .iter()
+            .map(|&v| mesh.mesh.positions[v as usize].as_dvec3())
+            .collect();
+        for (j, t) in p["tables"].as_array().into_iter().flatten().enumerate() {
+            let at = format!("{at}.tables[{j}]");
+            let key = t["key"]
+                .as_str()
+                .and_then(TableKey::from_name)
+                .ok_or_else(|| {
+                    bad(
+                        rig,
+                        &format!("{at}.key"),
+                        "not a FAP, viseme or expression name",
+                    )
+                })?;
+            let borders: Vec<f64> = t["borders"]
+                .as_array()
+                .and_then(|a| a.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>())
+                .filter(|b| b.len() >= 2 && b.windows(2).all(|w| w[0] < w[1]))
+                .ok_or_else(|| {
+                    bad(
+                        rig,
+                        &format!("{at}.borders"),
+                        "must be two or more increasing numbers",
+                    )
+                })?;
+            let rotations: Vec<Quat> = t["rotations"]
+                .as_array()
+                .and_then(|a| a.iter().map(quat).collect::<Option<Vec<Quat>>>())
+                .filter(|r| r.len() == borders.len())
+                .ok_or_else(|| {
+                    bad(
+                        rig,
+                        &format!("{at}.rotations"),
+                        "must be one quaternion per border",
+                    )
+                })?;
+            // Each vertex's displacement at each border, then the rates between borders.
+            let at_border: Vec<Vec<DVec3>> = rotations
+                .iter()
+                .map(|q| {
+                    let r = q.as_dquat();
+                    rest.iter()
+                        .map(|&x| r * (x - center) + center - x)
+                        .collect()
+                })
+                .collect();
+            let unit = f64::from(face_unit);
+            let n = borders.len() - 1;
+            let displacements: Vec<Vec3> = (0..vertices.len())
+                .flat_map(|v| {
+                    let at_border = &at_border;
+                    let borders = &borders;
+                    (0..n).map(move |k| {
+                        ((at_border[k + 1][v] - at_border[k][v])
+                            / ((borders[k + 1] - borders[k]) * unit))
+                            .as_vec3()
+                    })
+                })
+                .collect();
+            let table = by_key.entry(key).or_insert_with(|| FaceDefTable::new(key));
+            let entry = FaceDefMesh {
+                mesh: mesh.name.clone(),
+                interval_borders: borders,
+                coord_index: vertices.clone(),
+                displacements,
+            };
+            match table.meshes.iter_mut().find(|m| m.mesh == entry.mesh) {
+                Some(old) => *old = joined(old, &entry),
+                None => table.meshes.push(entry),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Two entries of one mesh as one: both on the union of their borders, rates of a vertex in
+/// both added.
+fn joined(a: &FaceDefMesh, b: &FaceDefMesh) -> FaceDefMesh {
+    let mut borders: Vec<f64> = a
+        .interval_borders
+        .iter()
+        .chain(&b.interval_borders)
+        .copied()
+        .collect();
+    borders.sort_by(f64::total_cmp);
+    borders.dedup();
+    let (a, b) = (on_borders(a, &borders), on_borders(b, &borders));
+    let n = borders.len().saturating_sub(1);
+    let mut rows: BTreeMap<u32, Vec<Vec3>> = BTreeMap::new();
+    for e in [&a, &b] {
+        for (i, &v) in e.coord_index.iter().enumerate() {
+            let row = rows.entry(v).or_insert_with(|| vec![Vec3::ZERO; n]);
+            for (k, r) in row.iter_mut().enumerate() {
+                *r += e
+                    .displacements
+                    .get(i * n + k)
+                    .copied()
+                    .unwrap_or(Vec3::ZERO);
+            }
+        }
+    }
+    FaceDefMesh {
+        mesh: a.mesh.clone(),
+        interval_borders: borders,
+        coord_index: rows.keys().copied().collect(),
+        displacements: rows.into_values().flatten().collect(),
+    }
 }
 
 type Structure = (Vec<FaceTransform>, Vec<MeshRecord>);

@@ -11,7 +11,8 @@
 //! optionally a tongue after the rows ([`Options::tongue`]).
 //!
 //! Other variants move the eyeballs onto nodes of their own ([`Options::eye_nodes`]) or skin
-//! them to eye joints ([`Options::skinned_eyes`]).
+//! them to eye joints ([`Options::skinned_eyes`]), or keep both eyeballs in `Body`'s `eyes`
+//! primitive skinned to two eye joints, the VRM / VRoid layout ([`Options::vrm_eyes`]).
 //!
 //! The jaw's inverse bind matrix was taken half a centimetre higher than the jaw rests, so the
 //! mouth's vertices (weighted to jaw and head) are placed per vertex at rest; the other joints
@@ -99,6 +100,12 @@ pub struct Options {
     /// ReadyPlayerMe and Mixamo avatars have them: `Some(share)` weights each eyeball vertex
     /// to its eye joint by `share`, the rest to `Head`. Not with [`Options::eye_nodes`].
     pub skinned_eyes: Option<f32>,
+    /// Both eyeballs stay in `Body`'s `eyes` primitive, each skinned to its own eye joint
+    /// `LeftEye` / `RightEye` ([`LEFT_EYE_JOINT`], [`RIGHT_EYE_JOINT`]: the same joints as
+    /// [`Options::skinned_eyes`], skin slots 4 and 5), as VRM / VRoid avatars hold them:
+    /// `Some(share)` weights each eyeball vertex to its eye joint by `share`, the rest to
+    /// `Head`. Not with the other eye options.
+    pub vrm_eyes: Option<f32>,
 }
 
 /// With [`Options::skinned_eyes`]: the eye joints and the nodes of the eye meshes (indices).
@@ -281,6 +288,15 @@ pub fn teeth_fp_lines() -> String {
 /// The primitives of `Body` with `opts`.
 pub fn body_prims_with(opts: &Options) -> Vec<Prim> {
     let mut prims = body_prims();
+    if let Some(share) = opts.vrm_eyes {
+        // `eyes` holds the right eyeball, then the left ([`body_prims`]).
+        let eyes = &mut prims[2];
+        let half = eyes.positions.len() / 2;
+        for (v, j) in eyes.joints.iter_mut().enumerate() {
+            let slot = if v < half { 5u8 } else { 4u8 };
+            *j = [(slot, share), (2, 1.0 - share)];
+        }
+    }
     if opts.teeth {
         prims.push(if opts.tongue {
             teeth_prim_with_tongue()
@@ -576,6 +592,10 @@ pub fn build_with(opts: &Options) -> Avatar {
     }
     // The eye meshes of `Options::skinned_eyes`: each sphere in the armature's centimetres
     // like `Body`, weighted to its eye joint (slot 4 left, 5 right) and the head (slot 2).
+    assert!(
+        opts.vrm_eyes.is_none() || !(opts.eye_nodes || opts.skinned_eyes.is_some()),
+        "one eye layout"
+    );
     if let Some(share) = opts.skinned_eyes {
         assert!(!opts.eye_nodes, "eye nodes or skinned eyes, not both");
         for (left, slot) in [(true, 4u8), (false, 5u8)] {
@@ -626,7 +646,7 @@ pub fn build_with(opts: &Options) -> Avatar {
         };
         ibm.extend((bind.inverse() * armature).to_cols_array());
     }
-    if opts.skinned_eyes.is_some() {
+    if opts.skinned_eyes.is_some() || opts.vrm_eyes.is_some() {
         for left in [true, false] {
             ibm.extend((eye_joint_world(left).inverse() * armature).to_cols_array());
         }
@@ -730,6 +750,15 @@ pub fn build_with(opts: &Options) -> Avatar {
             nodes.push(json!({"name": name, "mesh": mesh, "skin": 0}));
         }
         json["meshes"].as_array_mut().unwrap().extend(eye_meshes);
+    } else if opts.vrm_eyes.is_some() {
+        json["nodes"][3]["children"] = json!([4, 6, LEFT_EYE_JOINT, RIGHT_EYE_JOINT]);
+        json["skins"][0]["joints"] = json!([1, 2, 3, 4, LEFT_EYE_JOINT, RIGHT_EYE_JOINT]);
+        let nodes = json["nodes"].as_array_mut().unwrap();
+        for (left, name) in [(true, "LeftEye"), (false, "RightEye")] {
+            nodes.push(json!({"name": name,
+                "translation": eye_joint_translation(left).to_array(),
+                "rotation": eye_joint_rotation(left).to_array()}));
+        }
     }
     let mut bin = b.bin;
     while bin.len() % 4 != 0 {
