@@ -309,7 +309,7 @@ pub enum Command {
                       transcript is spoken by espeak-ng (library libespeak-ng, Debian package \
                       espeak-ng), which gives its phonemes in 100+ languages (--lang); the \
                       rendition is aligned to the recording by dynamic time warping of their \
-                      MFCCs; for English recordings up to 5 minutes the phones are then placed \
+                      MFCCs; for English recordings up to 2 minutes the phones are then placed \
                       by PocketSphinx forced alignment when it is installed (Debian packages \
                       pocketsphinx pocketsphinx-en-us; without it the warp's times are used). \
                       Silences relax the mouth, and the phones become FAP 1 visemes with \

@@ -46,9 +46,12 @@ use crate::speech::SpeechError;
 /// The program run: `pocketsphinx_batch`, of the same package as the recogniser.
 pub const BATCH_PROGRAM: &str = "pocketsphinx_batch";
 
-/// Longest recording aligned this way, seconds: the search keeps every frame's candidates,
-/// so longer recordings keep the warp's times (bounded memory).
-pub const MAX_SECONDS: f64 = 300.0;
+/// Longest recording aligned this way, seconds. The recogniser's grammar search costs
+/// about the grammar's length at every frame, so its time grows with the square of the
+/// length: 0.16 s for 24 s of speech, 23 s for 290 s (the whole lip sync then 23×, 16× and
+/// 8× real time at 24, 97 and 290 s). Longer recordings keep the warp's times (cutting them
+/// into pieces at pauses the warp finds would lift this limit; not done yet).
+pub const MAX_SECONDS: f64 = 120.0;
 
 /// Whether the recogniser, its English acoustic model and dictionary are installed (asked
 /// once per process).

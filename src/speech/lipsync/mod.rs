@@ -21,8 +21,8 @@
 //! Festival condition better; on espeak-ng's own voices, whose rendition is the recording's
 //! twin so the warp is nearly exact, it went from 100 / 95.5 / 1.6 to 98.0 / 89.9 / 3.0 %
 //! (pocketsphinx's boundaries are acoustic, espeak-ng's reported phone starts are not
-//! always); it is kept because people are not espeak-ng. Speed on a 24 s recording: 50× →
-//! 23× real time on one core (the warp still runs, for the confidence).
+//! always); it is kept because people are not espeak-ng. Speed on one core: 50× → 23× real
+//! time on a 24 s recording, 76× → 16× on 97 s (the warp still runs, for the confidence).
 //!
 //! Without a transcript (English only), PocketSphinx recognises the phones
 //! ([`recognition`]) and [`closures`] adds the lip closures the sound shows that the phones
