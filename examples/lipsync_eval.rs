@@ -13,7 +13,8 @@
 //! it says. Festival is for this evaluation only: the conditions are skipped, with a note,
 //! when it or a voice is not installed.
 //!
-//! Run: `cargo run --release --example lipsync_eval` (needs espeak-ng; ffmpeg and
+//! Run: `cargo run --release --example lipsync_eval` (`LIPSYNC_WARP_ONLY=1` measures the
+//! transcript path without PocketSphinx's forced alignment; needs espeak-ng; ffmpeg and
 //! pocketsphinx + pocketsphinx-en-us for the MP3 condition and the recognition figures;
 //! festival festvox-kallpc16k festvox-kdlpc16k festvox-us-slt-hts for the Festival ones).
 #![allow(dead_code)] // Also included as a module by the tests, which do not call `main`.
@@ -350,7 +351,12 @@ pub fn run_case_with(
     let (_dir, path, truth) = make_recording(text, c)?;
     let started = Instant::now();
     let rec = analyse_file(&path, &mut |_| {})?;
-    let sync = lipsync_transcript_at(&rec, text, &LipsyncOptions::default(), fps)?;
+    let opts = LipsyncOptions {
+        // The warp alone, for comparison with forced alignment.
+        forced: std::env::var_os("LIPSYNC_WARP_ONLY").is_none(),
+        ..LipsyncOptions::default()
+    };
+    let sync = lipsync_transcript_at(&rec, text, &opts, fps)?;
     let work_seconds = started.elapsed().as_secs_f64();
     let started = Instant::now();
     let recognised = if recognise && recognition_available() {
@@ -451,8 +457,10 @@ fn main() {
         eprintln!("espeak-ng is not installed (apt-get install espeak-ng)");
         std::process::exit(1);
     }
-    let recognise = recognition_available();
-    if !recognise {
+    // LIPSYNC_EVAL_TRANSCRIPT_ONLY skips the (slow) figures without a transcript.
+    let recognise =
+        recognition_available() && std::env::var_os("LIPSYNC_EVAL_TRANSCRIPT_ONLY").is_none();
+    if !recognise && std::env::var_os("LIPSYNC_EVAL_TRANSCRIPT_ONLY").is_none() {
         println!("(PocketSphinx is not installed: no figures without a transcript)");
     }
     let have_ffmpeg = ffmpeg_available();

@@ -64,12 +64,59 @@ fn transcript_alignment_meets_the_issue_targets() {
     assert!(total.closures >= 30, "{total:?}");
     assert!(total.closure_rate() >= 0.95, "{total:?}");
     assert!(total.agreement() >= 0.85, "{total:?}");
-    // Issue target 2 %; measured 1.6 % on the full evaluation (examples/lipsync_eval.rs); this
-    // subset of 8 cases is held to 3 %.
+    // Issue target 2 %; on the full evaluation's espeak-ng voices (examples/lipsync_eval.rs)
+    // measured 1.6 % with the warp alone and 3.0 % with PocketSphinx's forced alignment
+    // (which serves real voices far better: see the test below); this subset of 8 cases
+    // measured 2.8 % and is held to 3 %.
     assert!(total.false_closure_rate() <= 0.03, "{total:?}");
     // Better than stretching the rendition over the recording.
     assert!(total.closure_rate() >= baseline.closure_rate());
     assert!(total.false_closure_rate() < baseline.false_closure_rate());
+}
+
+/// Issue 22's targets with a transcript on Festival's voices built from real speakers (a
+/// closer stand-in for people than espeak-ng's formant voices): PocketSphinx's forced
+/// alignment places the phones. The warp alone measured 93.4 % closures, 78.7 % agreement
+/// and 4.9 % false closures on all of `examples/lipsync_eval.rs`'s Festival conditions;
+/// forced alignment 100 / 96.3 / 1.3 %. Skipped without Festival, its voices or PocketSphinx
+/// (CI has no Festival: the figures are from `examples/lipsync_eval.rs`).
+#[test]
+fn transcript_alignment_meets_the_issue_targets_on_real_speakers_voices() {
+    let name = "transcript_alignment_meets_the_issue_targets_on_real_speakers_voices";
+    if skip(name) {
+        return;
+    }
+    let conditions: Vec<_> = lipsync_eval::conditions()
+        .into_iter()
+        .filter(|c| c.synth == lipsync_eval::Synth::Festival && !c.mp3)
+        .collect();
+    if !fbakit::speech::lipsync::forced::available()
+        || !conditions
+            .iter()
+            .all(|c| lipsync_eval::festival_voice_available(c.voice))
+    {
+        eprintln!(
+            "skip {name}: needs pocketsphinx pocketsphinx-en-us festival festvox-kallpc16k \
+             festvox-kdlpc16k festvox-us-slt-hts"
+        );
+        return;
+    }
+    let mut total = LipsyncScore::default();
+    for c in &conditions {
+        for text in &lipsync_eval::SENTENCES[..4] {
+            total.add(&lipsync_eval::run_case(text, c, 25.0).unwrap().aligned);
+        }
+    }
+    eprintln!(
+        "aligned: closures {:.3}, agreement {:.3}, false closures {:.3}",
+        total.closure_rate(),
+        total.agreement(),
+        total.false_closure_rate()
+    );
+    assert!(total.closures >= 40, "{total:?}");
+    assert!(total.closure_rate() >= 0.95, "{total:?}");
+    assert!(total.agreement() >= 0.85, "{total:?}");
+    assert!(total.false_closure_rate() <= 0.02, "{total:?}");
 }
 
 #[test]

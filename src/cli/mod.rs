@@ -309,7 +309,10 @@ pub enum Command {
                       transcript is spoken by espeak-ng (library libespeak-ng, Debian package \
                       espeak-ng), which gives its phonemes in 100+ languages (--lang); the \
                       rendition is aligned to the recording by dynamic time warping of their \
-                      MFCCs, silences relax the mouth, and the phones become FAP 1 visemes with \
+                      MFCCs; for English recordings up to 2 minutes the phones are then placed \
+                      by PocketSphinx forced alignment when it is installed (Debian packages \
+                      pocketsphinx pocketsphinx-en-us; without it the warp's times are used). \
+                      Silences relax the mouth, and the phones become FAP 1 visemes with \
                       blends (never skipping a lip closure, no shape shorter than a frame). \
                       The recording is read a chunk at a time. A transcript that fits poorly \
                       gives a warning with its confidence; one that does not fit at all is \

@@ -42,10 +42,15 @@ pub const PROGRAM: &str = "pocketsphinx_continuous";
 /// Where Debian's `pocketsphinx-en-us` puts the model.
 pub const MODEL_DIR: &str = "/usr/share/pocketsphinx/model/en-us";
 
+/// The model directory: `FBAKIT_POCKETSPHINX_MODEL`, else [`MODEL_DIR`].
+pub(super) fn model_dir() -> PathBuf {
+    std::env::var_os("FBAKIT_POCKETSPHINX_MODEL")
+        .map_or_else(|| PathBuf::from(MODEL_DIR), PathBuf::from)
+}
+
 /// The acoustic model and phone language model, or why they are missing.
 fn model() -> Result<(PathBuf, PathBuf)> {
-    let dir = std::env::var_os("FBAKIT_POCKETSPHINX_MODEL")
-        .map_or_else(|| PathBuf::from(MODEL_DIR), PathBuf::from);
+    let dir = model_dir();
     let hmm = dir.join("en-us");
     let lm = dir.join("en-us-phone.lm.bin");
     if hmm.join("mdef").is_file() && lm.is_file() {
@@ -156,7 +161,7 @@ fn quietest_cut(samples: &[i16], limit: usize, search: usize) -> usize {
     best.1.max(1)
 }
 
-fn write_piece(path: &Path, samples: &[i16]) -> Result<()> {
+pub(super) fn write_piece(path: &Path, samples: &[i16]) -> Result<()> {
     let spec = hound::WavSpec {
         channels: 1,
         sample_rate: ANALYSIS_RATE,
