@@ -79,7 +79,7 @@ fn transcript_alignment_meets_the_issue_targets() {
 /// alignment places the phones. The warp alone measured 93.4 % closures, 78.7 % agreement
 /// and 4.9 % false closures on all of `examples/lipsync_eval.rs`'s Festival conditions;
 /// forced alignment 100 / 96.3 / 1.3 %. Skipped without Festival, its voices or PocketSphinx
-/// (CI has no Festival: the figures are from `examples/lipsync_eval.rs`).
+/// (`.ci/run` installs them: test data only, fbakit never runs Festival).
 #[test]
 fn transcript_alignment_meets_the_issue_targets_on_real_speakers_voices() {
     let name = "transcript_alignment_meets_the_issue_targets_on_real_speakers_voices";
