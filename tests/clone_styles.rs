@@ -130,7 +130,9 @@ fn print(p: &Pair) {
         .timings
         .steps
         .iter()
-        .filter(|(n, _)| matches!(n.as_str(), "guard" | "smooth" | "gain") || n.starts_with("fit:"))
+        .filter(|(n, _)| {
+            matches!(n.as_str(), "guard" | "smooth" | "gain" | "bound") || n.starts_with("fit:")
+        })
         .map(|(n, t)| format!("{n} {:.0} ms", t * 1e3))
         .collect();
     eprintln!(
@@ -196,17 +198,27 @@ fn print(p: &Pair) {
 /// back at ICT's lip corner under `viseme_1`): bruno → ict 12.1 → 8.4 (now `viseme_2` at
 /// the same corner), candide → ict and → ict-rig 12.8 → 12.6 (`open_jaw` at the chin),
 /// ict → candide 10.7 → 10.5, ict-rig → candide 10.6 → 10.7, the rest within 0.01.
+/// Since the explicit `bound` step (2026-11-27: the last skin step re-solves a harmonic fill
+/// around triangles still turning over 1.4× the source's, corners of slivers following their
+/// base; feature points, lid margins and the lips' slit held): the ICT heads onto CANDIDE
+/// 10.5 / 10.7 → 2.64 / 2.61 (CANDIDE's nearly collinear triangle at the side of the head,
+/// folded by the slight motion the brow FAPs leave on the temple, now moves with its base;
+/// what is left is `close_t_l_eyelid` by the held lid margin), alma → ict and → ict-rig
+/// 6.92 → 4.02 (`lower_t_lip_rm` at ICT's inner lip corner), bruno → ict 8.4 → 5.09
+/// (`viseme_9`, the same corner), candide → ict and → ict-rig 12.6 → 12.3 (`open_jaw`: the
+/// whole chin of the dense head turns more than CANDIDE's coarse one, over a thousand
+/// triangles; the fill does not bring it down), ict → alma 1.46 → 1.37, the rest within 0.01.
 const BOUNDS: [(&str, &str, f64, f64); 10] = [
-    ("alma", "ict", 0.015, 7.2),
-    ("bruno", "ict", 0.015, 8.8),
-    ("candide", "ict", 0.015, 13.0),
-    ("ict", "alma", 0.015, 1.55),
+    ("alma", "ict", 0.015, 4.15),
+    ("bruno", "ict", 0.015, 5.25),
+    ("candide", "ict", 0.015, 12.7),
+    ("ict", "alma", 0.015, 1.45),
     ("ict", "bruno", 0.01, 2.05),
-    ("ict", "candide", 0.01, 11.0),
-    ("alma", "ict-rig", 0.015, 7.2),
-    ("candide", "ict-rig", 0.015, 13.0),
+    ("ict", "candide", 0.01, 2.75),
+    ("alma", "ict-rig", 0.015, 4.15),
+    ("candide", "ict-rig", 0.015, 12.7),
     ("ict-rig", "alma", 0.015, 1.45),
-    ("ict-rig", "candide", 0.01, 11.0),
+    ("ict-rig", "candide", 0.01, 2.75),
 ];
 
 #[test]

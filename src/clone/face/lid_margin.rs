@@ -120,6 +120,11 @@ fn fp(s: &str) -> FeaturePointId {
 }
 
 impl LidMargins {
+    /// The surface vertices on every lid's margin.
+    pub fn margin_vertices(&self) -> impl Iterator<Item = u32> + '_ {
+        self.lids.iter().flat_map(|l| l.vertices.iter().copied())
+    }
+
     /// The margins of `surf`'s lids (those whose corner, lid and pupil points it knows).
     pub fn of(surf: &CloneSurface) -> LidMargins {
         let pos = |id: &str| surf.fp(fp(id));

@@ -91,6 +91,16 @@
 //!    stillness above it, not the surface method's per-vertex motion, which read unrelated
 //!    source places there. A face without such an interior is not changed, nor is any
 //!    target of a source with a mouth interior of its own (a rig head hands on its motion).
+//!    **`bound`** (every method, `turn_bound.rs`), last: a motion whose target still has a
+//!    triangle turning more than 1.4× the source's largest turn (at least 1°; issue 21 asks
+//!    1.5×) is re-solved around those triangles — a harmonic fill (edges weighed by inverse
+//!    length) over their corners and a ring that grows each round, and in triangles still
+//!    above the bound the corner opposite the longest edge following that edge (a sliver
+//!    moves with its base) — feature points, the lips' and lids' margins held, the round turning least kept
+//!    if it turns less than the clone's own. It settles what `smooth`'s uniform steps cannot:
+//!    CANDIDE-3's slivers at the sides of the head under the brow FAPs, ICT's tenth-of-a-
+//!    millimetre triangles at the inner lip corners. Re-solved motions join
+//!    [`CloneReport::smoothed`].
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
@@ -173,7 +183,7 @@
 //! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
 //! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
 //! the surface (steps 4 and 8), `rescale` step 6, the guard and the gain, `smooth` the smooth
-//! step, `rigid`, `part_motion` and `jaw_follow`
+//! step, `turn_bound` the bound, `rigid`, `part_motion` and `jaw_follow`
 //! step 7, `assemble`, `attached` and `lid_margin` step 8 and `fold` step 9. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
@@ -197,6 +207,7 @@ mod skin_surface;
 mod smooth;
 mod split;
 mod target_check;
+mod turn_bound;
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -610,6 +621,22 @@ fn clone_skin_motions(
             .for_each(|m| interior.fill(tsurf, m));
     }
     report.timings.push("mouth", clock.elapsed().as_secs_f64());
+    // Last, an explicit bound on the skin's turn: what `smooth`'s uniform steps could not
+    // settle (tiny or sliver triangles) is re-solved around it.
+    let clock = Instant::now();
+    let lids: Vec<u32> = lid_margin::LidMargins::of(&tsurf.surface)
+        .margin_vertices()
+        .collect();
+    for (k, n) in turn_bound::bound_turns(
+        &ssurf.surface,
+        &moving,
+        &tsurf.surface,
+        &lids,
+        &mut result.motions,
+    ) {
+        *report.smoothed.entry(k).or_default() += n;
+    }
+    report.timings.push("bound", clock.elapsed().as_secs_f64());
     Ok(result.motions)
 }
 

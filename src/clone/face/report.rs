@@ -59,8 +59,8 @@ pub struct CloneReport {
     pub fapu_rescale: BTreeMap<String, f64>,
     /// Compliance gains at the feature points (`gain` step), per FAP name and value.
     pub fapu_gain: BTreeMap<String, f64>,
-    /// Motions the `smooth` step re-solved, per FAP name and value: how many target surface
-    /// vertices.
+    /// Motions the `smooth` and `bound` steps re-solved, per FAP name and value: how many
+    /// target surface vertices.
     pub smoothed: BTreeMap<String, usize>,
     /// Target surface vertices of the hidden mouth interior the `mouth` step fills (0: none).
     pub mouth_interior: usize,

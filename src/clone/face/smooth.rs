@@ -38,7 +38,7 @@ const SWEEPS: usize = 2;
 
 /// Unit normal and doubled area of each triangle at `positions` (zero normal: degenerate or
 /// out of range).
-fn normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+pub(super) fn normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     triangles
         .iter()
         .map(|t| {
@@ -62,7 +62,7 @@ fn normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
 
 /// Whether triangle `t` (neutral unit normal `n0`) turns by more than the angle whose cosine
 /// is `cos_tau` under displacements `d`.
-fn rough(positions: &[Vec3], d: &[Vec3], t: &[u32; 3], n0: Vec3, cos_tau: f32) -> bool {
+pub(super) fn rough(positions: &[Vec3], d: &[Vec3], t: &[u32; 3], n0: Vec3, cos_tau: f32) -> bool {
     if n0 == Vec3::ZERO {
         return false;
     }
@@ -77,7 +77,7 @@ fn rough(positions: &[Vec3], d: &[Vec3], t: &[u32; 3], n0: Vec3, cos_tau: f32) -
 }
 
 /// The triangles using each of `n` vertices.
-fn incident_triangles(n: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+pub(super) fn incident_triangles(n: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
     let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
     for (i, t) in triangles.iter().enumerate() {
         for &v in t {
@@ -91,7 +91,7 @@ fn incident_triangles(n: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
 
 /// The triangles (each once, ascending) with a corner among the `offsets`' vertices: the
 /// only ones a motion can turn, so the only ones its checks need to look at.
-fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u32> {
+pub(super) fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u32> {
     let mut tris: Vec<u32> = offsets
         .iter()
         .filter_map(|&(v, _)| incident.get(v as usize))

@@ -1,0 +1,429 @@
+//! The `bound` step (module docs of [`super`]): after every other change to the skin's motion
+//! (smoothing, the FAPU gain, the mouth fill), no target triangle may turn more than
+//! `BOUND` × the source motion's largest turn (at least 1°). `smooth` works towards that
+//! with uniform Laplacian steps, which cannot settle two kinds of triangle:
+//!
+//! - triangles much smaller than their neighbours (ICT's inner lip corners, a tenth of a
+//!   millimetre wide between an upper and a lower lip that move apart): a uniform mean pulls
+//!   their corners towards neighbours millimetres away, so the tiny triangle keeps a steep
+//!   gradient across it;
+//! - slivers (CANDIDE-3's nearly collinear triangles at the sides of the head): their height
+//!   is so small that any motion short of an exactly affine one folds them, even the slight
+//!   motion a brow FAP leaves on the temple.
+//!
+//! Per motion whose target still has a triangle above the bound: the corners of those triangles
+//! and one ring around them are re-solved as a harmonic fill of the motion around them (edges
+//! weighed by inverse length, so close vertices move alike whatever the mesh's scale there),
+//! the rest held. Each further round, in every triangle still above the bound the corner
+//! opposite the longest edge is made to *follow* that edge (its motion is the edge ends'
+//! motion interpolated at its foot on the edge: a sliver then moves with its base and keeps
+//! its shape, a tiny triangle between two lips moves with the lip it hangs on) and the
+//! region grows by one ring, up to `ROUNDS` rounds. Held, every motion as it was: the feature
+//! points (compliance is measured there), the lips' slit (the surface's borders near the
+//! mouth and two rings around them) and the lid margins: the slits' gaps and the lashes
+//! riding on the lids must stay as cloned. Rigid parts are not on the skin surface and are not
+//! touched. Each round's motion is measured over every triangle and the one turning least is
+//! kept, if it turns less than the clone's own; a motion already under the bound is not
+//! changed at all.
+
+use std::collections::{BTreeMap, HashMap};
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::smooth::{incident_triangles, normals, rough, touching};
+use crate::clone::quality::{max_normal_turn, NORMAL_TURN_FLOOR};
+use crate::clone::{CloneSurface, SurfaceMotion};
+use crate::mesh::geometry::adjacency;
+
+/// Largest allowed target turn over the source's: the 1.5 less a margin for what the
+/// later steps (rigid parts, the fold of a one-mesh head) add.
+pub(super) const BOUND: f64 = 1.4;
+/// Rounds at most (each makes the triangles still above the bound follow and grows the region).
+const ROUNDS: usize = 4;
+/// Gauss–Seidel sweeps at most per harmonic fill.
+const SWEEPS: usize = 400;
+
+/// A vertex that follows the edge opposite it in a triangle: its motion is the motion of the
+/// edge's ends interpolated at its foot on that edge (`a`, `b`, parameter `t`).
+type Follows = BTreeMap<u32, (u32, u32, f32)>;
+
+/// The vertex of triangle `t` opposite its longest edge, that edge's ends and the parameter
+/// of the vertex's foot on it (clamped to the edge).
+fn apex(positions: &[Vec3], t: &[u32; 3]) -> (u32, (u32, u32, f32)) {
+    let p = |v: u32| positions[v as usize];
+    let k = (0..3)
+        .max_by(|&i, &j| {
+            let l = |k: usize| p(t[k]).distance_squared(p(t[(k + 1) % 3]));
+            l(i).total_cmp(&l(j))
+        })
+        .unwrap_or(0);
+    let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+    let e = p(b) - p(a);
+    let s = (p(c) - p(a)).dot(e) / e.length_squared().max(f32::MIN_POSITIVE);
+    (c, (a, b, s.clamp(0.0, 1.0)))
+}
+
+/// The harmonic fill of `d` over the `region` (every other vertex held): each vertex takes
+/// the inverse-length weighted mean of its neighbours, each follower (module docs) the motion
+/// of its edge.
+fn fill(positions: &[Vec3], adj: &[Vec<u32>], region: &[u32], follows: &Follows, d: &mut [Vec3]) {
+    let free: Vec<(u32, Vec<(u32, f32)>)> = region
+        .iter()
+        .filter(|v| !follows.contains_key(v) && !adj[**v as usize].is_empty())
+        .map(|&v| {
+            let edges = adj[v as usize]
+                .iter()
+                .map(|&w| {
+                    let l = positions[v as usize].distance(positions[w as usize]);
+                    (w, 1.0 / l.max(1e-9))
+                })
+                .collect();
+            (v, edges)
+        })
+        .collect();
+    let scale = region
+        .iter()
+        .map(|&v| d[v as usize].length())
+        .fold(0.0f32, f32::max)
+        .max(1e-12);
+    for _ in 0..SWEEPS {
+        let mut change = 0.0f32;
+        for (v, edges) in &free {
+            let (sum, weight) = edges.iter().fold((Vec3::ZERO, 0.0f32), |(s, t), &(w, c)| {
+                (s + c * d[w as usize], t + c)
+            });
+            let value = sum / weight;
+            change = change.max(value.distance(d[*v as usize]));
+            d[*v as usize] = value;
+        }
+        for (&c, &(a, b, t)) in follows {
+            let value = (1.0 - t) * d[a as usize] + t * d[b as usize];
+            change = change.max(value.distance(d[c as usize]));
+            d[c as usize] = value;
+        }
+        if change < 1e-5 * scale {
+            break;
+        }
+    }
+}
+
+/// The largest turn (cosine: smallest) over `tris` under `d`; 1 without triangles.
+fn worst_cos(
+    positions: &[Vec3],
+    d: &[Vec3],
+    triangles: &[[u32; 3]],
+    tn: &[Vec3],
+    tris: &[u32],
+) -> f32 {
+    tris.iter()
+        .filter(|&&i| tn[i as usize] != Vec3::ZERO)
+        .map(|&i| {
+            let t = triangles[i as usize];
+            let p = |k: usize| positions[t[k] as usize] + d[t[k] as usize];
+            let n1 = (p(1) - p(0)).cross(p(2) - p(0));
+            let l = n1.length();
+            if l.is_finite() && l > 0.0 {
+                tn[i as usize].dot(n1) / l
+            } else {
+                -1.0
+            }
+        })
+        .fold(1.0, f32::min)
+}
+
+/// The vertices every motion keeps (module docs): the feature points, the surface's borders
+/// near the mouth with two rings around them, and the `held` ones (the lid margins).
+fn fixed_vertices(target: &CloneSurface, held: &[u32]) -> Vec<bool> {
+    let n = target.positions.len();
+    let mut fixed = vec![false; n];
+    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in &target.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    // The lips' slit: borders near the mouth (within ¾ of the lip corners' distance of
+    // their midpoint); without both corners, every border. Not the outline of a face mask,
+    // whose slivers must follow their base.
+    let corners = ["8.3", "8.4"].map(|id| id.parse().ok().and_then(|f| target.fp(f)));
+    let near_mouth = |v: u32| match corners {
+        [Some(a), Some(b)] => {
+            target.positions[v as usize].distance(0.5 * (a + b)) < 0.75 * a.distance(b)
+        }
+        _ => true,
+    };
+    let border = edges
+        .into_iter()
+        .filter(|&(_, c)| c == 1)
+        .flat_map(|((a, b), _)| [a, b])
+        .filter(|&v| (v as usize) < n && near_mouth(v));
+    // The lips' margins and two rings around them: the slit's gap is read off the lips there.
+    let adj = adjacency(n, &target.triangles);
+    let mut lips: Vec<u32> = border.collect();
+    for _ in 0..2 {
+        let ring: Vec<u32> = lips
+            .iter()
+            .flat_map(|&v| adj[v as usize].iter().copied())
+            .collect();
+        lips.extend(ring);
+    }
+    for v in target
+        .fp_vertices
+        .values()
+        .copied()
+        .chain(held.iter().copied())
+        .chain(lips)
+    {
+        if let Some(f) = fixed.get_mut(v as usize) {
+            *f = true;
+        }
+    }
+    fixed
+}
+
+/// The bound on every cloned motion (module docs). Returns, per repaired motion
+/// (`name@value`), how many target vertices were re-solved.
+pub(super) fn bound_turns(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    target: &CloneSurface,
+    held: &[u32],
+    out: &mut [SurfaceMotion],
+) -> BTreeMap<String, usize> {
+    let n = target.positions.len();
+    let fixed = fixed_vertices(target, held);
+    let adj = adjacency(n, &target.triangles);
+    let incident = incident_triangles(n, &target.triangles);
+    let source_incident = incident_triangles(source.positions.len(), &source.triangles);
+    let tn = normals(&target.positions, &target.triangles);
+    let pos = &target.positions;
+    let tris = &target.triangles;
+    let all: Vec<u32> = (0..tris.len() as u32).collect();
+    let results: Vec<Option<(String, usize)>> = motions
+        .par_iter()
+        .zip(out.par_iter_mut())
+        .map(|(src, dst)| {
+            if dst.offsets.is_empty() {
+                return None;
+            }
+            let mut sd = source.positions.clone();
+            for &(v, o) in &src.offsets {
+                if let Some(p) = sd.get_mut(v as usize) {
+                    *p += o;
+                }
+            }
+            let moved: Vec<[u32; 3]> = touching(&source_incident, &src.offsets)
+                .into_iter()
+                .map(|i| source.triangles[i as usize])
+                .collect();
+            let theta = max_normal_turn(&source.positions, &sd, &moved).angle;
+            let tau = BOUND * theta.max(NORMAL_TURN_FLOOR);
+            if tau >= std::f64::consts::PI {
+                return None;
+            }
+            let cos_tau = tau.cos() as f32;
+            let mut d = vec![Vec3::ZERO; n];
+            for &(v, o) in &dst.offsets {
+                if let Some(s) = d.get_mut(v as usize) {
+                    *s = o;
+                }
+            }
+            let mut bad: Vec<u32> = touching(&incident, &dst.offsets)
+                .into_iter()
+                .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+                .collect();
+            if bad.is_empty() {
+                return None;
+            }
+            // Each round's field is measured over every triangle; the best one is kept, and
+            // only if it turns less than the clone's own.
+            let mut best = (
+                worst_cos(pos, &d, tris, &tn, &all),
+                None::<(Vec<Vec3>, usize)>,
+            );
+            let mut follows = Follows::new();
+            let mut in_region = vec![false; n];
+            let mut region: Vec<u32> = Vec::new();
+            let add = |v: u32, region: &mut Vec<u32>, in_region: &mut Vec<bool>| {
+                if !in_region[v as usize] && !fixed[v as usize] {
+                    in_region[v as usize] = true;
+                    region.push(v);
+                }
+            };
+            for round in 0..ROUNDS {
+                if round > 0 {
+                    for &i in &bad {
+                        let (c, edge) = apex(pos, &tris[i as usize]);
+                        if !fixed[c as usize] {
+                            follows.entry(c).or_insert(edge);
+                        }
+                    }
+                }
+                for &i in &bad {
+                    for &v in &tris[i as usize] {
+                        add(v, &mut region, &mut in_region);
+                    }
+                }
+                // One ring around the whole region.
+                let ring: Vec<u32> = region
+                    .iter()
+                    .flat_map(|&v| adj[v as usize].iter().copied())
+                    .collect();
+                for w in ring {
+                    add(w, &mut region, &mut in_region);
+                }
+                fill(pos, &adj, &region, &follows, &mut d);
+                let worst = worst_cos(pos, &d, tris, &tn, &all);
+                if worst > best.0 {
+                    best = (worst, Some((d.clone(), region.len())));
+                }
+                let mut seen = std::collections::HashSet::new();
+                bad = region
+                    .iter()
+                    .flat_map(|&v| incident[v as usize].iter().copied())
+                    .filter(|&i| seen.insert(i))
+                    .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+                    .collect();
+                if bad.is_empty() {
+                    break;
+                }
+            }
+            let (d, count) = best.1?;
+            dst.offsets = d
+                .iter()
+                .enumerate()
+                .filter(|(_, o)| **o != Vec3::ZERO && o.is_finite())
+                .map(|(v, &o)| (v as u32, o))
+                .collect();
+            Some((format!("{}@{}", src.key.name(), src.value), count))
+        })
+        .collect();
+    results.into_iter().flatten().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fat::TableKey;
+    use crate::fdp::{Fapu, FapuDistances};
+    use crate::spec::FapId;
+
+    fn surface(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> CloneSurface {
+        let d = FapuDistances {
+            irisd0: 1.0,
+            es0: 1.0,
+            ens0: 1.0,
+            mns0: 1.0,
+            mw0: 1.0,
+        };
+        CloneSurface {
+            positions,
+            triangles,
+            fp_vertices: Default::default(),
+            fp_positions: Default::default(),
+            fapu: Fapu::from_distances(d).unwrap(),
+        }
+    }
+
+    /// A flat grid of `k × k` vertices (spacing 1) in the xy plane.
+    fn grid(k: u32) -> CloneSurface {
+        let mut positions = Vec::new();
+        for j in 0..k {
+            for i in 0..k {
+                positions.push(Vec3::new(i as f32, j as f32, 0.0));
+            }
+        }
+        surface(positions, crate::clone::fixtures::grid_triangles(k))
+    }
+
+    fn motion(offsets: Vec<(u32, Vec3)>) -> SurfaceMotion {
+        SurfaceMotion {
+            key: TableKey::LowLevel(FapId::new(3).unwrap()),
+            value: 512.0,
+            offsets,
+        }
+    }
+
+    /// The largest turn of `m` on `s`, radians.
+    fn turn(s: &CloneSurface, m: &SurfaceMotion) -> f64 {
+        let d = crate::clone::quality::dense(m, s.positions.len());
+        let posed: Vec<Vec3> = s.positions.iter().zip(&d).map(|(p, o)| *p + *o).collect();
+        max_normal_turn(&s.positions, &posed, &s.triangles).angle
+    }
+
+    /// A gentle slope in z over the grid: every triangle turns by the same small angle.
+    fn slope(s: &CloneSurface) -> Vec<(u32, Vec3)> {
+        s.positions
+            .iter()
+            .enumerate()
+            .map(|(v, p)| (v as u32, Vec3::Z * (0.05 * p.x + 0.5)))
+            .collect()
+    }
+
+    #[test]
+    fn a_motion_under_the_bound_is_untouched() {
+        let s = grid(9);
+        let src = vec![motion(slope(&s))];
+        let mut out = src.clone();
+        assert!(bound_turns(&s, &src, &s, &[], &mut out).is_empty());
+        assert_eq!(out, src);
+    }
+
+    #[test]
+    fn a_sliver_folded_by_a_slight_motion_is_brought_under_the_bound() {
+        // The source: the grid under the slope. The target: the same grid with one more
+        // vertex just off the middle of an edge inside it, splitting a triangle into a sliver
+        // (CANDIDE-3's nearly collinear triangles at the sides of the head).
+        let s = grid(9);
+        let src = vec![motion(slope(&s))];
+        let mut positions = s.positions.clone();
+        let (a, b) = (4 * 9 + 3, 4 * 9 + 4);
+        let mid = positions.len() as u32;
+        positions.push(0.5 * (positions[a as usize] + positions[b as usize]) + Vec3::Y * 1e-3);
+        let mut triangles = Vec::new();
+        for t in &s.triangles {
+            // The triangle on the edge a–b on the new vertex's side (+y) is split at it, and
+            // the sliver a–b–new fills the gap to the edge.
+            let k = (0..3).find(|&k| {
+                let (p, q) = (t[k], t[(k + 1) % 3]);
+                ((p, q) == (a, b) || (p, q) == (b, a))
+                    && s.positions[t[(k + 2) % 3] as usize].y > 4.0
+            });
+            match k {
+                Some(k) => {
+                    let (p, q, r) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+                    triangles.push([p, mid, r]);
+                    triangles.push([mid, q, r]);
+                    triangles.push([p, q, mid]);
+                }
+                None => triangles.push(*t),
+            }
+        }
+        let t = surface(positions, triangles);
+        // The clone moves the new vertex a little off the slope: the sliver folds.
+        let mut offsets = slope(&t);
+        let z = offsets[mid as usize].1.z;
+        offsets[mid as usize].1 = Vec3::new(0.0, -0.01, z + 0.02);
+        assert_eq!(t.triangles.len(), s.triangles.len() + 2);
+        let mut out = vec![motion(offsets)];
+        let before = turn(&t, &out[0]);
+        let theta = turn(&s, &src[0]);
+        assert!(
+            before > 3.0 * BOUND * theta.max(NORMAL_TURN_FLOOR),
+            "{before} {theta}"
+        );
+        let done = bound_turns(&s, &src, &t, &[], &mut out);
+        assert_eq!(done.len(), 1, "{done:?}");
+        let after = turn(&t, &out[0]);
+        assert!(
+            after <= BOUND * theta.max(NORMAL_TURN_FLOOR),
+            "{after} {theta}"
+        );
+        // Far from the sliver the motion is the clone's own.
+        let d = crate::clone::quality::dense(&out[0], t.positions.len());
+        assert_eq!(d[0], slope(&t)[0].1);
+        assert_eq!(d[80], slope(&t)[80].1);
+    }
+}
