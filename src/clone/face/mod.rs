@@ -628,7 +628,7 @@ fn clone_skin_motions(
         .margin_vertices()
         .collect();
     for (k, n) in turn_bound::bound_turns(
-        &ssurf.surface,
+        &topology,
         &moving,
         &tsurf.surface,
         &lids,

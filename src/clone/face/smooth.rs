@@ -119,16 +119,16 @@ pub(super) fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u3
 /// source motions give the same tables.
 pub(super) struct SmoothTopology {
     /// Target vertex adjacency.
-    adj: Vec<Vec<u32>>,
+    pub(super) adj: Vec<Vec<u32>>,
     /// Target triangles of each target vertex.
-    incident: Vec<Vec<u32>>,
+    pub(super) incident: Vec<Vec<u32>>,
     /// Source triangles of each source vertex.
-    source_incident: Vec<Vec<u32>>,
+    pub(super) source_incident: Vec<Vec<u32>>,
     /// Target triangles' neutral unit normals.
-    tn: Vec<Vec3>,
+    pub(super) tn: Vec<Vec3>,
     /// The largest normal turn of each source motion (`source_turn`), in the order of the
     /// motions both passes get.
-    source_turns: Vec<f64>,
+    pub(super) source_turns: Vec<f64>,
 }
 
 impl SmoothTopology {

@@ -31,10 +31,9 @@ use std::collections::{BTreeMap, HashMap};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::smooth::{incident_triangles, normals, rough, touching};
-use crate::clone::quality::{max_normal_turn, NORMAL_TURN_FLOOR};
+use super::smooth::{rough, touching, SmoothTopology};
+use crate::clone::quality::NORMAL_TURN_FLOOR;
 use crate::clone::{CloneSurface, SurfaceMotion};
-use crate::mesh::geometry::adjacency;
 
 /// Largest allowed target turn over the source's: the 1.5 less a margin for what the
 /// later steps (rigid parts, the fold of a one-mesh head) add.
@@ -134,7 +133,7 @@ fn worst_cos(
 
 /// The vertices every motion keeps (module docs): the feature points, the surface's borders
 /// near the mouth with two rings around them, and the `held` ones (the lid margins).
-fn fixed_vertices(target: &CloneSurface, held: &[u32]) -> Vec<bool> {
+fn fixed_vertices(target: &CloneSurface, adj: &[Vec<u32>], held: &[u32]) -> Vec<bool> {
     let n = target.positions.len();
     let mut fixed = vec![false; n];
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
@@ -160,7 +159,6 @@ fn fixed_vertices(target: &CloneSurface, held: &[u32]) -> Vec<bool> {
         .flat_map(|((a, b), _)| [a, b])
         .filter(|&v| (v as usize) < n && near_mouth(v));
     // The lips' margins and two rings around them: the slit's gap is read off the lips there.
-    let adj = adjacency(n, &target.triangles);
     let mut lips: Vec<u32> = border.collect();
     for _ in 0..2 {
         let ring: Vec<u32> = lips
@@ -185,40 +183,27 @@ fn fixed_vertices(target: &CloneSurface, held: &[u32]) -> Vec<bool> {
 
 /// The bound on every cloned motion (module docs). Returns, per repaired motion
 /// (`name@value`), how many target vertices were re-solved.
+/// `topology` is the one both `smooth` passes read, built for the same `motions`.
 pub(super) fn bound_turns(
-    source: &CloneSurface,
+    topology: &SmoothTopology,
     motions: &[SurfaceMotion],
     target: &CloneSurface,
     held: &[u32],
     out: &mut [SurfaceMotion],
 ) -> BTreeMap<String, usize> {
     let n = target.positions.len();
-    let fixed = fixed_vertices(target, held);
-    let adj = adjacency(n, &target.triangles);
-    let incident = incident_triangles(n, &target.triangles);
-    let source_incident = incident_triangles(source.positions.len(), &source.triangles);
-    let tn = normals(&target.positions, &target.triangles);
+    let (adj, incident, tn) = (&topology.adj, &topology.incident, &topology.tn);
+    let fixed = fixed_vertices(target, adj, held);
     let pos = &target.positions;
     let tris = &target.triangles;
-    let all: Vec<u32> = (0..tris.len() as u32).collect();
     let results: Vec<Option<(String, usize)>> = motions
         .par_iter()
+        .zip(&topology.source_turns)
         .zip(out.par_iter_mut())
-        .map(|(src, dst)| {
+        .map(|((src, &theta), dst)| {
             if dst.offsets.is_empty() {
                 return None;
             }
-            let mut sd = source.positions.clone();
-            for &(v, o) in &src.offsets {
-                if let Some(p) = sd.get_mut(v as usize) {
-                    *p += o;
-                }
-            }
-            let moved: Vec<[u32; 3]> = touching(&source_incident, &src.offsets)
-                .into_iter()
-                .map(|i| source.triangles[i as usize])
-                .collect();
-            let theta = max_normal_turn(&source.positions, &sd, &moved).angle;
             let tau = BOUND * theta.max(NORMAL_TURN_FLOOR);
             if tau >= std::f64::consts::PI {
                 return None;
@@ -230,17 +215,26 @@ pub(super) fn bound_turns(
                     *s = o;
                 }
             }
-            let mut bad: Vec<u32> = touching(&incident, &dst.offsets)
-                .into_iter()
+            // Only triangles with a moving corner can turn: those of the clone's motion and,
+            // as the fill spreads it, those around the region.
+            let moving = touching(incident, &dst.offsets);
+            let mut bad: Vec<u32> = moving
+                .iter()
+                .copied()
                 .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
                 .collect();
             if bad.is_empty() {
                 return None;
             }
-            // Each round's field is measured over every triangle; the best one is kept, and
-            // only if it turns less than the clone's own.
+            let mut measured = vec![false; tris.len()];
+            for &i in &moving {
+                measured[i as usize] = true;
+            }
+            let mut measure = moving;
+            // Each round's field is measured over every triangle that can turn; the best one
+            // is kept, and only if it turns less than the clone's own.
             let mut best = (
-                worst_cos(pos, &d, tris, &tn, &all),
+                worst_cos(pos, &d, tris, tn, &measure),
                 None::<(Vec<Vec3>, usize)>,
             );
             let mut follows = Follows::new();
@@ -274,8 +268,15 @@ pub(super) fn bound_turns(
                 for w in ring {
                     add(w, &mut region, &mut in_region);
                 }
-                fill(pos, &adj, &region, &follows, &mut d);
-                let worst = worst_cos(pos, &d, tris, &tn, &all);
+                fill(pos, adj, &region, &follows, &mut d);
+                for &v in &region {
+                    for &i in &incident[v as usize] {
+                        if !std::mem::replace(&mut measured[i as usize], true) {
+                            measure.push(i);
+                        }
+                    }
+                }
+                let worst = worst_cos(pos, &d, tris, tn, &measure);
                 if worst > best.0 {
                     best = (worst, Some((d.clone(), region.len())));
                 }
@@ -306,6 +307,7 @@ pub(super) fn bound_turns(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::clone::quality::max_normal_turn;
     use crate::fat::TableKey;
     use crate::fdp::{Fapu, FapuDistances};
     use crate::spec::FapId;
@@ -367,7 +369,9 @@ mod tests {
         let s = grid(9);
         let src = vec![motion(slope(&s))];
         let mut out = src.clone();
-        assert!(bound_turns(&s, &src, &s, &[], &mut out).is_empty());
+        assert!(
+            bound_turns(&SmoothTopology::new(&s, &src, &s), &src, &s, &[], &mut out).is_empty()
+        );
         assert_eq!(out, src);
     }
 
@@ -414,7 +418,7 @@ mod tests {
             before > 3.0 * BOUND * theta.max(NORMAL_TURN_FLOOR),
             "{before} {theta}"
         );
-        let done = bound_turns(&s, &src, &t, &[], &mut out);
+        let done = bound_turns(&SmoothTopology::new(&s, &src, &t), &src, &t, &[], &mut out);
         assert_eq!(done.len(), 1, "{done:?}");
         let after = turn(&t, &out[0]);
         assert!(
