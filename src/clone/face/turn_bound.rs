@@ -235,7 +235,8 @@ pub(super) fn bound_turns(
             // is kept, and only if it turns less than the clone's own.
             let mut best = (
                 worst_cos(pos, &d, tris, tn, &measure),
-                None::<(Vec<Vec3>, usize)>,
+                // The region's values of that round (only the region changes).
+                None::<Vec<Vec3>>,
             );
             let mut follows = Follows::new();
             let mut in_region = vec![false; n];
@@ -278,7 +279,7 @@ pub(super) fn bound_turns(
                 }
                 let worst = worst_cos(pos, &d, tris, tn, &measure);
                 if worst > best.0 {
-                    best = (worst, Some((d.clone(), region.len())));
+                    best = (worst, Some(region.iter().map(|&v| d[v as usize]).collect()));
                 }
                 let mut seen = std::collections::HashSet::new();
                 bad = region
@@ -291,7 +292,19 @@ pub(super) fn bound_turns(
                     break;
                 }
             }
-            let (d, count) = best.1?;
+            let kept = best.1?;
+            // The clone's own motion with the best round's region put back (later rounds
+            // changed a larger region).
+            d.fill(Vec3::ZERO);
+            for &(v, o) in &dst.offsets {
+                if let Some(s) = d.get_mut(v as usize) {
+                    *s = o;
+                }
+            }
+            let count = kept.len();
+            for (&v, &o) in region.iter().zip(&kept) {
+                d[v as usize] = o;
+            }
             dst.offsets = d
                 .iter()
                 .enumerate()
