@@ -17,6 +17,7 @@ use serde_json::{json, Value};
 
 use super::gltf_carried::ShareReader;
 use super::gltf_rotations::{eye_nodes, RotationNodes};
+use super::gltf_user_nodes::eye_node_refusal;
 use crate::error::Diagnostic;
 use crate::face::FaceModel;
 use crate::fat::eval::Activation;
@@ -187,16 +188,7 @@ pub fn eye_parts(
         if vertices.is_empty() {
             continue;
         }
-        let label = json["nodes"][node]["name"]
-            .as_str()
-            .map_or_else(|| format!("#{node}"), str::to_string);
-        let refuse = |why: String| {
-            Diagnostic::warning(format!(
-                "{}: eye node `{label}` is not turned ({why}); its eye motion stays in morph \
-                 targets",
-                source.path.display()
-            ))
-        };
+        let refuse = |why: String| eye_node_refusal(source, node, &why);
         // How much of every face vertex the joint moves.
         let mut shares: Vec<Vec<f32>> = Vec::with_capacity(face.meshes.len());
         let mut unreadable = None;

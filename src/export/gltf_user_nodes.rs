@@ -33,6 +33,17 @@ const EYEBALL_CARRIED: f32 = 0.95;
 /// turn skin (a lid weighted to the eye bone) with the eye.
 const STRAY_SHARE: f32 = 1e-3;
 
+/// The warning for an eye node of `source` that does not turn its eyeball, and `why`.
+pub(super) fn eye_node_refusal(source: &GltfSource, node: usize, why: &str) -> Diagnostic {
+    let label = source.json["nodes"][node]["name"]
+        .as_str()
+        .map_or_else(|| format!("#{node}"), str::to_string);
+    Diagnostic::warning(format!(
+        "{}: eye node `{label}` is not turned ({why}); its eye motion stays in morph targets",
+        source.path.display()
+    ))
+}
+
 /// The face transforms of `face` that the user's eye nodes show, as `(transform, node)`.
 /// Nodes already showing a transform (`taken`) are left as they are. An eye node shows an
 /// eyeball when it moves that eyeball alone: a plain mesh under it, or a skinned mesh
@@ -71,16 +82,7 @@ pub fn eye_transforms(
         let Some(node) = node.filter(|n| !taken.contains(&Some(*n))) else {
             continue;
         };
-        let label = json["nodes"][node]["name"]
-            .as_str()
-            .map_or_else(|| format!("#{node}"), str::to_string);
-        let refuse = |why: String| {
-            Diagnostic::warning(format!(
-                "{}: eye node `{label}` is not turned ({why}); its eye motion stays in morph \
-                 targets",
-                source.path.display()
-            ))
-        };
+        let refuse = |why: String| eye_node_refusal(source, node, &why);
         // How much of each face mesh's vertices the node moves (its own meshes and its
         // descendants', or skin weights on it and the joints below it).
         let mut unreadable = None;

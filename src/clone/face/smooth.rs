@@ -89,6 +89,27 @@ pub(super) fn incident_triangles(n: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u3
     incident
 }
 
+/// A motion's sparse `offsets` as a field over `n` vertices, zero elsewhere (offsets of
+/// vertices past `n` are ignored).
+pub(super) fn dense_field(n: usize, offsets: &[(u32, Vec3)]) -> Vec<Vec3> {
+    let mut d = vec![Vec3::ZERO; n];
+    for &(v, o) in offsets {
+        if let Some(s) = d.get_mut(v as usize) {
+            *s = o;
+        }
+    }
+    d
+}
+
+/// The non-zero, finite entries of a field, as a motion's sparse offsets.
+pub(super) fn sparse_offsets(d: &[Vec3]) -> Vec<(u32, Vec3)> {
+    d.iter()
+        .enumerate()
+        .filter(|(_, o)| **o != Vec3::ZERO && o.is_finite())
+        .map(|(v, &o)| (v as u32, o))
+        .collect()
+}
+
 /// The triangles (each once, ascending) with a corner among the `offsets`' vertices: the
 /// only ones a motion can turn, so the only ones its checks need to look at.
 pub(super) fn touching(incident: &[Vec<u32>], offsets: &[(u32, Vec3)]) -> Vec<u32> {
@@ -205,12 +226,7 @@ pub(super) fn smooth_motions(
                 return None;
             }
             let cos_tau = tau.cos() as f32;
-            let mut d = vec![Vec3::ZERO; n];
-            for &(v, o) in &dst.offsets {
-                if let Some(s) = d.get_mut(v as usize) {
-                    *s = o;
-                }
-            }
+            let mut d = dense_field(n, &dst.offsets);
             let pos = &target.positions;
             let tris = &target.triangles;
             let mut bad: Vec<u32> = touching(incident, &dst.offsets)
@@ -288,12 +304,7 @@ pub(super) fn smooth_motions(
                     break;
                 }
             }
-            dst.offsets = d
-                .iter()
-                .enumerate()
-                .filter(|(_, o)| **o != Vec3::ZERO && o.is_finite())
-                .map(|(v, &o)| (v as u32, o))
-                .collect();
+            dst.offsets = sparse_offsets(&d);
             Some((format!("{}@{}", src.key.name(), src.value), count))
         })
         .collect();

@@ -31,7 +31,7 @@ use std::collections::{BTreeMap, HashMap};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::smooth::{rough, touching, SmoothTopology};
+use super::smooth::{dense_field, rough, sparse_offsets, touching, SmoothTopology};
 use crate::clone::quality::NORMAL_TURN_FLOOR;
 use crate::clone::{CloneSurface, SurfaceMotion};
 
@@ -209,12 +209,7 @@ pub(super) fn bound_turns(
                 return None;
             }
             let cos_tau = tau.cos() as f32;
-            let mut d = vec![Vec3::ZERO; n];
-            for &(v, o) in &dst.offsets {
-                if let Some(s) = d.get_mut(v as usize) {
-                    *s = o;
-                }
-            }
+            let mut d = dense_field(n, &dst.offsets);
             // Only triangles with a moving corner can turn: those of the clone's motion and,
             // as the fill spreads it, those around the region.
             let moving = touching(incident, &dst.offsets);
@@ -295,22 +290,12 @@ pub(super) fn bound_turns(
             let kept = best.1?;
             // The clone's own motion with the best round's region put back (later rounds
             // changed a larger region).
-            d.fill(Vec3::ZERO);
-            for &(v, o) in &dst.offsets {
-                if let Some(s) = d.get_mut(v as usize) {
-                    *s = o;
-                }
-            }
+            let mut d = dense_field(n, &dst.offsets);
             let count = kept.len();
             for (&v, &o) in region.iter().zip(&kept) {
                 d[v as usize] = o;
             }
-            dst.offsets = d
-                .iter()
-                .enumerate()
-                .filter(|(_, o)| **o != Vec3::ZERO && o.is_finite())
-                .map(|(v, &o)| (v as u32, o))
-                .collect();
+            dst.offsets = sparse_offsets(&d);
             Some((format!("{}@{}", src.key.name(), src.value), count))
         })
         .collect();
