@@ -23,6 +23,7 @@ use crate::face::FaceModel;
 use crate::fat::eval::Activation;
 use crate::fat::{interval_weights, TableKey};
 use crate::gltf::source::GltfSource;
+use crate::mesh::rotation_fit::fit_rotation;
 use crate::spec::{FapId, FeaturePointId};
 
 /// Least share of an eyeball's skin weight on its eye joint (as for whole eyeball meshes).
@@ -412,32 +413,8 @@ fn fit_turns(
 fn kabsch(from: &[DVec3], to: &[DVec3], mean: DVec3) -> DMat3 {
     let n = to.len().max(1) as f64;
     let tm = to.iter().copied().sum::<DVec3>() / n;
-    let mut h = nalgebra::Matrix3::<f64>::zeros();
-    for (x, y) in from.iter().zip(to) {
-        let (p, q) = (*x - mean, *y - tm);
-        h += nalgebra::Vector3::new(q.x, q.y, q.z)
-            * nalgebra::Vector3::new(p.x, p.y, p.z).transpose();
-    }
-    let svd = h.svd(true, true);
-    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-        return DMat3::IDENTITY;
-    };
-    let mut d = nalgebra::Matrix3::<f64>::identity();
-    if (u * vt).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    let r = u * d * vt;
-    DMat3::from_cols_array(&[
-        r[(0, 0)],
-        r[(1, 0)],
-        r[(2, 0)],
-        r[(0, 1)],
-        r[(1, 1)],
-        r[(2, 1)],
-        r[(0, 2)],
-        r[(1, 2)],
-        r[(2, 2)],
-    ])
+    let pairs = from.iter().zip(to).map(|(x, y)| (*x - mean, *y - tm));
+    fit_rotation(pairs).map_or(DMat3::IDENTITY, |fit| fit.rotation)
 }
 
 #[cfg(test)]

@@ -21,6 +21,7 @@ pub mod geometry;
 pub mod obj;
 pub mod obj_patch;
 pub mod orient;
+pub mod rotation_fit;
 pub mod spatial;
 pub mod subdivide;
 pub(crate) mod text;

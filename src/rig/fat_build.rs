@@ -30,7 +30,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use glam::{DVec3, Vec3};
+use glam::{DQuat, DVec3, Vec3};
 use serde::Serialize;
 
 use super::fap_map::{FapMap, ShapeLookup};
@@ -41,6 +41,7 @@ use crate::fat::eval::Activation;
 use crate::fat::morph::{fat_from_morph_targets, MorphMesh, MorphTarget};
 use crate::fat::{FaceDefMesh, FaceDefTable, TableKey, HIGH_LEVEL_FULL};
 use crate::fdp::{Fapu, FeaturePointSet};
+use crate::mesh::rotation_fit::fit_rotation;
 use crate::spec::{Expression, FapId, FeaturePointId, Viseme};
 
 /// Smallest |FAP value| a shape at weight 1 must show to be calibrated: below it the shape
@@ -615,30 +616,17 @@ fn eyeball_angle(
 /// Kabsch fit `q ≈ R p + t`: the rotation vector of `R` and the RMS residual relative to the
 /// RMS motion.
 fn rigid_rotation(pairs: &[(DVec3, DVec3)]) -> (DVec3, f64) {
-    use nalgebra::{Matrix3, Rotation3, Vector3};
     let n = pairs.len() as f64;
     let cp = pairs.iter().map(|p| p.0).sum::<DVec3>() / n;
     let cq = pairs.iter().map(|p| p.1).sum::<DVec3>() / n;
-    let v = |d: DVec3| Vector3::new(d.x, d.y, d.z);
-    let mut h = Matrix3::zeros();
-    for (p, q) in pairs {
-        h += v(*p - cp) * v(*q - cq).transpose();
-    }
-    let svd = h.svd(true, true);
-    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+    let Some(fit) = fit_rotation(pairs.iter().map(|(p, q)| (*p - cp, *q - cq))) else {
         return (DVec3::ZERO, f64::INFINITY);
     };
-    let mut d = Matrix3::identity();
-    if (vt.transpose() * u.transpose()).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    let r = vt.transpose() * d * u.transpose();
-    let rot = Rotation3::from_matrix_unchecked(r);
-    let sa = rot.scaled_axis();
+    let r = fit.rotation;
     let (mut err, mut motion) = (0.0, 0.0);
     for (p, q) in pairs {
-        let fitted = r * v(*p - cp) + v(cq);
-        err += (fitted - v(*q)).norm_squared();
+        let fitted = r * (*p - cp) + cq;
+        err += (fitted - *q).length_squared();
         motion += (*q - *p).length_squared();
     }
     let residual = if motion > 0.0 {
@@ -646,7 +634,7 @@ fn rigid_rotation(pairs: &[(DVec3, DVec3)]) -> (DVec3, f64) {
     } else {
         f64::INFINITY
     };
-    (DVec3::new(sa.x, sa.y, sa.z), residual)
+    (DQuat::from_mat3(&r).to_scaled_axis(), residual)
 }
 
 #[cfg(test)]

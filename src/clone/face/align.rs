@@ -1,13 +1,14 @@
 //! The similarity that aligns the target face onto the source (Umeyama's least-squares fit,
 //! with small rotations snapped away; module docs of [`super`], step 2).
 
-use glam::{DMat3, DVec3, Vec3};
+use glam::{DVec3, Vec3};
 use serde::Serialize;
 
 use super::CloneOptions;
 use crate::clone::CloneError;
 use crate::error::Result;
 use crate::face::FaceModel;
+use crate::mesh::rotation_fit::fit_rotation;
 
 /// Largest turn (degrees) of a face's alignment under which it keeps its own axes
 /// ([`Similarity::keeps_own_axes`]).
@@ -83,44 +84,19 @@ impl Similarity {
         }
         let mf = from[..n].iter().sum::<DVec3>() / n as f64;
         let mt = to[..n].iter().sum::<DVec3>() / n as f64;
-        let mut cov = nalgebra::Matrix3::<f64>::zeros();
-        let mut var_f = 0.0;
-        for i in 0..n {
-            let a = from[i] - mf;
-            let b = to[i] - mt;
-            var_f += a.length_squared();
-            cov += nalgebra::Vector3::new(b.x, b.y, b.z)
-                * nalgebra::Vector3::new(a.x, a.y, a.z).transpose();
-        }
-        cov /= n as f64;
-        var_f /= n as f64;
-        let svd = cov.svd(true, true);
-        let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-            return Err(CloneError::SvdFailed.into());
-        };
-        let mut sv = svd.singular_values;
+        let var_f = from[..n]
+            .iter()
+            .map(|a| (*a - mf).length_squared())
+            .sum::<f64>()
+            / n as f64;
+        let pairs = (0..n).map(|i| ((from[i] - mf) / n as f64, to[i] - mt));
+        let fit = fit_rotation(pairs).ok_or(CloneError::SvdFailed)?;
         // Rank check: collinear points leave the rotation undetermined.
-        if var_f <= 0.0 || sv.iter().filter(|&&x| x > 1e-12 * sv.max()).count() < 2 {
+        if var_f <= 0.0 || fit.rank(1e-12) < 2 {
             return Err(CloneError::CollinearPoints.into());
         }
-        let mut d = nalgebra::Matrix3::<f64>::identity();
-        if (u * vt).determinant() < 0.0 {
-            d[(2, 2)] = -1.0;
-            sv[2] = -sv[2];
-        }
-        let r = u * d * vt;
-        let scale = sv.sum() / var_f;
-        let rm = DMat3::from_cols_array(&[
-            r[(0, 0)],
-            r[(1, 0)],
-            r[(2, 0)],
-            r[(0, 1)],
-            r[(1, 1)],
-            r[(2, 1)],
-            r[(0, 2)],
-            r[(1, 2)],
-            r[(2, 2)],
-        ]);
+        let scale = fit.singular_values.iter().sum::<f64>() / var_f;
+        let rm = fit.rotation;
         let rotation = glam::DQuat::from_mat3(&rm).normalize();
         let translation = mt - rotation * mf * scale;
         if !scale.is_finite() || scale <= 0.0 || !translation.is_finite() {
