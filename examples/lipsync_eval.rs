@@ -26,7 +26,7 @@ use fbakit::speech::espeak::{speak_at, TimedPhoneme, Utterance};
 use fbakit::speech::lipsync::coarticulation::lipsync_keys;
 use fbakit::speech::lipsync::evaluation::{degrade, score, Degradation, LipsyncScore};
 use fbakit::speech::lipsync::recognition::{
-    arpabet_to_espeak, recognise_file, recognition_available,
+    arpabet_to_espeak, recognise_file_with, recognition_available, Recognise,
 };
 use fbakit::speech::lipsync::{
     analyse_file, lipsync_recognised, lipsync_transcript_at, render_transcript, LipsyncOptions,
@@ -336,9 +336,19 @@ pub fn make_recording(
 pub fn run_recognised(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<LipsyncScore> {
     let (_dir, path, truth) = make_recording(text, c)?;
     let rec = analyse_file(&path, &mut |_| {})?;
-    let phones = recognise_file(&path, &mut |_| {})?;
+    let phones = recognise_file_with(&path, recogniser(), &mut |_| {})?;
     let sync = lipsync_recognised(&rec, phones, fps)?;
     Ok(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
+}
+
+/// How the figures without a transcript recognise speech: `LIPSYNC_EVAL_RECOGNISE=phones`
+/// or `words`, else the library's default.
+pub fn recogniser() -> Recognise {
+    match std::env::var("LIPSYNC_EVAL_RECOGNISE").as_deref() {
+        Ok("phones") => Recognise::Phones,
+        Ok("words") => Recognise::Words,
+        _ => Recognise::default(),
+    }
 }
 
 /// Runs one sentence under one condition; also without the transcript when `recognise`.
@@ -361,7 +371,7 @@ pub fn run_case_with(
     let started = Instant::now();
     let recognised = if recognise && recognition_available() {
         let rec = analyse_file(&path, &mut |_| {})?;
-        let phones = recognise_file(&path, &mut |_| {})?;
+        let phones = recognise_file_with(&path, recogniser(), &mut |_| {})?;
         let sync = lipsync_recognised(&rec, phones, fps)?;
         Some(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
     } else {

@@ -50,6 +50,7 @@ pub mod features;
 pub mod forced;
 pub mod recognition;
 pub mod rendition;
+pub mod words;
 
 use std::path::{Path, PathBuf};
 

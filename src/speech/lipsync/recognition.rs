@@ -49,7 +49,7 @@ pub(super) fn model_dir() -> PathBuf {
 }
 
 /// The acoustic model and phone language model, or why they are missing.
-fn model() -> Result<(PathBuf, PathBuf)> {
+pub(super) fn model() -> Result<(PathBuf, PathBuf)> {
     let dir = model_dir();
     let hmm = dir.join("en-us");
     let lm = dir.join("en-us-phone.lm.bin");
@@ -60,7 +60,7 @@ fn model() -> Result<(PathBuf, PathBuf)> {
     }
 }
 
-fn missing(detail: &str) -> Error {
+pub(super) fn missing(detail: &str) -> Error {
     SpeechError::EngineMissing {
         engine: "PocketSphinx".into(),
         why: format!("lip sync without a transcript recognises phones with it ({detail})"),
@@ -92,10 +92,43 @@ pub const SEGMENT_SECONDS: f64 = 300.0;
 /// cut falls in a pause rather than inside a phone.
 const CUT_SEARCH_SECONDS: f64 = 20.0;
 
-/// The ARPAbet phones of the recording at `path` with their times; the share of the file
-/// read goes to `progress`.
+/// The ARPAbet phones of the recording at `path` with their times, recognised as `how`
+/// says; the share of the file read goes to `progress`.
+pub fn recognise_file_with(
+    path: &Path,
+    how: Recognise,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<AlignedPhone>> {
+    match how {
+        Recognise::Phones => recognise_file(path, progress),
+        Recognise::Words => super::words::recognise_words_file(path, progress),
+    }
+}
+
+/// How speech is recognised without a transcript.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Recognise {
+    /// Phones from the phone loop.
+    #[default]
+    Phones,
+    /// Words from the English dictionary and language model; their phones and times.
+    Words,
+}
+
+/// The ARPAbet phones of the recording at `path` with their times, from the phone loop;
+/// the share of the file read goes to `progress`.
 pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<AlignedPhone>> {
     let (hmm, lm) = model()?;
+    in_pieces(path, progress, &mut |wav| run_recogniser(wav, &hmm, &lm))
+}
+
+/// `run` on the recording at `path`, written as 16 kHz WAV files of at most
+/// [`SEGMENT_SECONDS`] one at a time; what it finds in each, in file times.
+pub(super) fn in_pieces(
+    path: &Path,
+    progress: &mut dyn FnMut(f64),
+    run: &mut dyn FnMut(&Path) -> Result<Vec<AlignedPhone>>,
+) -> Result<Vec<AlignedPhone>> {
     // The recogniser reads 16 kHz mono 16-bit: pieces of the recording are written so, one
     // at a time, and recognised in turn.
     let scratch = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
@@ -107,10 +140,10 @@ pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<
     let mut pending: Vec<i16> = Vec::new();
     let mut offset = 0usize;
     let mut phones: Vec<AlignedPhone> = Vec::new();
-    let recognise = |samples: &[i16], offset: usize, phones: &mut Vec<AlignedPhone>| {
+    let mut recognise = |samples: &[i16], offset: usize, phones: &mut Vec<AlignedPhone>| {
         write_piece(&wav, samples)?;
         let start = offset as f64 / rate as f64;
-        for mut p in run_recogniser(&wav, &hmm, &lm)? {
+        for mut p in run(&wav)? {
             p.start += start;
             p.end += start;
             let floor = phones.last().map_or(0.0, |q: &AlignedPhone| q.end);
@@ -176,26 +209,25 @@ pub(super) fn write_piece(path: &Path, samples: &[i16]) -> Result<()> {
     w.finalize().map_err(encode)
 }
 
-/// Runs the recogniser on the 16 kHz WAV file `wav`.
+/// Runs the phone loop on the 16 kHz WAV file `wav`.
 fn run_recogniser(wav: &Path, hmm: &Path, lm: &Path) -> Result<Vec<AlignedPhone>> {
-    let out = Command::new(PROGRAM)
+    let mut cmd = Command::new(PROGRAM);
+    cmd.arg("-allphone")
+        .arg(lm)
+        .args(["-allphone_ci", "yes", "-backtrace", "yes"])
+        .args(["-beam", "1e-20", "-pbeam", "1e-20", "-lw", "1.0"]);
+    run_timed(cmd, wav, hmm)
+}
+
+/// Runs the recogniser `cmd` (its search set up) on the 16 kHz WAV file `wav` with the
+/// acoustic model `hmm`: what it heard, one `SYMBOL START END CONFIDENCE` line each.
+pub(super) fn run_timed(mut cmd: Command, wav: &Path, hmm: &Path) -> Result<Vec<AlignedPhone>> {
+    let out = cmd
         .arg("-infile")
         .arg(wav)
         .arg("-hmm")
         .arg(hmm)
-        .arg("-allphone")
-        .arg(lm)
-        .args(["-allphone_ci", "yes", "-backtrace", "yes", "-time", "yes"])
-        .args([
-            "-beam",
-            "1e-20",
-            "-pbeam",
-            "1e-20",
-            "-lw",
-            "1.0",
-            "-logfn",
-            "/dev/null",
-        ])
+        .args(["-time", "yes", "-logfn", "/dev/null"])
         .output()
         .map_err(|e| missing(&e.to_string()))?;
     if !out.status.success() {
