@@ -28,6 +28,7 @@ use fbakit::speech::lipsync::evaluation::{degrade, score, Degradation, LipsyncSc
 use fbakit::speech::lipsync::recognition::{
     arpabet_to_espeak, recognise_file_with, recognition_available, Recognise,
 };
+use fbakit::speech::lipsync::words::WordPhones;
 use fbakit::speech::lipsync::{
     analyse_file, lipsync_recognised, lipsync_transcript_at, render_transcript, LipsyncOptions,
 };
@@ -341,12 +342,15 @@ pub fn run_recognised(text: &str, c: &Condition, fps: f64) -> fbakit::error::Res
     Ok(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
 }
 
-/// How the figures without a transcript recognise speech: `LIPSYNC_EVAL_RECOGNISE=phones`
-/// or `words`, else the library's default.
+/// How the figures without a transcript recognise speech: `LIPSYNC_EVAL_RECOGNISE=phones`,
+/// `words` (dictionary phones sharing each word's time), `words-aligned` or `words-mixed`
+/// ([`WordPhones`]), else the library's default.
 pub fn recogniser() -> Recognise {
     match std::env::var("LIPSYNC_EVAL_RECOGNISE").as_deref() {
         Ok("phones") => Recognise::Phones,
-        Ok("words") => Recognise::Words,
+        Ok("words") => Recognise::Words(WordPhones::Shared),
+        Ok("words-aligned") => Recognise::Words(WordPhones::Aligned),
+        Ok("words-mixed") => Recognise::Words(WordPhones::Mixed),
         _ => Recognise::default(),
     }
 }

@@ -15,18 +15,20 @@
 //! 1 rather than 2 put more frames in the right mouth class on every condition (all: 63.9 →
 //! 66.3 %, closures 50.5 → 53.1 %, false closures 2.5 → 2.9 %), so it is used; a weight of
 //! 4, a phone insertion penalty of 0.3, wider beams, `-topn 2` or no noise removal moved
-//! the phones' own figures by a few points at most, none better on every condition. Word
-//! recognition (`-lm en-us.lm.bin -dict cmudict-en-us.dict`) to feed the transcript path was
-//! tried: on these voices it heard nonsense words, at about 3× real time.
+//! the phones' own figures by a few points at most, none better on every condition.
 //!
 //! On Festival's voices built from real speakers (`examples/lipsync_eval.rs`), clean, the
 //! phones include most m, b and p; with the evaluation's noise they mostly turn into f, v or
-//! th ([`super::closures::fricative_closures`] takes the f's and v's). Word recognition
-//! there heard "my mother bought a map of bombay" word for word (HTS voice slt, clean) and
-//! "my mother bought 'em up of bombay" (diphone voice kal), but at 3–4× real time on this
-//! machine (0.25 s of it loading the dictionary and language model); with settings fast
-//! enough (`-fwdflat no -bestpath no -maxhmmpf 3000 -topn 2`, 6× real time) the words were
-//! wrong. The phone lattice (for phone posteriors) is not available: `pocketsphinx_batch
+//! th ([`super::closures::fricative_closures`] takes the f's and v's).
+//!
+//! Word recognition ([`Recognise::Words`], [`super::words`]) hears Festival's clean voices
+//! word for word ("my mother bought a map of bombay"), but in the evaluation's noise the
+//! words go wrong; its phones, shared over the words' times, force-aligned, or mixed with
+//! the phone loop's where the words are unsure, were no better overall than the phone
+//! loop's on Festival's voices and worse on espeak-ng's, at about a quarter of the speed
+//! (figures in [`super::words`]). The phone loop stays the default.
+//!
+//! The phone lattice (for phone posteriors) is not available: `pocketsphinx_batch
 //! -outlatdir` gives none for the phone-loop search (`-allphone`).
 
 use std::path::{Path, PathBuf};
@@ -101,7 +103,7 @@ pub fn recognise_file_with(
 ) -> Result<Vec<AlignedPhone>> {
     match how {
         Recognise::Phones => recognise_file(path, progress),
-        Recognise::Words => super::words::recognise_words_file(path, progress),
+        Recognise::Words(placing) => super::words::recognise_words_file(path, placing, progress),
     }
 }
 
@@ -111,15 +113,16 @@ pub enum Recognise {
     /// Phones from the phone loop.
     #[default]
     Phones,
-    /// Words from the English dictionary and language model; their phones and times.
-    Words,
+    /// Words from the English dictionary and language model, their phones placed so
+    /// ([`super::words`]).
+    Words(super::words::WordPhones),
 }
 
 /// The ARPAbet phones of the recording at `path` with their times, from the phone loop;
 /// the share of the file read goes to `progress`.
 pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<AlignedPhone>> {
     let (hmm, lm) = model()?;
-    in_pieces(path, progress, &mut |wav| run_recogniser(wav, &hmm, &lm))
+    in_pieces(path, progress, &mut |wav| run_phone_loop(wav, &hmm, &lm))
 }
 
 /// `run` on the recording at `path`, written as 16 kHz WAV files of at most
@@ -210,7 +213,7 @@ pub(super) fn write_piece(path: &Path, samples: &[i16]) -> Result<()> {
 }
 
 /// Runs the phone loop on the 16 kHz WAV file `wav`.
-fn run_recogniser(wav: &Path, hmm: &Path, lm: &Path) -> Result<Vec<AlignedPhone>> {
+pub(super) fn run_phone_loop(wav: &Path, hmm: &Path, lm: &Path) -> Result<Vec<AlignedPhone>> {
     let mut cmd = Command::new(PROGRAM);
     cmd.arg("-allphone")
         .arg(lm)
