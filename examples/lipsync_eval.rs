@@ -17,6 +17,8 @@
 //! transcript path without PocketSphinx's forced alignment; needs espeak-ng; ffmpeg and
 //! pocketsphinx + pocketsphinx-en-us for the MP3 condition and the recognition figures;
 //! festival festvox-kallpc16k festvox-kdlpc16k festvox-us-slt-hts for the Festival ones).
+//! `LIPSYNC_EVAL_RECOGNISE=phones|words|words-aligned|words-mixed` chooses how the figures
+//! without a transcript recognise speech (`speech::lipsync::words` has the figures of each).
 #![allow(dead_code)] // Also included as a module by the tests, which do not call `main`.
 
 use std::time::Instant;
