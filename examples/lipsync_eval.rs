@@ -17,6 +17,8 @@
 //! transcript path without PocketSphinx's forced alignment; needs espeak-ng; ffmpeg and
 //! pocketsphinx + pocketsphinx-en-us for the MP3 condition and the recognition figures;
 //! festival festvox-kallpc16k festvox-kdlpc16k festvox-us-slt-hts for the Festival ones).
+//! `LIPSYNC_EVAL_RECOGNISE=phones|words|words-aligned|words-mixed` chooses how the figures
+//! without a transcript recognise speech (`speech::lipsync::words` has the figures of each).
 #![allow(dead_code)] // Also included as a module by the tests, which do not call `main`.
 
 use std::time::Instant;
@@ -26,8 +28,9 @@ use fbakit::speech::espeak::{speak_at, TimedPhoneme, Utterance};
 use fbakit::speech::lipsync::coarticulation::lipsync_keys;
 use fbakit::speech::lipsync::evaluation::{degrade, score, Degradation, LipsyncScore};
 use fbakit::speech::lipsync::recognition::{
-    arpabet_to_espeak, recognise_file, recognition_available,
+    arpabet_to_espeak, recognise_file_with, recognition_available, Recognise,
 };
+use fbakit::speech::lipsync::words::WordPhones;
 use fbakit::speech::lipsync::{
     analyse_file, lipsync_recognised, lipsync_transcript_at, render_transcript, LipsyncOptions,
 };
@@ -336,9 +339,22 @@ pub fn make_recording(
 pub fn run_recognised(text: &str, c: &Condition, fps: f64) -> fbakit::error::Result<LipsyncScore> {
     let (_dir, path, truth) = make_recording(text, c)?;
     let rec = analyse_file(&path, &mut |_| {})?;
-    let phones = recognise_file(&path, &mut |_| {})?;
+    let phones = recognise_file_with(&path, recogniser(), &mut |_| {})?;
     let sync = lipsync_recognised(&rec, phones, fps)?;
     Ok(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
+}
+
+/// How the figures without a transcript recognise speech: `LIPSYNC_EVAL_RECOGNISE=phones`,
+/// `words` (dictionary phones sharing each word's time), `words-aligned` or `words-mixed`
+/// ([`WordPhones`]), else the library's default.
+pub fn recogniser() -> Recognise {
+    match std::env::var("LIPSYNC_EVAL_RECOGNISE").as_deref() {
+        Ok("phones") => Recognise::Phones,
+        Ok("words") => Recognise::Words(WordPhones::Shared),
+        Ok("words-aligned") => Recognise::Words(WordPhones::Aligned),
+        Ok("words-mixed") => Recognise::Words(WordPhones::Mixed),
+        _ => Recognise::default(),
+    }
 }
 
 /// Runs one sentence under one condition; also without the transcript when `recognise`.
@@ -361,7 +377,7 @@ pub fn run_case_with(
     let started = Instant::now();
     let recognised = if recognise && recognition_available() {
         let rec = analyse_file(&path, &mut |_| {})?;
-        let phones = recognise_file(&path, &mut |_| {})?;
+        let phones = recognise_file_with(&path, recogniser(), &mut |_| {})?;
         let sync = lipsync_recognised(&rec, phones, fps)?;
         Some(score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps))
     } else {

@@ -15,18 +15,20 @@
 //! 1 rather than 2 put more frames in the right mouth class on every condition (all: 63.9 →
 //! 66.3 %, closures 50.5 → 53.1 %, false closures 2.5 → 2.9 %), so it is used; a weight of
 //! 4, a phone insertion penalty of 0.3, wider beams, `-topn 2` or no noise removal moved
-//! the phones' own figures by a few points at most, none better on every condition. Word
-//! recognition (`-lm en-us.lm.bin -dict cmudict-en-us.dict`) to feed the transcript path was
-//! tried: on these voices it heard nonsense words, at about 3× real time.
+//! the phones' own figures by a few points at most, none better on every condition.
 //!
 //! On Festival's voices built from real speakers (`examples/lipsync_eval.rs`), clean, the
 //! phones include most m, b and p; with the evaluation's noise they mostly turn into f, v or
-//! th ([`super::closures::fricative_closures`] takes the f's and v's). Word recognition
-//! there heard "my mother bought a map of bombay" word for word (HTS voice slt, clean) and
-//! "my mother bought 'em up of bombay" (diphone voice kal), but at 3–4× real time on this
-//! machine (0.25 s of it loading the dictionary and language model); with settings fast
-//! enough (`-fwdflat no -bestpath no -maxhmmpf 3000 -topn 2`, 6× real time) the words were
-//! wrong. The phone lattice (for phone posteriors) is not available: `pocketsphinx_batch
+//! th ([`super::closures::fricative_closures`] takes the f's and v's).
+//!
+//! Word recognition ([`Recognise::Words`], [`super::words`]) hears Festival's clean voices
+//! word for word ("my mother bought a map of bombay"), but in the evaluation's noise the
+//! words go wrong; its phones, shared over the words' times, force-aligned, or mixed with
+//! the phone loop's where the words are unsure, were no better overall than the phone
+//! loop's on Festival's voices and worse on espeak-ng's, at about a quarter of the speed
+//! (figures in [`super::words`]). The phone loop stays the default.
+//!
+//! The phone lattice (for phone posteriors) is not available: `pocketsphinx_batch
 //! -outlatdir` gives none for the phone-loop search (`-allphone`).
 
 use std::path::{Path, PathBuf};
@@ -49,7 +51,7 @@ pub(super) fn model_dir() -> PathBuf {
 }
 
 /// The acoustic model and phone language model, or why they are missing.
-fn model() -> Result<(PathBuf, PathBuf)> {
+pub(super) fn model() -> Result<(PathBuf, PathBuf)> {
     let dir = model_dir();
     let hmm = dir.join("en-us");
     let lm = dir.join("en-us-phone.lm.bin");
@@ -60,7 +62,7 @@ fn model() -> Result<(PathBuf, PathBuf)> {
     }
 }
 
-fn missing(detail: &str) -> Error {
+pub(super) fn missing(detail: &str) -> Error {
     SpeechError::EngineMissing {
         engine: "PocketSphinx".into(),
         why: format!("lip sync without a transcript recognises phones with it ({detail})"),
@@ -92,10 +94,44 @@ pub const SEGMENT_SECONDS: f64 = 300.0;
 /// cut falls in a pause rather than inside a phone.
 const CUT_SEARCH_SECONDS: f64 = 20.0;
 
-/// The ARPAbet phones of the recording at `path` with their times; the share of the file
-/// read goes to `progress`.
+/// The ARPAbet phones of the recording at `path` with their times, recognised as `how`
+/// says; the share of the file read goes to `progress`.
+pub fn recognise_file_with(
+    path: &Path,
+    how: Recognise,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<AlignedPhone>> {
+    match how {
+        Recognise::Phones => recognise_file(path, progress),
+        Recognise::Words(placing) => super::words::recognise_words_file(path, placing, progress),
+    }
+}
+
+/// How speech is recognised without a transcript.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Recognise {
+    /// Phones from the phone loop.
+    #[default]
+    Phones,
+    /// Words from the English dictionary and language model, their phones placed so
+    /// ([`super::words`]).
+    Words(super::words::WordPhones),
+}
+
+/// The ARPAbet phones of the recording at `path` with their times, from the phone loop;
+/// the share of the file read goes to `progress`.
 pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<AlignedPhone>> {
     let (hmm, lm) = model()?;
+    in_pieces(path, progress, &mut |wav| run_phone_loop(wav, &hmm, &lm))
+}
+
+/// `run` on the recording at `path`, written as 16 kHz WAV files of at most
+/// [`SEGMENT_SECONDS`] one at a time; what it finds in each, in file times.
+pub(super) fn in_pieces(
+    path: &Path,
+    progress: &mut dyn FnMut(f64),
+    run: &mut dyn FnMut(&Path) -> Result<Vec<AlignedPhone>>,
+) -> Result<Vec<AlignedPhone>> {
     // The recogniser reads 16 kHz mono 16-bit: pieces of the recording are written so, one
     // at a time, and recognised in turn.
     let scratch = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
@@ -107,10 +143,10 @@ pub fn recognise_file(path: &Path, progress: &mut dyn FnMut(f64)) -> Result<Vec<
     let mut pending: Vec<i16> = Vec::new();
     let mut offset = 0usize;
     let mut phones: Vec<AlignedPhone> = Vec::new();
-    let recognise = |samples: &[i16], offset: usize, phones: &mut Vec<AlignedPhone>| {
+    let mut recognise = |samples: &[i16], offset: usize, phones: &mut Vec<AlignedPhone>| {
         write_piece(&wav, samples)?;
         let start = offset as f64 / rate as f64;
-        for mut p in run_recogniser(&wav, &hmm, &lm)? {
+        for mut p in run(&wav)? {
             p.start += start;
             p.end += start;
             let floor = phones.last().map_or(0.0, |q: &AlignedPhone| q.end);
@@ -176,26 +212,25 @@ pub(super) fn write_piece(path: &Path, samples: &[i16]) -> Result<()> {
     w.finalize().map_err(encode)
 }
 
-/// Runs the recogniser on the 16 kHz WAV file `wav`.
-fn run_recogniser(wav: &Path, hmm: &Path, lm: &Path) -> Result<Vec<AlignedPhone>> {
-    let out = Command::new(PROGRAM)
+/// Runs the phone loop on the 16 kHz WAV file `wav`.
+pub(super) fn run_phone_loop(wav: &Path, hmm: &Path, lm: &Path) -> Result<Vec<AlignedPhone>> {
+    let mut cmd = Command::new(PROGRAM);
+    cmd.arg("-allphone")
+        .arg(lm)
+        .args(["-allphone_ci", "yes", "-backtrace", "yes"])
+        .args(["-beam", "1e-20", "-pbeam", "1e-20", "-lw", "1.0"]);
+    run_timed(cmd, wav, hmm)
+}
+
+/// Runs the recogniser `cmd` (its search set up) on the 16 kHz WAV file `wav` with the
+/// acoustic model `hmm`: what it heard, one `SYMBOL START END CONFIDENCE` line each.
+pub(super) fn run_timed(mut cmd: Command, wav: &Path, hmm: &Path) -> Result<Vec<AlignedPhone>> {
+    let out = cmd
         .arg("-infile")
         .arg(wav)
         .arg("-hmm")
         .arg(hmm)
-        .arg("-allphone")
-        .arg(lm)
-        .args(["-allphone_ci", "yes", "-backtrace", "yes", "-time", "yes"])
-        .args([
-            "-beam",
-            "1e-20",
-            "-pbeam",
-            "1e-20",
-            "-lw",
-            "1.0",
-            "-logfn",
-            "/dev/null",
-        ])
+        .args(["-time", "yes", "-logfn", "/dev/null"])
         .output()
         .map_err(|e| missing(&e.to_string()))?;
     if !out.status.success() {
