@@ -15,7 +15,8 @@
 //!
 //! `LIPSYNC_EVAL_LONG=SECONDS` measures long recordings instead: each condition's voice says
 //! the sentences in turn, joined with pauses, for about that long (`LIPSYNC_EVAL_KEEP=DIR`
-//! keeps each recording and its transcript there).
+//! keeps each recording, its transcript and its phones there; `LIPSYNC_EVAL_VOICE=NAME`
+//! measures one voice's conditions).
 //!
 //! Run: `cargo run --release --example lipsync_eval` (`LIPSYNC_WARP_ONLY=1` measures the
 //! transcript path without PocketSphinx's forced alignment; needs espeak-ng; ffmpeg and
@@ -549,9 +550,14 @@ pub fn run_long_case(
 /// joined into one recording of about that length.
 fn long_main(seconds: f64) {
     let keep = std::env::var_os("LIPSYNC_EVAL_KEEP").map(std::path::PathBuf::from);
+    // LIPSYNC_EVAL_VOICE=NAME measures only the conditions of that voice.
+    let only = std::env::var("LIPSYNC_EVAL_VOICE").ok();
     let mut total = Totals::default();
     let have_ffmpeg = ffmpeg_available();
     for c in conditions() {
+        if only.as_deref().is_some_and(|v| v != c.voice) {
+            continue;
+        }
         if c.mp3 && !have_ffmpeg {
             continue;
         }
