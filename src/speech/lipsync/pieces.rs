@@ -14,6 +14,13 @@
 //! rendition's pause, which does not depend on the warp placing each word well; elsewhere
 //! at the first word the warp puts after the cut. Such matched pauses are preferred, then
 //! longer ones.
+//!
+//! Measured on `examples/lipsync_eval.rs` with `LIPSYNC_EVAL_LONG=130` (each voice saying
+//! the 24 sentences in turn with pauses of 0.3 to 1.2 s): Festival's three voices 100 %
+//! closures shown, 96.4 % agreement, 1.0 % false closures (the warp alone on kal, 128 s:
+//! 98.3 / 83.4 / 4.3 %); espeak-ng's three 95.1–97.6 / 87.6–90.8 / 2.4–3.4 %, one piece of
+//! en-us+f3 at 200 wpm not fitting. A 300 s recording took 7.1 s of CPU, 43× real time
+//! (60 s: 4.0 s), and at most 23 MB (60 s: 20 MB).
 
 use std::ops::Range;
 
