@@ -6,7 +6,7 @@
 //! 290 s of speech). Cut into pieces of at most [`PIECE_SECONDS`], an hour costs about
 //! 90 short searches instead.
 //!
-//! A cut goes in the middle of a pause the recording has ([`super::activity`]). The words
+//! A cut goes in the middle of a pause the recording has ([`mod@super::activity`]). The words
 //! before it are found through the warp: espeak-ng's rendition of the transcript reports
 //! where each word starts, in its own time and in the text, and the warp carries those
 //! times into the recording's. Where the rendition also pauses (a sentence or clause end)
