@@ -13,6 +13,11 @@
 //! it says. Festival is for this evaluation only: the conditions are skipped, with a note,
 //! when it or a voice is not installed.
 //!
+//! `LIPSYNC_EVAL_LONG=SECONDS` measures long recordings instead: each condition's voice says
+//! the sentences in turn, joined with pauses, for about that long (`LIPSYNC_EVAL_KEEP=DIR`
+//! keeps each recording, its transcript and its phones there; `LIPSYNC_EVAL_VOICE=NAME`
+//! measures one voice's conditions).
+//!
 //! Run: `cargo run --release --example lipsync_eval` (`LIPSYNC_WARP_ONLY=1` measures the
 //! transcript path without PocketSphinx's forced alignment; needs espeak-ng; ffmpeg and
 //! pocketsphinx + pocketsphinx-en-us for the MP3 condition and the recognition figures;
@@ -243,6 +248,7 @@ pub fn festival_speak(text: &str, voice: &str) -> fbakit::error::Result<Utteranc
         sample_rate: spec.sample_rate,
         samples,
         phonemes,
+        words: Vec::new(),
     })
 }
 
@@ -420,6 +426,201 @@ pub fn run_case_with(
     })
 }
 
+/// More sentences for the long recordings, which speak these and [`SENTENCES`] in turn.
+pub const MORE_SENTENCES: [&str; 16] = [
+    "Every morning the baker opens his shop at half past five.",
+    "The museum will be closed for repairs until the end of March.",
+    "She played the violin in a small band for many years.",
+    "Before the storm, the boats were pulled up onto the beach.",
+    "My brother bought a bicycle with money from his summer job.",
+    "The committee met on Monday to approve the budget.",
+    "Most maps of the period show the river much farther west.",
+    "A warm breeze moved through the open windows of the room.",
+    "He promised to bring back a book from the public library.",
+    "The puppy chewed up both of my brand new boots.",
+    "Members of the team will meet the mayor in the main hall.",
+    "Put the blue bowl on the top shelf above the microwave.",
+    "We watched the moon rise slowly over the bay.",
+    "Mark the problem numbers you want to review before the exam.",
+    "The old bridge was built from stone more than a hundred years ago.",
+    "Many people prefer to walk when the weather is mild.",
+];
+
+/// A long recording under condition `c`: the sentences spoken one at a time in turn and
+/// joined with pauses of 0.3 to 1.2 s until it lasts at least `seconds`. The temporary
+/// directory (kept while the file is used), the file, its transcript and its phones.
+pub fn make_long_recording(
+    c: &Condition,
+    seconds: f64,
+) -> fbakit::error::Result<(
+    tempfile::TempDir,
+    std::path::PathBuf,
+    String,
+    Vec<TimedPhoneme>,
+)> {
+    let texts: Vec<&str> = SENTENCES.iter().chain(&MORE_SENTENCES).copied().collect();
+    let mut said: Vec<Option<Utterance>> = vec![None; texts.len()];
+    let mut whole = Utterance {
+        sample_rate: 0,
+        samples: Vec::new(),
+        phonemes: Vec::new(),
+        words: Vec::new(),
+    };
+    let mut transcript = String::new();
+    let mut k = 0usize;
+    while whole.duration() < seconds || k == 0 {
+        let i = k % texts.len();
+        if said[i].is_none() {
+            said[i] = Some(match c.synth {
+                Synth::Espeak => speak_at(texts[i], c.voice, c.rate)?,
+                Synth::Festival => festival_speak(texts[i], c.voice)?,
+            });
+        }
+        let u = said[i].as_ref().expect("spoken above");
+        whole.sample_rate = u.sample_rate;
+        // Pauses of several lengths, some too short to cut at.
+        let pause = [0.6, 0.3, 1.2, 0.45, 0.8][k % 5];
+        let gap = if k == 0 { 0.0 } else { pause };
+        let offset = whole.duration() + gap;
+        if gap > 0.0 {
+            whole.phonemes.push(TimedPhoneme {
+                symbol: "_".into(),
+                start: whole.duration(),
+                end: offset,
+            });
+        }
+        whole.samples.extend(std::iter::repeat_n(
+            0i16,
+            (gap * f64::from(u.sample_rate)) as usize,
+        ));
+        whole.samples.extend_from_slice(&u.samples);
+        whole
+            .phonemes
+            .extend(u.phonemes.iter().map(|p| TimedPhoneme {
+                start: p.start + offset,
+                end: p.end + offset,
+                ..p.clone()
+            }));
+        if !transcript.is_empty() {
+            transcript.push(' ');
+        }
+        transcript.push_str(texts[i]);
+        k += 1;
+    }
+    let (wav, truth) = degrade(&whole, &c.degradation)?;
+    let dir = tempfile::tempdir().map_err(|e| fbakit::error::Error::io("tempdir", e))?;
+    let path = dir.path().join("long.wav");
+    std::fs::write(&path, wav).map_err(|e| fbakit::error::Error::io(&path, e))?;
+    Ok((dir, path, transcript, truth))
+}
+
+/// The score of a long recording under condition `c` with its transcript.
+pub struct LongResult {
+    /// The aligner's score.
+    pub aligned: LipsyncScore,
+    /// Length of the recording.
+    pub audio_seconds: f64,
+    /// Time to analyse and align (no video).
+    pub work_seconds: f64,
+    /// The lip sync's warnings.
+    pub warnings: Vec<String>,
+    /// The phones' confidences (forced ones from the recogniser's scores).
+    pub confidences: Vec<f64>,
+}
+
+/// Aligns a recording of at least `seconds` made by [`make_long_recording`]; when `keep` is
+/// given the recording and its transcript are copied there (`long.wav`, `long.txt`).
+pub fn run_long_case(
+    c: &Condition,
+    seconds: f64,
+    fps: f64,
+    keep: Option<&std::path::Path>,
+) -> fbakit::error::Result<LongResult> {
+    let (_dir, path, text, truth) = make_long_recording(c, seconds)?;
+    if let Some(keep) = keep {
+        let io = |e| fbakit::error::Error::io(keep, e);
+        std::fs::create_dir_all(keep).map_err(io)?;
+        std::fs::copy(&path, keep.join("long.wav")).map_err(io)?;
+        std::fs::write(keep.join("long.txt"), &text).map_err(io)?;
+        let truth = serde_json::to_string(&truth).unwrap_or_default();
+        std::fs::write(keep.join("truth.json"), truth).map_err(io)?;
+    }
+    let started = Instant::now();
+    let rec = analyse_file(&path, &mut |_| {})?;
+    let opts = LipsyncOptions {
+        forced: std::env::var_os("LIPSYNC_WARP_ONLY").is_none(),
+        ..LipsyncOptions::default()
+    };
+    let sync = lipsync_transcript_at(&rec, &text, &opts, fps)?;
+    let work_seconds = started.elapsed().as_secs_f64();
+    Ok(LongResult {
+        aligned: score(&truth, &frames_of(&sync.keys, rec.seconds, fps), fps),
+        audio_seconds: rec.seconds,
+        work_seconds,
+        warnings: sync.warnings,
+        confidences: sync.phones.iter().map(|p| p.confidence).collect(),
+    })
+}
+
+/// The long-recording evaluation (`LIPSYNC_EVAL_LONG=SECONDS`): each condition's sentences
+/// joined into one recording of about that length.
+fn long_main(seconds: f64) {
+    let keep = std::env::var_os("LIPSYNC_EVAL_KEEP").map(std::path::PathBuf::from);
+    // LIPSYNC_EVAL_VOICE=NAME measures only the conditions of that voice.
+    let only = std::env::var("LIPSYNC_EVAL_VOICE").ok();
+    let mut total = Totals::default();
+    let have_ffmpeg = ffmpeg_available();
+    for c in conditions() {
+        if only.as_deref().is_some_and(|v| v != c.voice) {
+            continue;
+        }
+        if c.mp3 && !have_ffmpeg {
+            continue;
+        }
+        if c.synth == Synth::Festival && !festival_voice_available(c.voice) {
+            println!(
+                "{}: skipped (Festival or its voice is not installed)",
+                c.name
+            );
+            continue;
+        }
+        if c.mp3 {
+            // The long path reads MP3 like any file; the condition is left to the short
+            // evaluation to keep this one quick.
+            continue;
+        }
+        let keep = keep.as_ref().map(|k| k.join(c.voice));
+        match run_long_case(&c, seconds, 25.0, keep.as_deref()) {
+            Ok(r) => {
+                println!(
+                    "{}: {:.1} s in {:.2} s ({:.0}x real time)",
+                    c.name,
+                    r.audio_seconds,
+                    r.work_seconds,
+                    r.audio_seconds / r.work_seconds.max(1e-9)
+                );
+                line("aligned", &r.aligned);
+                for w in &r.warnings {
+                    println!("    warning: {w}");
+                }
+                if c.synth == Synth::Festival {
+                    total.aligned.add(&r.aligned);
+                    total.audio += r.audio_seconds;
+                    total.work += r.work_seconds;
+                }
+            }
+            Err(e) => println!("{}: {e}", c.name),
+        }
+    }
+    total.print("all Festival conditions, long", false);
+    println!(
+        "{:.1} s of audio analysed and aligned in {:.2} s: {:.0}x real time",
+        total.audio,
+        total.work,
+        total.audio / total.work.max(1e-9)
+    );
+}
+
 fn line(name: &str, s: &LipsyncScore) {
     println!(
         "  {name:<10} closures {:>5.1} % ({}/{})  agreement {:>5.1} %  false closures {:>4.1} %  ({} speech frames; PP on other consonants {:>4.1} %)",
@@ -472,6 +673,13 @@ fn main() {
     if !fbakit::speech::espeak_available() {
         eprintln!("espeak-ng is not installed (apt-get install espeak-ng)");
         std::process::exit(1);
+    }
+    if let Some(seconds) = std::env::var("LIPSYNC_EVAL_LONG")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+    {
+        long_main(seconds);
+        return;
     }
     // LIPSYNC_EVAL_TRANSCRIPT_ONLY skips the (slow) figures without a transcript.
     let recognise =

@@ -60,6 +60,10 @@ pub struct LipsyncArgs {
     #[arg(long, value_enum, default_value = "visemes")]
     pub mouth: MouthArg,
     /// Print the report (phones with times and confidences, per-frame visemes) as JSON.
+    /// A phone's confidence (0..1) says how well its sound fits the phone: from the speech
+    /// recogniser's acoustic score when it placed the phone (one half at −4 nats a frame
+    /// below the best-matching sound), else from how close the sound is to the transcript
+    /// spoken by espeak-ng there. The report's `confidence` is the transcript's overall fit.
     #[arg(long)]
     pub json: bool,
 }

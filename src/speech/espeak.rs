@@ -33,6 +33,15 @@ pub struct TimedPhoneme {
     pub end: f64,
 }
 
+/// A word's start in the audio and in the text.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct TimedWord {
+    /// Start in seconds from the beginning of the audio.
+    pub start: f64,
+    /// Byte offset of the word in the text spoken.
+    pub text_start: usize,
+}
+
 /// Synthesised speech: mono 16-bit samples and the phonemes in order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Utterance {
@@ -42,6 +51,8 @@ pub struct Utterance {
     pub samples: Vec<i16>,
     /// Phonemes, in time order, covering the audio from the first phoneme on.
     pub phonemes: Vec<TimedPhoneme>,
+    /// Where each word espeak-ng spoke starts, in time order (empty when not known).
+    pub words: Vec<TimedWord>,
 }
 
 impl Utterance {
@@ -59,6 +70,7 @@ const POS_CHARACTER: c_int = 1;
 const CHARS_UTF8: c_uint = 1;
 const ENDPAUSE: c_uint = 0x1000;
 const EVENT_LIST_TERMINATED: c_int = 0;
+const EVENT_WORD: c_int = 1;
 const EVENT_PHONEME: c_int = 7;
 const EE_OK: c_int = 0;
 
@@ -124,6 +136,8 @@ struct Collector {
     samples: Vec<i16>,
     /// (milliseconds, mnemonic)
     phonemes: Vec<(i64, String)>,
+    /// (milliseconds, 1-based character position in the text)
+    words: Vec<(i64, i64)>,
 }
 
 static ENGINE: OnceLock<std::result::Result<Mutex<Engine>, String>> = OnceLock::new();
@@ -217,6 +231,11 @@ unsafe extern "C" fn callback(wav: *mut c_short, n: c_int, events: *mut Event) -
                     i64::from((*e).audio_position),
                     String::from_utf8_lossy(&bytes).into_owned(),
                 ));
+            } else if (*e).kind == EVENT_WORD {
+                c.words.push((
+                    i64::from((*e).audio_position),
+                    i64::from((*e).text_position),
+                ));
             }
             e = e.add(1);
         }
@@ -291,9 +310,28 @@ pub fn speak_at(text: &str, voice: &str, words_per_minute: u32) -> Result<Uttera
     let duration = collected.samples.len() as f64 / f64::from(sample_rate);
     Ok(Utterance {
         phonemes: timed(&collected.phonemes, duration),
+        words: timed_words(&collected.words, text, duration),
         sample_rate,
         samples: collected.samples,
     })
+}
+
+/// Word events (milliseconds, 1-based character position) as times and byte offsets in
+/// `text`, in time order; positions past the text are dropped.
+pub fn timed_words(events: &[(i64, i64)], text: &str, duration: f64) -> Vec<TimedWord> {
+    let offsets: Vec<usize> = text.char_indices().map(|(b, _)| b).collect();
+    let mut out: Vec<TimedWord> = events
+        .iter()
+        .filter_map(|&(ms, pos)| {
+            let k = usize::try_from(pos.checked_sub(1)?).ok()?;
+            Some(TimedWord {
+                start: (ms as f64 / 1000.0).clamp(0.0, duration),
+                text_start: *offsets.get(k)?,
+            })
+        })
+        .collect();
+    out.sort_by(|a, b| a.start.total_cmp(&b.start));
+    out
 }
 
 fn poisoned() -> Error {
@@ -349,6 +387,15 @@ mod tests {
         assert!(t[2].start >= t[1].start);
         assert!(t.iter().all(|p| p.end >= p.start));
         assert!((t[3].end - 0.734).abs() < 1e-12);
+    }
+
+    #[test]
+    fn word_events_become_byte_offsets() {
+        // "é" takes two bytes: the fourth character, b, starts at byte 4.
+        let w = timed_words(&[(400, 4), (0, 1), (900, 0), (950, 99)], "éa bc", 0.5);
+        assert_eq!(w.len(), 2);
+        assert_eq!((w[0].start, w[0].text_start), (0.0, 0));
+        assert_eq!((w[1].start, w[1].text_start), (0.4, 4));
     }
 
     #[test]

@@ -38,6 +38,7 @@ mod tests {
             sample_rate: 22_050,
             samples: vec![0, 1, -1, i16::MAX, i16::MIN],
             phonemes: Vec::new(),
+            words: Vec::new(),
         };
         let bytes = wav_bytes(&u).unwrap();
         let mut r = hound::WavReader::new(std::io::Cursor::new(bytes)).unwrap();

@@ -9,13 +9,15 @@
 //! viseme keys. (Moving m/b/p closures onto the recording's energy dips was tried and
 //! measured: it showed fewer closures on the evaluation set, so it is not done.)
 //!
-//! **English** (`--lang en`, `en-*`) recordings read from a file of at most
-//! [`forced::MAX_SECONDS`] then have their phones placed by PocketSphinx's forced alignment
-//! ([`forced`]: the transcript's dictionary phones, the recording searched for exactly that
-//! sequence) when Debian's `pocketsphinx` and `pocketsphinx-en-us` are installed; the warp
-//! still gives the confidence, its warning and the refusal. Every other language, longer
-//! recordings, a missing PocketSphinx, or a transcript the recogniser cannot fit (a warning
-//! says so) keep the warp's times. On `examples/lipsync_eval.rs` forced alignment took
+//! **English** (`--lang en`, `en-*`) recordings read from a file then have their phones
+//! placed by PocketSphinx's forced alignment ([`forced`]: the transcript's dictionary
+//! phones, the recording searched for exactly that sequence) when Debian's `pocketsphinx`
+//! and `pocketsphinx-en-us` are installed, a piece of at most
+//! [`pieces::PIECE_SECONDS`] at a time cut at pauses ([`pieces`]), so recordings of any
+//! length; each phone gets a confidence from the recogniser's acoustic score, and the warp
+//! still gives the overall confidence, its warning and the refusal. Every other language,
+//! a missing PocketSphinx, or a piece of the transcript the recogniser cannot fit (a warning
+//! names its time span) keep the warp's times. On `examples/lipsync_eval.rs` forced alignment took
 //! Festival's voices built from real speakers (the honest stand-in for people) from 93.4 %
 //! closures shown, 78.7 % agreement and 4.9 % false closures to 100 / 96.3 / 1.3 %, every
 //! Festival condition better; on espeak-ng's own voices, whose rendition is the recording's
@@ -49,6 +51,7 @@ pub mod coarticulation;
 pub mod evaluation;
 pub mod features;
 pub mod forced;
+pub mod pieces;
 pub mod recognition;
 pub mod rendition;
 pub mod words;
@@ -61,6 +64,7 @@ use self::activity::{activity, Activity};
 use self::alignment::{unrelated_distance, warp, DEFAULT_RADIUS};
 use self::coarticulation::lipsync_keys;
 use self::features::{frame_at, frame_time, normalise, FeatureExtractor, FeatureFrame};
+use self::pieces::{plan, PlacedWord, RenditionPause, Timeline, MIN_PIECE_SECONDS, PIECE_SECONDS};
 pub use self::rendition::{render_features, render_transcript, Rendition};
 use super::animation::{frame_count, key_frame, MouthFaps, SpeechOptions, VisemeKey};
 use super::audio::{open_audio, AudioInfo, ANALYSIS_RATE};
@@ -79,9 +83,8 @@ pub struct LipsyncOptions {
     /// Extra cost of a warp step that holds one side still, as a share of the distance
     /// between unrelated frames: keeps the warp from stalling on noise.
     pub step_penalty: f64,
-    /// For English read from a file (at most [`forced::MAX_SECONDS`] long), place the phones
-    /// with PocketSphinx's forced alignment when it is installed, rather than through the
-    /// warp alone.
+    /// For English read from a file, place the phones with PocketSphinx's forced alignment
+    /// when it is installed, rather than through the warp alone.
     pub forced: bool,
 }
 
@@ -172,7 +175,12 @@ pub struct AlignedPhone {
     pub start: f64,
     /// End, seconds.
     pub end: f64,
-    /// How well the recording matches the rendition here, 0 (not at all) to 1.
+    /// How sure the placement is, 0 (not at all) to 1. Placed by forced alignment: from
+    /// the recogniser's acoustic score for the phone per frame, against the best-matching
+    /// sound of its model at each frame ([`forced::acoustic_confidence`]: one half at
+    /// −4 nats a frame). Placed by the warp: how close the recording's sound is to the
+    /// rendition's here, against unrelated frames. Recognised without a transcript: the
+    /// recogniser's own phone confidence.
     pub confidence: f64,
 }
 
@@ -314,34 +322,78 @@ pub fn lipsync_transcript_at(
     for k in 0..phones.len().saturating_sub(1) {
         phones[k].end = phones[k + 1].start.max(phones[k].start);
     }
-    let mut note = None;
-    if opts.forced
-        && forced::is_english(&opts.lang)
-        && rec.info.is_some()
-        && rec.seconds <= forced::MAX_SECONDS
-        && forced::available()
-    {
-        match forced::align_file(&rec.source, text)? {
-            Some(placed) => {
-                // The recogniser gives no per-phone score under a grammar: the warp's fit
-                // stands for each.
-                phones = placed
-                    .into_iter()
-                    .map(|p| AlignedPhone { confidence, ..p })
-                    .collect();
-            }
-            None => {
-                note = Some(
-                    "PocketSphinx could not fit the transcript's phones to the recording; \
-                     their times come from the warp alone"
-                        .to_string(),
+    let mut notes = Vec::new();
+    if opts.forced && forced::is_english(&opts.lang) && rec.info.is_some() && forced::available() {
+        let words: Vec<PlacedWord> = rendition
+            .words
+            .iter()
+            .map(|w| PlacedWord {
+                start: map_time(w.start),
+                text_start: w.text_start,
+            })
+            .collect();
+        let pauses = rendition_pauses(&rendition, text.len(), &map_time);
+        let energy: Vec<f32> = rec.frames.iter().map(|f| f.energy_db).collect();
+        let timeline = Timeline {
+            duration: rec.seconds,
+            text_len: text.len(),
+            silences: &rec.activity.silences,
+            rendition_pauses: &pauses,
+            words: &words,
+            energy_db: &energy,
+        };
+        let pieces = plan(&timeline, MIN_PIECE_SECONDS, PIECE_SECONDS);
+        drop(energy);
+        let pronounced = forced::pronounced_words(text)?;
+        let aligned = forced::align_pieces(&rec.source, &pronounced, &pieces, &phones)?;
+        if aligned.aligned_pieces > 0 {
+            phones = aligned.phones;
+        }
+        if pieces.len() == 1 && !aligned.failed.is_empty() {
+            notes.push(
+                "PocketSphinx could not fit the transcript's phones to the recording; \
+                 their times come from the warp alone"
+                    .to_string(),
+            );
+        } else {
+            notes.extend(aligned.failed.iter().map(|(a, b)| {
+                format!(
+                    "PocketSphinx could not fit the transcript's phones from {a:.1} to {b:.1} s; \
+                     their times there come from the warp alone"
                 )
-            }
+            }));
         }
     }
     let mut sync = finish(rec, phones, confidence, fps, |s| s.to_string(), false);
-    sync.warnings.extend(note);
+    sync.warnings.extend(notes);
     Ok(sync)
+}
+
+/// The rendition's pauses between words, carried into the recording by `map_time`, each
+/// with the byte offset of the word after it (`text_len` when none follows).
+fn rendition_pauses(
+    rendition: &Rendition,
+    text_len: usize,
+    map_time: &dyn Fn(f64) -> f64,
+) -> Vec<RenditionPause> {
+    let n = rendition.phonemes.len();
+    rendition
+        .phonemes
+        .iter()
+        .enumerate()
+        .filter(|(k, p)| *k > 0 && k + 1 < n && p.symbol.starts_with('_'))
+        .map(|(_, p)| {
+            let mid = 0.5 * (p.start + p.end);
+            RenditionPause {
+                start: map_time(p.start),
+                end: map_time(p.end),
+                next_word: rendition
+                    .words
+                    .get(rendition.words.partition_point(|w| w.start < mid))
+                    .map_or(text_len, |w| w.text_start),
+            }
+        })
+        .collect()
 }
 
 /// Phones recognised in the recording (ARPAbet, [`recognition`]) to a lip sync at `fps`;

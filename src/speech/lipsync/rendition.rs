@@ -9,7 +9,9 @@
 use super::features::{FeatureExtractor, FeatureFrame};
 use crate::error::Result;
 use crate::speech::audio::{Resampler, ANALYSIS_RATE};
-use crate::speech::espeak::{espeak_available, speak_at, TimedPhoneme, Utterance, DEFAULT_RATE};
+use crate::speech::espeak::{
+    espeak_available, speak_at, TimedPhoneme, TimedWord, Utterance, DEFAULT_RATE,
+};
 use crate::speech::SpeechError;
 
 /// Longest piece of transcript spoken at once, bytes (about a minute of speech).
@@ -20,10 +22,25 @@ pub const PIECE_BYTES: usize = 1_000;
 pub struct Rendition {
     /// The phonemes, in time order, covering the rendition (pauses `_` at both ends).
     pub phonemes: Vec<TimedPhoneme>,
+    /// Where each word starts, in time order (byte offsets into the whole transcript).
+    pub words: Vec<TimedWord>,
     /// Features every 10 ms.
     pub frames: Vec<FeatureFrame>,
     /// Length in seconds.
     pub seconds: f64,
+}
+
+/// Byte offset of `piece`, a slice of `text`, within it.
+fn offset_in(text: &str, piece: &str) -> usize {
+    (piece.as_ptr() as usize).saturating_sub(text.as_ptr() as usize)
+}
+
+/// `words` of a piece starting `seconds` and `bytes` into the whole.
+fn shifted(words: Vec<TimedWord>, seconds: f64, bytes: usize) -> impl Iterator<Item = TimedWord> {
+    words.into_iter().map(move |w| TimedWord {
+        start: w.start + seconds,
+        text_start: w.text_start + bytes,
+    })
 }
 
 fn engine_missing() -> crate::error::Error {
@@ -81,11 +98,16 @@ pub fn render_transcript(text: &str, voice: &str) -> Result<Utterance> {
     }
     let mut whole: Option<Utterance> = None;
     for piece in pieces(text, PIECE_BYTES) {
-        let u = speak_at(piece, voice, DEFAULT_RATE)?;
+        let mut u = speak_at(piece, voice, DEFAULT_RATE)?;
+        let bytes = offset_in(text, piece);
         match &mut whole {
-            None => whole = Some(u),
+            None => {
+                u.words = shifted(u.words, 0.0, bytes).collect();
+                whole = Some(u);
+            }
             Some(w) => {
                 let offset = w.duration();
+                w.words.extend(shifted(u.words, offset, bytes));
                 w.samples.extend_from_slice(&u.samples);
                 w.phonemes
                     .extend(u.phonemes.into_iter().map(|p| TimedPhoneme {
@@ -160,6 +182,7 @@ pub fn render_features(text: &str, voice: &str, pad: f64) -> Result<Rendition> {
     }
     let mut fx = Featuriser::new();
     let mut phonemes: Vec<TimedPhoneme> = Vec::new();
+    let mut words: Vec<TimedWord> = Vec::new();
     let mut rate = 0u32;
     let mut samples = 0u64;
     for piece in pieces(text, PIECE_BYTES) {
@@ -177,6 +200,7 @@ pub fn render_features(text: &str, voice: &str, pad: f64) -> Result<Rendition> {
             });
         }
         let offset = samples as f64 / f64::from(rate);
+        words.extend(shifted(u.words, offset, offset_in(text, piece)));
         phonemes.extend(u.phonemes.into_iter().map(|p| TimedPhoneme {
             start: p.start + offset,
             end: p.end + offset,
@@ -197,6 +221,7 @@ pub fn render_features(text: &str, voice: &str, pad: f64) -> Result<Rendition> {
     }
     Ok(Rendition {
         phonemes,
+        words,
         frames: fx.finish(),
         seconds,
     })
