@@ -208,17 +208,25 @@ fn print(p: &Pair) {
 /// (`viseme_9`, the same corner), candide → ict and → ict-rig 12.6 → 12.3 (`open_jaw`: the
 /// whole chin of the dense head turns more than CANDIDE's coarse one, over a thousand
 /// triangles; the fill does not bring it down), ict → alma 1.46 → 1.37, the rest within 0.01.
+/// Since `bound` holds only the FAP's own feature point and, where a triangle at that point
+/// turns over the bound, also tries it spread as a bump as wide as the source's triangles
+/// there (2026-11-27): the ICT heads onto CANDIDE 2.64 / 2.61 → 1.39 / 1.39 (the lid margin's
+/// eye-corner points no longer pin the re-solved skin: **met**), candide → ict and → ict-rig
+/// 12.3 → 9.50 (the chin point 2.1, 21 mm down beside neighbours at 13.5 mm, 86°, is spread;
+/// left: the chin below it and the mouth socket's cut, 63–66°), alma → ict and → ict-rig
+/// 4.02 → 3.52 (`viseme_12`), bruno → ict 5.09 → 4.90 (`viseme_9` at ICT's inner lip
+/// corner, inside the held slit), the rest within 0.01.
 const BOUNDS: [(&str, &str, f64, f64); 10] = [
-    ("alma", "ict", 0.015, 4.15),
-    ("bruno", "ict", 0.015, 5.25),
-    ("candide", "ict", 0.015, 12.7),
+    ("alma", "ict", 0.015, 3.6),
+    ("bruno", "ict", 0.015, 5.0),
+    ("candide", "ict", 0.015, 9.7),
     ("ict", "alma", 0.015, 1.45),
     ("ict", "bruno", 0.01, 2.05),
-    ("ict", "candide", 0.01, 2.75),
-    ("alma", "ict-rig", 0.015, 4.15),
-    ("candide", "ict-rig", 0.015, 12.7),
+    ("ict", "candide", 0.01, 1.45),
+    ("alma", "ict-rig", 0.015, 3.6),
+    ("candide", "ict-rig", 0.015, 9.7),
     ("ict-rig", "alma", 0.015, 1.45),
-    ("ict-rig", "candide", 0.01, 2.75),
+    ("ict-rig", "candide", 0.01, 1.45),
 ];
 
 #[test]

@@ -629,6 +629,7 @@ fn clone_skin_motions(
         .collect();
     for (k, n) in turn_bound::bound_turns(
         &topology,
+        &ssurf.surface,
         &moving,
         &tsurf.surface,
         &lids,

@@ -136,7 +136,7 @@ const MAX_GAIN: f64 = 10.0;
 
 /// Wendland's C² bump `(1 − x)⁴ (4x + 1)` on `[0, 1]`, 0 beyond: 1 at the centre, flat at
 /// both ends.
-fn bump(x: f32) -> f32 {
+pub(super) fn bump(x: f32) -> f32 {
     if x >= 1.0 {
         0.0
     } else {

@@ -31,6 +31,7 @@ use std::collections::{BTreeMap, HashMap};
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::rescale::{bump, fap_fp};
 use super::smooth::{dense_field, rough, sparse_offsets, touching, SmoothTopology};
 use crate::clone::quality::NORMAL_TURN_FLOOR;
 use crate::clone::{CloneSurface, SurfaceMotion};
@@ -131,8 +132,78 @@ fn worst_cos(
         .fold(1.0, f32::min)
 }
 
-/// The vertices every motion keeps (module docs): the feature points, the surface's borders
-/// near the mouth with two rings around them, and the `held` ones (the lid margins).
+/// How a low-level FAP's own feature point keeps its motion when a triangle at it turns
+/// over the bound: the point joins the fill, and afterwards the difference between its
+/// motion and the fill's is added back as a smooth bump (Wendland's, 1 at the point) over a
+/// ball as wide as the source's triangles around its own feature point. Held as one vertex
+/// beside its re-solved neighbours, the point stood out as a spike: the fill of a field
+/// pinned at one vertex falls off within one edge (CANDIDE-3's chin point under `open_jaw`
+/// moved 21 mm, its neighbours 4 mm away 13.5 mm: 86°, 12× the source's turn), while the
+/// source moves a whole coarse triangle fan with its point.
+struct PointSpread {
+    /// The feature point's vertex and its motion.
+    vertex: u32,
+    motion: Vec3,
+    /// The vertices of the ball that may move (not held) and their bump weights.
+    ball: Vec<(u32, f32)>,
+}
+
+impl PointSpread {
+    /// The spread of the feature point `vertex` of `target` under motion `motion`, with the
+    /// source's point at `source_vertex`; `None` without a usable radius.
+    fn new(
+        source: &CloneSurface,
+        source_incident: &[Vec<u32>],
+        source_vertex: u32,
+        target: &CloneSurface,
+        vertex: u32,
+        motion: Vec3,
+        fixed: &[bool],
+    ) -> Option<PointSpread> {
+        // The source's reach at its point: the mean length of its edges there (both faces
+        // are in the aligned frame).
+        let at = *source.positions.get(source_vertex as usize)?;
+        let (sum, count) = source_incident
+            .get(source_vertex as usize)?
+            .iter()
+            .flat_map(|&i| source.triangles[i as usize])
+            .filter(|&w| w != source_vertex)
+            .filter_map(|w| source.positions.get(w as usize))
+            .fold((0.0f32, 0usize), |(s, c), p| (s + p.distance(at), c + 1));
+        let radius = sum / count.max(1) as f32;
+        if !(radius > 0.0 && radius.is_finite()) {
+            return None;
+        }
+        let centre = *target.positions.get(vertex as usize)?;
+        let ball = target
+            .positions
+            .iter()
+            .enumerate()
+            .filter(|&(v, p)| !fixed[v] && v as u32 != vertex && p.distance(centre) < radius)
+            .map(|(v, p)| (v as u32, bump(p.distance(centre) / radius)))
+            .collect();
+        Some(PointSpread {
+            vertex,
+            motion,
+            ball,
+        })
+    }
+
+    /// Puts the point's motion back on `d` after a fill changed it, the difference spread
+    /// over the ball; every changed vertex joins the `region`.
+    fn apply(&self, d: &mut [Vec3], mut add: impl FnMut(u32)) {
+        let e = self.motion - d[self.vertex as usize];
+        d[self.vertex as usize] = self.motion;
+        for &(v, w) in &self.ball {
+            d[v as usize] += w * e;
+            add(v);
+        }
+    }
+}
+
+/// The vertices every motion keeps (module docs): the surface's borders near the mouth with
+/// two rings around them and the `held` ones (the lid margins). A motion's own feature point
+/// is kept by [`bound_turns`].
 fn fixed_vertices(target: &CloneSurface, adj: &[Vec<u32>], held: &[u32]) -> Vec<bool> {
     let n = target.positions.len();
     let mut fixed = vec![false; n];
@@ -167,13 +238,7 @@ fn fixed_vertices(target: &CloneSurface, adj: &[Vec<u32>], held: &[u32]) -> Vec<
             .collect();
         lips.extend(ring);
     }
-    for v in target
-        .fp_vertices
-        .values()
-        .copied()
-        .chain(held.iter().copied())
-        .chain(lips)
-    {
+    for v in held.iter().copied().chain(lips) {
         if let Some(f) = fixed.get_mut(v as usize) {
             *f = true;
         }
@@ -181,19 +246,162 @@ fn fixed_vertices(target: &CloneSurface, adj: &[Vec<u32>], held: &[u32]) -> Vec<
     fixed
 }
 
+/// What every motion's rounds read: the target's tables and the vertices held for all.
+struct Bounds<'a> {
+    topology: &'a SmoothTopology,
+    source: &'a CloneSurface,
+    target: &'a CloneSurface,
+    fixed: &'a [bool],
+}
+
+/// One motion's best round: its worst turn (cosine) and the values it gave its region.
+struct Round {
+    worst: f32,
+    values: Vec<(u32, Vec3)>,
+}
+
+impl Bounds<'_> {
+    /// The rounds of one motion (module docs) from the clone's field `d0`, whose triangles
+    /// that can turn are `measure`; the FAP's own feature point `own` (source and target vertex)
+    /// is held, or, with `spread`, spread ([`PointSpread`]) once a triangle at it is above
+    /// the bound. Returns the round turning least (`None` when none turned less than `best`,
+    /// the clone's own) and whether a triangle at the feature point was above the bound.
+    fn rounds(
+        &self,
+        d0: &[Vec3],
+        mut measure: Vec<u32>,
+        cos_tau: f32,
+        own: Option<(u32, u32)>,
+        spread_point: bool,
+        best: f32,
+    ) -> (Option<Round>, bool) {
+        let (adj, incident, tn) = (
+            &self.topology.adj,
+            &self.topology.incident,
+            &self.topology.tn,
+        );
+        let (pos, tris, fixed) = (&self.target.positions, &self.target.triangles, self.fixed);
+        let n = pos.len();
+        let mut d = d0.to_vec();
+        let mut bad: Vec<u32> = measure
+            .iter()
+            .copied()
+            .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+            .collect();
+        let mut measured = vec![false; tris.len()];
+        for &i in &measure {
+            measured[i as usize] = true;
+        }
+        let mut best = (best, None::<Vec<Vec3>>);
+        let mut follows = Follows::new();
+        let mut in_region = vec![false; n];
+        let mut region: Vec<u32> = Vec::new();
+        let add = |v: u32, region: &mut Vec<u32>, in_region: &mut Vec<bool>| {
+            if !in_region[v as usize] && !fixed[v as usize] {
+                in_region[v as usize] = true;
+                region.push(v);
+            }
+        };
+        let own_target = own.map(|o| o.1);
+        let mut spread: Option<PointSpread> = None;
+        let mut at_own = false;
+        for round in 0..ROUNDS {
+            if round > 0 {
+                for &i in &bad {
+                    let (c, edge) = apex(pos, &tris[i as usize]);
+                    if !fixed[c as usize] && Some(c) != own_target {
+                        follows.entry(c).or_insert(edge);
+                    }
+                }
+            }
+            for &i in &bad {
+                for &v in &tris[i as usize] {
+                    if Some(v) == own_target && spread.is_none() {
+                        at_own = true;
+                        if let (Some((sv, tv)), true) = (own, spread_point) {
+                            spread = PointSpread::new(
+                                self.source,
+                                &self.topology.source_incident,
+                                sv,
+                                self.target,
+                                tv,
+                                d[tv as usize],
+                                fixed,
+                            );
+                        }
+                        if spread.is_none() {
+                            continue;
+                        }
+                    }
+                    add(v, &mut region, &mut in_region);
+                }
+            }
+            // One ring around the whole region.
+            let ring: Vec<u32> = region
+                .iter()
+                .flat_map(|&v| adj[v as usize].iter().copied())
+                .collect();
+            for w in ring {
+                if Some(w) != own_target || spread.is_some() {
+                    add(w, &mut region, &mut in_region);
+                }
+            }
+            fill(pos, adj, &region, &follows, &mut d);
+            if let Some(s) = &spread {
+                s.apply(&mut d, |v| add(v, &mut region, &mut in_region));
+            }
+            for &v in &region {
+                for &i in &incident[v as usize] {
+                    if !std::mem::replace(&mut measured[i as usize], true) {
+                        measure.push(i);
+                    }
+                }
+            }
+            let worst = worst_cos(pos, &d, tris, tn, &measure);
+            if worst > best.0 {
+                best = (worst, Some(region.iter().map(|&v| d[v as usize]).collect()));
+            }
+            let mut seen = std::collections::HashSet::new();
+            bad = region
+                .iter()
+                .flat_map(|&v| incident[v as usize].iter().copied())
+                .filter(|&i| seen.insert(i))
+                .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+                .collect();
+            if bad.is_empty() {
+                break;
+            }
+        }
+        // The best round's region is the start of the last one's (the region only grows).
+        let round = best.1.map(|values| Round {
+            worst: best.0,
+            values: region.iter().copied().zip(values).collect(),
+        });
+        (round, at_own)
+    }
+}
+
 /// The bound on every cloned motion (module docs). Returns, per repaired motion
 /// (`name@value`), how many target vertices were re-solved.
-/// `topology` is the one both `smooth` passes read, built for the same `motions`.
+/// `topology` is the one both `smooth` passes read, built for `source`, the same `motions`
+/// and `target`.
 pub(super) fn bound_turns(
     topology: &SmoothTopology,
+    source: &CloneSurface,
     motions: &[SurfaceMotion],
     target: &CloneSurface,
     held: &[u32],
     out: &mut [SurfaceMotion],
 ) -> BTreeMap<String, usize> {
     let n = target.positions.len();
-    let (adj, incident, tn) = (&topology.adj, &topology.incident, &topology.tn);
-    let fixed = fixed_vertices(target, adj, held);
+    let (incident, tn) = (&topology.incident, &topology.tn);
+    let fixed = fixed_vertices(target, &topology.adj, held);
+    let bounds = Bounds {
+        topology,
+        source,
+        target,
+        fixed: &fixed,
+    };
     let pos = &target.positions;
     let tris = &target.triangles;
     let results: Vec<Option<(String, usize)>> = motions
@@ -209,94 +417,44 @@ pub(super) fn bound_turns(
                 return None;
             }
             let cos_tau = tau.cos() as f32;
-            let mut d = dense_field(n, &dst.offsets);
+            let d = dense_field(n, &dst.offsets);
             // Only triangles with a moving corner can turn: those of the clone's motion and,
             // as the fill spreads it, those around the region.
             let moving = touching(incident, &dst.offsets);
-            let mut bad: Vec<u32> = moving
+            if !moving
                 .iter()
-                .copied()
-                .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
-                .collect();
-            if bad.is_empty() {
+                .any(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+            {
                 return None;
             }
-            let mut measured = vec![false; tris.len()];
-            for &i in &moving {
-                measured[i as usize] = true;
-            }
-            let mut measure = moving;
             // Each round's field is measured over every triangle that can turn; the best one
             // is kept, and only if it turns less than the clone's own.
-            let mut best = (
-                worst_cos(pos, &d, tris, tn, &measure),
-                // The region's values of that round (only the region changes).
-                None::<Vec<Vec3>>,
-            );
-            let mut follows = Follows::new();
-            let mut in_region = vec![false; n];
-            let mut region: Vec<u32> = Vec::new();
-            let add = |v: u32, region: &mut Vec<u32>, in_region: &mut Vec<bool>| {
-                if !in_region[v as usize] && !fixed[v as usize] {
-                    in_region[v as usize] = true;
-                    region.push(v);
-                }
+            let own_cos = worst_cos(pos, &d, tris, tn, &moving);
+            // The FAP's own feature point keeps its motion (what the FAP defines, where
+            // compliance is measured); other feature points are skin like any other. Held
+            // as one vertex it can stand out as a spike, spread it can bend a wide ball:
+            // when a triangle at it turns over the bound both are tried, the better kept.
+            let own = fap_fp(src.key, source, target)
+                .map(|(fp, _)| (source.fp_vertices[&fp], target.fp_vertices[&fp]));
+            let (held_round, at_own) =
+                bounds.rounds(&d, moving.clone(), cos_tau, own, false, own_cos);
+            let floor = held_round.as_ref().map_or(own_cos, |r| r.worst);
+            let spread_round = if at_own {
+                bounds.rounds(&d, moving, cos_tau, own, true, floor).0
+            } else {
+                None
             };
-            for round in 0..ROUNDS {
-                if round > 0 {
-                    for &i in &bad {
-                        let (c, edge) = apex(pos, &tris[i as usize]);
-                        if !fixed[c as usize] {
-                            follows.entry(c).or_insert(edge);
-                        }
-                    }
-                }
-                for &i in &bad {
-                    for &v in &tris[i as usize] {
-                        add(v, &mut region, &mut in_region);
-                    }
-                }
-                // One ring around the whole region.
-                let ring: Vec<u32> = region
-                    .iter()
-                    .flat_map(|&v| adj[v as usize].iter().copied())
-                    .collect();
-                for w in ring {
-                    add(w, &mut region, &mut in_region);
-                }
-                fill(pos, adj, &region, &follows, &mut d);
-                for &v in &region {
-                    for &i in &incident[v as usize] {
-                        if !std::mem::replace(&mut measured[i as usize], true) {
-                            measure.push(i);
-                        }
-                    }
-                }
-                let worst = worst_cos(pos, &d, tris, tn, &measure);
-                if worst > best.0 {
-                    best = (worst, Some(region.iter().map(|&v| d[v as usize]).collect()));
-                }
-                let mut seen = std::collections::HashSet::new();
-                bad = region
-                    .iter()
-                    .flat_map(|&v| incident[v as usize].iter().copied())
-                    .filter(|&i| seen.insert(i))
-                    .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
-                    .collect();
-                if bad.is_empty() {
-                    break;
-                }
-            }
-            let kept = best.1?;
-            // The clone's own motion with the best round's region put back (later rounds
-            // changed a larger region).
-            let mut d = dense_field(n, &dst.offsets);
-            let count = kept.len();
-            for (&v, &o) in region.iter().zip(&kept) {
+            let kept = spread_round.or(held_round)?;
+            // The clone's own motion with the best round's region put back.
+            let mut d = d;
+            for &(v, o) in &kept.values {
                 d[v as usize] = o;
             }
             dst.offsets = sparse_offsets(&d);
-            Some((format!("{}@{}", src.key.name(), src.value), count))
+            Some((
+                format!("{}@{}", src.key.name(), src.value),
+                kept.values.len(),
+            ))
         })
         .collect();
     results.into_iter().flatten().collect()
@@ -362,14 +520,76 @@ mod tests {
             .collect()
     }
 
+    /// A `k × k` grid of spacing `h` with feature point 2.1 at its centre vertex.
+    fn chin_grid(k: u32, h: f32) -> CloneSurface {
+        let mut s = grid(k);
+        for p in &mut s.positions {
+            *p *= h;
+        }
+        s.fp_vertices
+            .insert(crate::spec::FeaturePointId::FP_2_1, (k / 2) * k + k / 2);
+        s
+    }
+
+    /// A tent in z: 1 at the centre (4, 4), 0 at a distance of 4 along each axis.
+    fn tent(s: &CloneSurface) -> Vec<(u32, Vec3)> {
+        s.positions
+            .iter()
+            .enumerate()
+            .map(|(v, p)| {
+                let r = ((p.x - 4.0).abs()).max((p.y - 4.0).abs());
+                (v as u32, Vec3::Z * (1.0 - r / 4.0).max(0.0))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_feature_point_standing_out_of_its_fill_is_spread_not_held() {
+        // The source: a coarse 3 × 3 grid (spacing 4) whose centre, the FAP's feature
+        // point, carries a tent (CANDIDE-3's chin under `open_jaw`). The target: the same
+        // square as a fine grid (spacing 0.5), the tent sampled, its feature point 0.3
+        // higher than the tent (the registration's exact point beside its neighbours).
+        let (s, t) = (chin_grid(3, 4.0), chin_grid(17, 0.5));
+        let src = vec![motion(tent(&s))];
+        let fp = t.fp_vertices[&crate::spec::FeaturePointId::FP_2_1];
+        let mut offsets = tent(&t);
+        offsets[fp as usize].1.z += 0.3;
+        let wanted = offsets[fp as usize].1;
+        let mut out = vec![motion(offsets)];
+        let before = turn(&t, &out[0]);
+        let theta = turn(&s, &src[0]);
+        assert!(before > BOUND * theta, "{before} {theta}");
+        bound_turns(
+            &SmoothTopology::new(&s, &src, &t),
+            &s,
+            &src,
+            &t,
+            &[],
+            &mut out,
+        );
+        let after = turn(&t, &out[0]);
+        // Held as one vertex the point stays a spike whatever its neighbours do (the fill
+        // pinned at one vertex falls off within an edge); spread, its neighbours rise with it.
+        assert!(after < 0.75 * before, "{after} {before} {theta}");
+        // The FAP still moves its point exactly.
+        let d = crate::clone::quality::dense(&out[0], t.positions.len());
+        assert_eq!(d[fp as usize], wanted);
+    }
+
     #[test]
     fn a_motion_under_the_bound_is_untouched() {
         let s = grid(9);
         let src = vec![motion(slope(&s))];
         let mut out = src.clone();
-        assert!(
-            bound_turns(&SmoothTopology::new(&s, &src, &s), &src, &s, &[], &mut out).is_empty()
-        );
+        assert!(bound_turns(
+            &SmoothTopology::new(&s, &src, &s),
+            &s,
+            &src,
+            &s,
+            &[],
+            &mut out
+        )
+        .is_empty());
         assert_eq!(out, src);
     }
 
@@ -416,7 +636,14 @@ mod tests {
             before > 3.0 * BOUND * theta.max(NORMAL_TURN_FLOOR),
             "{before} {theta}"
         );
-        let done = bound_turns(&SmoothTopology::new(&s, &src, &t), &src, &t, &[], &mut out);
+        let done = bound_turns(
+            &SmoothTopology::new(&s, &src, &t),
+            &s,
+            &src,
+            &t,
+            &[],
+            &mut out,
+        );
         assert_eq!(done.len(), 1, "{done:?}");
         let after = turn(&t, &out[0]);
         assert!(
