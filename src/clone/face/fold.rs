@@ -129,7 +129,7 @@ pub(super) fn fold_into_target(
     // so the part reads back as one motion (each mesh's bisection alone ends elsewhere).
     let mut cut_count: HashMap<usize, usize> = HashMap::new();
     for cut in &cuts {
-        let ts: BTreeSet<usize> = cut.meshes.iter().filter_map(|m| baked_by(m)).collect();
+        let ts: BTreeSet<usize> = cut.meshes.iter().filter_map(&baked_by).collect();
         for t in ts {
             *cut_count.entry(t).or_default() += 1;
         }
