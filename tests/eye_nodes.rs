@@ -7,7 +7,8 @@
 //! weighted eyeball stays in morph targets with a warning. Both eyeballs in one primitive of
 //! the skinned body (VRM / VRoid), each on its own eye joint, turn those joints by the turn
 //! fitted to the cloner's per-vertex rows (`nodeParts`); partly weighted, they stay baked
-//! with a warning. The head rotations are recorded on
+//! with a warning. So do VRoid's eyes, whose irises and highlights are more primitives (or a
+//! mesh of their own) on the same joints: each joint turns its eye over all of them. The head rotations are recorded on
 //! the `Head` joint and read back. The jaw joint takes `open_jaw` in play with every
 //! `open_jaw` target held at zero. VRML and new-document outputs keep the eye motion.
 
@@ -24,7 +25,7 @@ use fbakit::spec::{FapId, FeaturePointId};
 use glam::{Mat4, Quat, Vec3};
 use serde_json::Value;
 use support::avatar::{
-    self, Options, LEFT_EYE_JOINT, LEFT_EYE_MESH_NODE, LEFT_EYE_NODE, RIGHT_EYE_JOINT,
+    self, Options, VroidEyes, LEFT_EYE_JOINT, LEFT_EYE_MESH_NODE, LEFT_EYE_NODE, RIGHT_EYE_JOINT,
     RIGHT_EYE_MESH_NODE, RIGHT_EYE_NODE,
 };
 
@@ -894,15 +895,14 @@ fn an_eye_joint_that_moves_skin_too_is_not_used() {
     );
 }
 
-/// The avatar's `Body` with both eyeballs in its `eyes` primitive, skinned to the eye joints
-/// by `share` (the VRM / VRoid layout), cloned from alma into `d`: the glb and csv written,
-/// the output path and the clone's stderr.
-fn clone_vrm_eyes(d: &Path, source: &FaceModel, share: f32) -> (PathBuf, PathBuf, PathBuf, String) {
-    let opts = Options {
-        vrm_eyes: Some(share),
-        ..Options::default()
-    };
-    let (glb, csv) = write_avatar_with(d, source, &opts);
+/// The avatar with `opts` (an eye layout on the two eye joints), cloned from alma into `d`:
+/// the glb and csv written, the output path and the clone's stderr.
+fn clone_eyes_with(
+    d: &Path,
+    source: &FaceModel,
+    opts: &Options,
+) -> (PathBuf, PathBuf, PathBuf, String) {
+    let (glb, csv) = write_avatar_with(d, source, opts);
     let out = d.join("out.glb");
     let o = support::cli::command()
         .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
@@ -915,32 +915,45 @@ fn clone_vrm_eyes(d: &Path, source: &FaceModel, share: f32) -> (PathBuf, PathBuf
     (glb, csv, out, stderr)
 }
 
-/// Both eyeballs in one primitive of the skinned `Body`, each weighted wholly to its eye joint
-/// (VRM / VRoid): the joints show the eyes' turns. No eyeball target is written, the scene
-/// record lists each eyeball as a part its joint turns (`nodeParts`), the glb reads back with
-/// the clone's FAT (`face diff` equal), and `play` turns the joints so that the eyeballs
-/// posed by them (joint world × inverse bind, i.e. the joint's motion applied to the rest
-/// vertices) land where the FAT read back puts them within 1 % of the eyeball's size (2.4 cm
-/// across: the joint composes yaw and pitch where the FAT adds their displacements, 0.5 %
-/// at the stream's 0.13 rad mixed frame). The files add no validator issue, and three.js and
-/// Blender load the played one with its `play` clip.
-#[test]
-fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
+/// The eyes' turn FAPs (23–26) as table names.
+const TURNS: [&str; 4] = [
+    "yaw_l_eyeball",
+    "yaw_r_eyeball",
+    "pitch_l_eyeball",
+    "pitch_r_eyeball",
+];
+
+/// Every mesh's target names in a document.
+fn all_target_names(json: &Value) -> String {
+    json["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["extras"]["targetNames"].to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Eyeballs weighted wholly to their eye joints, their vertices in the face meshes
+/// `eye_meshes` (each holding both eyes): cloned from alma, the joints show the eyes' turns.
+/// No mesh has a target for the turns (every row of every eyeball mesh left them), the scene
+/// record lists each eyeball as a part its joint turns (`nodeParts`) over all of
+/// `eye_meshes`, the glb reads back with the clone's FAT (`face diff` equal), and `play`
+/// turns the joints so that the eyeballs posed by them (joint world × inverse bind, i.e. the
+/// joint's motion applied to the rest vertices) land where the FAT read back puts them
+/// within 1 % of the eyeball's size (2.4 cm across: the joint composes yaw and pitch where
+/// the FAT adds their displacements, 0.5 % at the stream's 0.13 rad mixed frame). The files
+/// add no validator issue, and three.js and Blender load the played one with its `play` clip.
+fn check_eye_joints_turn(opts: &Options, eye_meshes: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let source = fbakit::face::read("alma").unwrap();
-    let (glb, csv, out, stderr) = clone_vrm_eyes(d, &source, 1.0);
+    let (glb, csv, out, stderr) = clone_eyes_with(d, &source, opts);
     assert!(!stderr.contains("eye node"), "{stderr}");
     let (patched, _) = glb_parts(&out);
     // No target for the turns (23–26); the thrusts (27, 28) stay targets.
-    let turns = [
-        "yaw_l_eyeball",
-        "yaw_r_eyeball",
-        "pitch_l_eyeball",
-        "pitch_r_eyeball",
-    ];
-    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
-    assert!(!turns.iter().any(|t| names.contains(t)), "{names}");
+    let names = all_target_names(&patched);
+    assert!(!TURNS.iter().any(|t| names.contains(t)), "{names}");
     let record = &patched["scenes"][0]["extras"]["fbakit"];
     let parts = record["nodeParts"].as_array().expect("nodeParts");
     assert_eq!(parts.len(), 2, "{}", record["nodeParts"]);
@@ -960,6 +973,13 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
         for k in keys {
             assert!(tables.contains(k), "{k}: {tables}");
         }
+        let meshes: Vec<&str> = p["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["mesh"].as_str().unwrap())
+            .collect();
+        assert_eq!(meshes, eye_meshes, "joint {node}");
     }
 
     // Read back: the clone's FAT.
@@ -972,6 +992,35 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
     let back = fbakit::face::read(&out).unwrap();
     let report = diff(&cloned, &back, &DiffOptions::default());
     assert!(report.equal, "{report}");
+    if let [_] = eye_meshes {
+        // A file of the first schema (one `mesh` and its `vertices` on each entry) reads the
+        // same.
+        let (mut json, bin) = glb_parts(&out);
+        for p in json["scenes"][0]["extras"]["fbakit"]["nodeParts"]
+            .as_array_mut()
+            .unwrap()
+        {
+            let m = p["meshes"][0].clone();
+            let p = p.as_object_mut().unwrap();
+            p.remove("meshes");
+            p.insert("mesh".into(), m["mesh"].clone());
+            p.insert("vertices".into(), m["vertices"].clone());
+        }
+        let old = d.join("old-schema.glb");
+        let glb = avatar::Avatar {
+            json,
+            bin,
+            prims: Vec::new(),
+        }
+        .to_glb();
+        std::fs::write(&old, glb).unwrap();
+        let report = diff(
+            &back,
+            &fbakit::face::read(&old).unwrap(),
+            &DiffOptions::default(),
+        );
+        assert!(report.equal, "{report}");
+    }
 
     // Play a gaze stream: the joints turn the eyeballs where the FAT puts them.
     let gaze = write_gaze(d);
@@ -990,8 +1039,8 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
     assert!(o.status.success(), "{play_err}");
     assert!(!play_err.contains("eye node"), "{play_err}");
     let (pj, bin) = glb_parts(&played);
-    let names = pj["meshes"][0]["extras"]["targetNames"].to_string();
-    assert!(!turns.iter().any(|t| names.contains(t)), "{names}");
+    let names = all_target_names(&pj);
+    assert!(!TURNS.iter().any(|t| names.contains(t)), "{names}");
     let play = pj["animations"]
         .as_array()
         .unwrap()
@@ -1010,18 +1059,23 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
                 floats(&pj, &bin, s["output"].as_u64().unwrap() as usize)
             })
     };
-    // Both pupils on the one eyes mesh.
-    let (mesh, _) = back.fp_vertex(FeaturePointId::FP_3_5).unwrap();
-    assert_eq!(back.fp_vertex(FeaturePointId::FP_3_6).unwrap().0, mesh);
     let neutral = back.neutral_world_positions();
     for node in [LEFT_EYE_JOINT, RIGHT_EYE_JOINT] {
-        let vertices: Vec<usize> = part_of(node)["vertices"]
+        // The eyeball's vertices over its meshes: (face mesh, vertex).
+        let vertices: Vec<(usize, usize)> = part_of(node)["meshes"]
             .as_array()
             .unwrap()
             .iter()
-            .map(|v| v.as_u64().unwrap() as usize)
+            .flat_map(|m| {
+                let mi = back.mesh_index(m["mesh"].as_str().unwrap()).unwrap();
+                m["vertices"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(move |v| (mi, v.as_u64().unwrap() as usize))
+            })
             .collect();
-        let rest: Vec<Vec3> = vertices.iter().map(|&v| neutral[mesh][v]).collect();
+        let rest: Vec<Vec3> = vertices.iter().map(|&(m, v)| neutral[m][v]).collect();
         let lo = rest
             .iter()
             .fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
@@ -1041,9 +1095,9 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
             let motion = world * rest_world.inverse();
             let posed = back.pose(&gaze_activations(v)).unwrap();
             let mut moved = 0.0f32;
-            for (&vi, &p) in vertices.iter().zip(&rest) {
+            for (&(mi, vi), &p) in vertices.iter().zip(&rest) {
                 let got = motion.transform_point3(p);
-                let want = posed[mesh][vi];
+                let want = posed[mi][vi];
                 moved = moved.max(want.distance(p));
                 worst = worst.max(got.distance(want) / size);
             }
@@ -1060,7 +1114,7 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
             "joint {node}: off by {worst} of the eyeball's size"
         );
     }
-    // No turn weights are keyed: the played `Body` has no target for them at all.
+    // No turn weights are keyed: the played meshes have no target for them at all.
     assert!(channel(LEFT_EYE_JOINT, "weights").is_none());
 
     let files = [glb.clone(), out.clone(), played.clone()];
@@ -1099,6 +1153,84 @@ fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
     }
 }
 
+/// Both eyeballs in one primitive of the skinned `Body`, each weighted wholly to its eye joint
+/// (VRM): the joints show the eyes' turns ([`check_eye_joints_turn`]).
+#[test]
+fn eyeballs_in_one_primitive_turn_their_two_eye_joints() {
+    check_eye_joints_turn(
+        &Options {
+            vrm_eyes: Some(1.0),
+            ..Options::default()
+        },
+        &["Body.2"],
+    );
+}
+
+/// VRoid's eyes: the eye whites in `Body`'s `eyes` primitive, the irises and the highlights
+/// (floating in front) in two more primitives of `Body`, all on the eye joints: each joint
+/// turns its eye over the three primitives ([`check_eye_joints_turn`]).
+#[test]
+fn eyes_over_three_primitives_turn_their_two_eye_joints() {
+    check_eye_joints_turn(
+        &Options {
+            vroid_eyes: Some(VroidEyes {
+                highlight_node: false,
+                iris_share: 1.0,
+            }),
+            ..Options::default()
+        },
+        &["Body.2", "Body.4", "Body.5"],
+    );
+}
+
+/// As [`eyes_over_three_primitives_turn_their_two_eye_joints`] with the highlights in a
+/// mesh node of their own, skinned to the same joints.
+#[test]
+fn eyes_over_two_meshes_turn_their_two_eye_joints() {
+    check_eye_joints_turn(
+        &Options {
+            vroid_eyes: Some(VroidEyes {
+                highlight_node: true,
+                iris_share: 1.0,
+            }),
+            ..Options::default()
+        },
+        &["Body.2", "Body.4", "EyeHighlight"],
+    );
+}
+
+/// VRoid's eyes with the irises weighted to their eye joints by 60 % only (the eye whites and
+/// highlights wholly): the joints cannot turn them; the eye motion stays baked in morph
+/// targets, with one warning per joint naming the iris primitive.
+#[test]
+fn eyes_over_three_primitives_partly_weighted_stay_baked_and_are_said_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let opts = Options {
+        vroid_eyes: Some(VroidEyes {
+            highlight_node: false,
+            iris_share: 0.6,
+        }),
+        ..Options::default()
+    };
+    let (_, _, out, stderr) = clone_eyes_with(d, &source, &opts);
+    for joint in ["LeftEye", "RightEye"] {
+        let said =
+            format!("eye node `{joint}` is not turned (the eyeball in mesh `Body.4` is weighted");
+        assert_eq!(stderr.matches(&said).count(), 1, "{joint}: {stderr}");
+    }
+    assert!(stderr.contains("by 60 % only"), "{stderr}");
+    let (patched, _) = glb_parts(&out);
+    let names = patched["meshes"][0]["extras"]["targetNames"].to_string();
+    for name in TURNS {
+        assert!(names.contains(name), "{name}: {names}");
+    }
+    assert!(patched["scenes"][0]["extras"]["fbakit"]
+        .get("nodeParts")
+        .is_none());
+}
+
 /// Both eyeballs in one primitive weighted to their eye joints by 60 % only: the joints
 /// cannot turn them; the eye motion stays baked in morph targets, with one warning per joint
 /// saying why.
@@ -1107,7 +1239,11 @@ fn eyeballs_in_one_primitive_partly_weighted_stay_baked_and_are_said_so() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let source = fbakit::face::read("alma").unwrap();
-    let (_, _, out, stderr) = clone_vrm_eyes(d, &source, 0.6);
+    let opts = Options {
+        vrm_eyes: Some(0.6),
+        ..Options::default()
+    };
+    let (_, _, out, stderr) = clone_eyes_with(d, &source, &opts);
     for joint in ["LeftEye", "RightEye"] {
         let said = format!("eye node `{joint}` is not turned (the eyeball in mesh ");
         assert_eq!(stderr.matches(&said).count(), 1, "{joint}: {stderr}");

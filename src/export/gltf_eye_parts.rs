@@ -5,12 +5,14 @@
 //! The cloner cuts such a primitive into one eyeball each and bakes each eye's turn (FAPs
 //! 23–26) into per-vertex displacements of that eyeball's vertices (a FAT transform covers a
 //! whole mesh). When an eye joint carries at least 95 % of the skin weight of the vertices one
-//! eye's tables move, and nothing else of the face beyond strays, the joint shows that motion
-//! instead: the displacements at each interval border of the eye's tables are fitted by a
-//! rotation about one pivot (the eyeball's centre, common to yaw and pitch), the vertices get
-//! no morph delta under those tables, and `play` turns the joint by the fitted rotation
-//! (interpolated in angle between borders). The fit is recorded in the scene's extras
-//! (`nodeParts`, `specs/gltf-fat.md`), from which a reader rebuilds the same per-vertex rows.
+//! eye's tables move — in the pupil's mesh and in every other mesh the joint carries any of
+//! them (VRoid's iris and highlight primitives, or meshes of their own) — and nothing else of
+//! the face beyond strays, the joint shows that motion instead: the displacements at each
+//! interval border of the eye's tables are fitted, over all those meshes, by a rotation about
+//! one pivot (the eyeball's centre, common to yaw and pitch), the vertices get no morph delta
+//! under those tables, and `play` turns the joint by the fitted rotation (interpolated in
+//! angle between borders). The fit is recorded in the scene's extras (`nodeParts`,
+//! `specs/gltf-fat.md`), from which a reader rebuilds the same per-vertex rows.
 
 use glam::{Affine3A, DMat3, DVec3, Quat, Vec3};
 use serde_json::{json, Value};
@@ -21,7 +23,7 @@ use super::gltf_user_nodes::eye_node_refusal;
 use crate::error::Diagnostic;
 use crate::face::FaceModel;
 use crate::fat::eval::Activation;
-use crate::fat::{interval_weights, TableKey};
+use crate::fat::{interval_weights, FaceDefMesh, TableKey};
 use crate::gltf::source::GltfSource;
 use crate::mesh::rotation_fit::fit_rotation;
 use crate::spec::{FapId, FeaturePointId};
@@ -73,15 +75,23 @@ impl PartTurn {
     }
 }
 
-/// An eyeball of a mesh shown by a user's eye joint.
+/// The vertices of one face mesh that belong to an eyeball a joint turns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartMesh {
+    /// The face mesh.
+    pub mesh: usize,
+    /// Its vertices in the eyeball (those the eye's tables move), increasing.
+    pub vertices: Vec<u32>,
+}
+
+/// An eyeball shown by a user's eye joint: vertices of one or several face meshes (VRoid's
+/// eye white, iris and highlight primitives), turned about one pivot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EyePart {
     /// The glTF node (the eye joint).
     pub node: usize,
-    /// The face mesh holding the eyeball.
-    pub mesh: usize,
-    /// The eyeball's vertices (those the eye's tables move).
-    pub vertices: Vec<u32>,
+    /// The eyeball's vertices, per face mesh (in the face's mesh order).
+    pub meshes: Vec<PartMesh>,
     /// The pivot, in the face frame.
     pub center: Vec3,
     /// One turn per table of the eye.
@@ -112,10 +122,12 @@ impl EyePart {
     pub fn record(&self, face: &FaceModel, scale: f32) -> Value {
         let c = self.center * scale;
         json!({
-            "mesh": face.meshes[self.mesh].name,
+            "meshes": self.meshes.iter().map(|m| json!({
+                "mesh": face.meshes[m.mesh].name,
+                "vertices": m.vertices,
+            })).collect::<Vec<_>>(),
             "node": self.node,
             "userNode": true,
-            "vertices": self.vertices,
             "center": [c.x, c.y, c.z],
             "tables": self.turns.iter().map(|t| json!({
                 "key": t.key.name(),
@@ -126,11 +138,22 @@ impl EyePart {
     }
 }
 
-/// The eyeballs of `face` that are vertices of a mesh (their eye's tables move them vertex by
-/// vertex) and that the user's eye joints turn alone (module docs). Nodes in `taken` already
-/// show something. An eye joint weighted to part of its eyeball, or to more than it, or an
-/// eyeball the FAT does not turn rigidly, is not used: a warning says why, and the motion
-/// stays in morph targets.
+/// One face mesh's share of an eyeball while it is fitted: its frame, its vertices the eye's
+/// tables move, and those tables' entries on it.
+struct BallMesh<'a> {
+    mesh: usize,
+    frame: Affine3A,
+    vertices: Vec<u32>,
+    entries: Vec<(TableKey, &'a FaceDefMesh)>,
+}
+
+/// The eyeballs of `face` that are vertices of meshes (their eye's tables move them vertex by
+/// vertex) and that the user's eye joints turn alone (module docs). An eyeball is every vertex,
+/// over the face's meshes, that its eye's yaw and pitch tables move, on the pupil's mesh and on
+/// every other mesh the joint carries any of them (VRoid's eye white, iris and highlight).
+/// Nodes in `taken` already show something. An eye joint weighted to part of its eyeball in
+/// any of those meshes, or to more than it, or an eyeball the FAT does not turn rigidly, is
+/// not used: a warning says why, and the motion stays in morph targets.
 pub fn eye_parts(
     face: &FaceModel,
     source: &GltfSource,
@@ -147,46 +170,47 @@ pub fn eye_parts(
         let Some(node) = node.filter(|n| !taken.contains(n)) else {
             continue;
         };
-        let Some((mesh, pupil_vertex)) = face.fp_vertex(pupil) else {
+        let Some((pupil_mesh, pupil_vertex)) = face.fp_vertex(pupil) else {
             continue;
         };
-        let fm = &face.meshes[mesh];
         let keys: Vec<TableKey> = [yaw, pitch]
             .into_iter()
             .filter_map(FapId::new)
             .map(TableKey::LowLevel)
             .collect();
-        // The eye's entries on the pupil's mesh, and the vertices they move.
-        let entries: Vec<(TableKey, &crate::fat::FaceDefMesh)> = face
-            .fat
-            .tables
+        // Per face mesh, the eye's entries on it and the vertices they move.
+        let moved: Vec<BallMesh> = face
+            .meshes
             .iter()
-            .filter(|t| keys.contains(&t.key))
-            .flat_map(|t| {
-                t.meshes
+            .enumerate()
+            .map(|(mi, fm)| {
+                let entries: Vec<(TableKey, &FaceDefMesh)> = face
+                    .fat
+                    .tables
                     .iter()
-                    .filter(|m| m.mesh == fm.name)
-                    .map(move |m| (t.key, m))
-            })
-            .collect();
-        let mut vertices: Vec<u32> = entries
-            .iter()
-            .flat_map(|(_, e)| {
-                let k = e.interval_count();
-                e.coord_index
-                    .iter()
-                    .enumerate()
-                    .filter(move |(i, _)| {
-                        e.displacements
-                            .get(i * k..(i + 1) * k)
-                            .is_some_and(|r| r.iter().any(|d| *d != Vec3::ZERO))
+                    .filter(|t| keys.contains(&t.key))
+                    .flat_map(|t| {
+                        t.meshes
+                            .iter()
+                            .filter(|m| m.mesh == fm.name)
+                            .map(move |m| (t.key, m))
                     })
-                    .map(|(_, &v)| v)
+                    .collect();
+                let mut vertices: Vec<u32> = entries
+                    .iter()
+                    .flat_map(|(_, e)| moved_vertices(e))
+                    .collect();
+                vertices.sort_unstable();
+                vertices.dedup();
+                BallMesh {
+                    mesh: mi,
+                    frame: frames.meshes[mi],
+                    vertices,
+                    entries,
+                }
             })
             .collect();
-        vertices.sort_unstable();
-        vertices.dedup();
-        if vertices.is_empty() {
+        if moved[pupil_mesh].vertices.is_empty() {
             continue;
         }
         let refuse = |why: String| eye_node_refusal(source, node, &why);
@@ -207,12 +231,23 @@ pub fn eye_parts(
             };
             shares.push(s);
         }
-        let on = &shares[mesh];
-        let mean = vertices
+        // The mean share of the moved vertices of each mesh.
+        let mean = |b: &BallMesh| {
+            let on = &shares[b.mesh];
+            b.vertices
+                .iter()
+                .map(|&v| on.get(v as usize).copied().unwrap_or(0.0))
+                .sum::<f32>()
+                / b.vertices.len().max(1) as f32
+        };
+        let ball: Vec<&BallMesh> = moved
             .iter()
-            .map(|&v| on.get(v as usize).copied().unwrap_or(0.0))
-            .sum::<f32>()
-            / vertices.len() as f32;
+            .filter(|b| !b.vertices.is_empty() && (b.mesh == pupil_mesh || mean(b) > STRAY_SHARE))
+            .collect();
+        let in_ball = |m: usize, v: u32| {
+            ball.iter()
+                .any(|b| b.mesh == m && b.vertices.binary_search(&v).is_ok())
+        };
         // A vertex in no polygon is not seen and never moves (a sphere's unused pole copies).
         let elsewhere = shares.iter().enumerate().find_map(|(m, s)| {
             if !s.iter().any(|&x| x > STRAY_SHARE) {
@@ -226,14 +261,11 @@ pub fn eye_parts(
             }
             s.iter()
                 .enumerate()
-                .find(|&(v, &x)| {
-                    x > STRAY_SHARE
-                        && used[v]
-                        && !(m == mesh && vertices.binary_search(&(v as u32)).is_ok())
-                })
+                .find(|&(v, &x)| x > STRAY_SHARE && used[v] && !in_ball(m, v as u32))
                 .map(|(v, _)| (m, v as u32))
         });
-        if mean <= STRAY_SHARE && elsewhere.is_none() {
+        let pupil_share = mean(&moved[pupil_mesh]);
+        if ball.len() == 1 && pupil_share <= STRAY_SHARE && elsewhere.is_none() {
             if let Some(m) = unreadable {
                 warnings.push(refuse(format!(
                     "the skin weights of mesh `{m}` cannot be read"
@@ -242,17 +274,19 @@ pub fn eye_parts(
             // A joint that moves nothing of the face (an unused bone): nothing to turn.
             continue;
         }
-        if mean < EYEBALL_CARRIED {
-            warnings.push(refuse(if mean <= STRAY_SHARE {
-                "its meshes and the eyeball the face turns are not the same".into()
-            } else {
-                format!(
-                    "the eyeball in mesh `{}` is weighted to it by {:.0} % only, not {:.0} %",
-                    fm.name,
-                    mean * 100.0,
-                    EYEBALL_CARRIED * 100.0
-                )
-            }));
+        if pupil_share <= STRAY_SHARE {
+            warnings.push(refuse(
+                "its meshes and the eyeball the face turns are not the same".into(),
+            ));
+            continue;
+        }
+        if let Some(b) = ball.iter().find(|b| mean(b) < EYEBALL_CARRIED) {
+            warnings.push(refuse(format!(
+                "the eyeball in mesh `{}` is weighted to it by {:.0} % only, not {:.0} %",
+                face.meshes[b.mesh].name,
+                mean(b) * 100.0,
+                EYEBALL_CARRIED * 100.0
+            )));
             continue;
         }
         if let Some((m, v)) = elsewhere {
@@ -271,7 +305,7 @@ pub fn eye_parts(
             }));
             continue;
         }
-        if vertices.binary_search(&pupil_vertex).is_err() {
+        if !in_ball(pupil_mesh, pupil_vertex) {
             warnings.push(refuse(format!("its eyeball holds no pupil {pupil}")));
             continue;
         }
@@ -281,27 +315,29 @@ pub fn eye_parts(
             ));
             continue;
         }
-        // The eyeball at rest and each entry's displacements at its borders, face frame.
-        let frame = frames.meshes[mesh];
-        let rest: Vec<DVec3> = vertices
+        // The eyeball at rest, face frame, mesh after mesh.
+        let rest: Vec<DVec3> = ball
             .iter()
-            .map(|&v| {
-                let p = fm
-                    .mesh
-                    .positions
-                    .get(v as usize)
-                    .copied()
-                    .unwrap_or(Vec3::ZERO);
-                frame.transform_point3(p).as_dvec3()
+            .flat_map(|b| {
+                let positions = &face.meshes[b.mesh].mesh.positions;
+                b.vertices.iter().map(move |&v| {
+                    let p = positions.get(v as usize).copied().unwrap_or(Vec3::ZERO);
+                    b.frame.transform_point3(p).as_dvec3()
+                })
             })
             .collect();
         let size =
             crate::fat::bake::part_size(&rest.iter().map(|p| p.as_vec3()).collect::<Vec<_>>());
-        match fit_turns(&entries, &vertices, &rest, frame, f64::from(size)) {
+        match fit_turns(&keys, &ball, &rest, f64::from(size)) {
             Ok((center, turns)) => out.push(EyePart {
                 node,
-                mesh,
-                vertices,
+                meshes: ball
+                    .iter()
+                    .map(|b| PartMesh {
+                        mesh: b.mesh,
+                        vertices: b.vertices.clone(),
+                    })
+                    .collect(),
                 center,
                 turns,
             }),
@@ -314,48 +350,86 @@ pub fn eye_parts(
     out
 }
 
-/// The rotations fitting every entry at its borders and the pivot they share, or the largest
-/// miss when one is off by more than [`RIGID_TOLERANCE`] of `size`.
+/// The vertices `e` moves (a row not all zero).
+fn moved_vertices(e: &FaceDefMesh) -> impl Iterator<Item = u32> + '_ {
+    let k = e.interval_count();
+    e.coord_index
+        .iter()
+        .enumerate()
+        .filter(move |(i, _)| {
+            e.displacements
+                .get(i * k..(i + 1) * k)
+                .is_some_and(|r| r.iter().any(|d| *d != Vec3::ZERO))
+        })
+        .map(|(_, &v)| v)
+}
+
+/// The rotations fitting every table of `keys` at its borders over all of `ball` (at rest
+/// `rest`, face frame, mesh after mesh) and the pivot they share, or the largest miss when
+/// one is off by more than [`RIGID_TOLERANCE`] of `size`. A table's borders are those of its
+/// entries on every mesh of the ball (the same, as the cloner bakes one part's turn).
 fn fit_turns(
-    entries: &[(TableKey, &crate::fat::FaceDefMesh)],
-    vertices: &[u32],
+    keys: &[TableKey],
+    ball: &[&BallMesh],
     rest: &[DVec3],
-    frame: Affine3A,
     size: f64,
 ) -> Result<(Vec3, Vec<PartTurn>), f64> {
     let n = rest.len() as f64;
     let mean = rest.iter().copied().sum::<DVec3>() / n;
     let mut weights = Vec::new();
-    // Per entry, per border: (rotation, moved positions).
+    // Per table, per border: (rotation, moved positions).
     type Fits = Vec<(DMat3, Vec<DVec3>)>;
     let mut fitted: Vec<(TableKey, Vec<f64>, Fits)> = Vec::new();
-    for &(key, e) in entries {
-        let k = e.interval_count();
-        let slot: Vec<Option<usize>> = vertices
+    for &key in keys {
+        let mut borders: Vec<f64> = ball
             .iter()
-            .map(|v| e.coord_index.iter().position(|c| c == v))
+            .flat_map(|b| b.entries.iter().filter(|e| e.0 == key))
+            .flat_map(|e| e.1.interval_borders.iter().copied())
             .collect();
-        let mut per_border = Vec::with_capacity(e.interval_borders.len());
-        for &b in &e.interval_borders {
-            interval_weights(&e.interval_borders, b, &mut weights);
-            let moved: Vec<DVec3> = rest
-                .iter()
-                .zip(&slot)
-                .map(|(&x, s)| {
-                    let d = s.map_or(DVec3::ZERO, |i| {
-                        (0..k)
-                            .map(|j| {
-                                e.displacements[i * k + j].as_dvec3()
-                                    * weights.get(j).copied().unwrap_or(0.0)
+        borders.sort_by(f64::total_cmp);
+        borders.dedup();
+        if borders.len() < 2 {
+            continue;
+        }
+        // Per mesh, per vertex: its rows in this table's entries on the mesh.
+        let slots: Vec<Vec<Vec<(&FaceDefMesh, usize)>>> = ball
+            .iter()
+            .map(|b| {
+                b.vertices
+                    .iter()
+                    .map(|v| {
+                        b.entries
+                            .iter()
+                            .filter(|e| e.0 == key)
+                            .filter_map(|&(_, e)| {
+                                Some((e, e.coord_index.iter().position(|c| c == v)?))
                             })
-                            .sum::<DVec3>()
-                    });
-                    x + frame.transform_vector3(d.as_vec3()).as_dvec3()
-                })
-                .collect();
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut per_border = Vec::with_capacity(borders.len());
+        for &p in &borders {
+            let mut moved = Vec::with_capacity(rest.len());
+            for (b, slots) in ball.iter().zip(&slots) {
+                for rows in slots {
+                    let mut d = DVec3::ZERO;
+                    for &(e, i) in rows {
+                        interval_weights(&e.interval_borders, p, &mut weights);
+                        let k = e.interval_count();
+                        for (j, w) in weights.iter().enumerate().take(k) {
+                            let row = e.displacements.get(i * k + j).copied();
+                            d += row.unwrap_or(Vec3::ZERO).as_dvec3() * *w;
+                        }
+                    }
+                    let x = rest[moved.len()];
+                    moved.push(x + b.frame.transform_vector3(d.as_vec3()).as_dvec3());
+                }
+            }
             per_border.push((kabsch(rest, &moved, mean), moved));
         }
-        fitted.push((key, e.interval_borders.clone(), per_border));
+        fitted.push((key, borders, per_border));
     }
     // The pivot c with R·(x − c) + c = y for every fit: least squares over all borders, held
     // near the eyeball's centroid along an axis every turn shares.
@@ -422,10 +496,11 @@ mod tests {
     use super::*;
     use crate::fat::bake::{bake_motion, BakeRequest};
 
-    /// An eyeball turned about its centre by two tables (yaw about y, pitch about x), baked
-    /// into per-vertex rows as the cloner bakes them: the fit finds the centre and each
-    /// border's rotation, and the turn between borders stays on the baked rows within the
-    /// bake's tolerance.
+    /// An eyeball in two meshes (an eye white and, in a frame of its own, an iris) turned
+    /// about its centre by two tables (yaw about y, pitch about x), baked into per-vertex rows
+    /// as the cloner bakes them: the fit over both meshes finds the centre and each border's
+    /// rotation, and the turn between borders stays on the baked rows within the bake's
+    /// tolerance.
     #[test]
     fn baked_turns_are_fitted_back_with_their_pivot() {
         let centre = Vec3::new(0.03, 1.62, 0.08);
@@ -435,7 +510,10 @@ mod tests {
                 centre + 0.012 * Vec3::new(a.sin() * b.cos(), a.sin() * b.sin(), a.cos())
             })
             .collect();
-        let vertices: Vec<u32> = (0..rest.len() as u32).collect();
+        // The first 25 points are the white (mesh 0), the others the iris (mesh 1, its
+        // vertices numbered from 0, placed by a translation).
+        let split = 25;
+        let iris_frame = Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0));
         let yaw = TableKey::LowLevel(FapId::new(23).unwrap());
         let pitch = TableKey::LowLevel(FapId::new(25).unwrap());
         let turn = |axis: Vec3| {
@@ -445,12 +523,13 @@ mod tests {
                     * Affine3A::from_translation(-centre)
             }
         };
-        let bake = |axis: Vec3| {
+        let bake = |axis: Vec3, points: &[Vec3]| {
+            let vertices: Vec<u32> = (0..points.len() as u32).collect();
             bake_motion(
                 &BakeRequest {
                     mesh: "eyes",
                     vertices: &vertices,
-                    neutral: &rest,
+                    neutral: points,
                     range: (-40000.0, 40000.0),
                     borders: &[],
                     tolerance: 0.01 * 0.024,
@@ -459,12 +538,41 @@ mod tests {
             )
             .entry
         };
-        let (ey, ep) = (bake(Vec3::Y), bake(Vec3::X));
-        let entries = [(yaw, &ey), (pitch, &ep)];
+        let (white, iris) = rest.split_at(split);
+        let entries: Vec<[FaceDefMesh; 2]> = [Vec3::Y, Vec3::X]
+            .into_iter()
+            .map(|axis| [bake(axis, white), bake(axis, iris)])
+            .collect();
+        let counts = [white.len(), iris.len()];
+        fn ball(
+            entries: &[[FaceDefMesh; 2]],
+            keys: [TableKey; 2],
+            counts: [usize; 2],
+            iris_frame: Affine3A,
+        ) -> Vec<BallMesh<'_>> {
+            (0..2)
+                .map(|m| BallMesh {
+                    mesh: m,
+                    frame: if m == 0 {
+                        Affine3A::IDENTITY
+                    } else {
+                        iris_frame
+                    },
+                    vertices: (0..counts[m] as u32).collect(),
+                    entries: keys
+                        .into_iter()
+                        .zip(entries)
+                        .map(|(k, e)| (k, &e[m]))
+                        .collect(),
+                })
+                .collect()
+        }
+        let meshes = ball(&entries, [yaw, pitch], counts, iris_frame);
+        let refs: Vec<&BallMesh> = meshes.iter().collect();
         let rest64: Vec<DVec3> = rest.iter().map(|p| p.as_dvec3()).collect();
-        let (c, turns) =
-            fit_turns(&entries, &vertices, &rest64, Affine3A::IDENTITY, 0.024).unwrap();
+        let (c, turns) = fit_turns(&[yaw, pitch], &refs, &rest64, 0.024).unwrap();
         assert!(c.distance(centre) < 1e-5, "{c} vs {centre}");
+        assert_eq!(turns.len(), 2);
         for (t, axis) in turns.iter().zip([Vec3::Y, Vec3::X]) {
             for (b, q) in t.borders.iter().zip(&t.rotations) {
                 let want = Quat::from_axis_angle(axis, (*b * 1e-5) as f32);
@@ -478,8 +586,7 @@ mod tests {
             // Between borders: the played turn against the true one.
             let part = EyePart {
                 node: 0,
-                mesh: 0,
-                vertices: vertices.clone(),
+                meshes: Vec::new(),
                 center: c,
                 turns: vec![t.clone()],
             };
@@ -495,12 +602,13 @@ mod tests {
                 }
             }
         }
-        // Rows that are not one turn (every vertex pushed forward) are refused.
-        let mut bent = ey.clone();
-        for (i, d) in bent.displacements.iter_mut().enumerate() {
+        // Rows that are not one turn (the iris pushed forward) are refused.
+        let mut bent = entries.clone();
+        for (i, d) in bent[0][1].displacements.iter_mut().enumerate() {
             *d += Vec3::Z * 1e-7 * (i % 7) as f32;
         }
-        let entries = [(yaw, &bent)];
-        assert!(fit_turns(&entries, &vertices, &rest64, Affine3A::IDENTITY, 0.024).is_err());
+        let meshes = ball(&bent, [yaw, pitch], counts, iris_frame);
+        let refs: Vec<&BallMesh> = meshes.iter().collect();
+        assert!(fit_turns(&[yaw, pitch], &refs, &rest64, 0.024).is_err());
     }
 }

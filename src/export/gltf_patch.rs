@@ -528,14 +528,18 @@ pub fn patch_face(
 fn without_parts(face: &FaceModel, parts: &[EyePart]) -> FaceModel {
     let mut out = face.clone();
     for table in &mut out.fat.tables {
-        for p in parts.iter().filter(|p| p.takes(table.key)) {
-            let name = &face.meshes[p.mesh].name;
+        for m in parts
+            .iter()
+            .filter(|p| p.takes(table.key))
+            .flat_map(|p| &p.meshes)
+        {
+            let name = &face.meshes[m.mesh].name;
             for e in table.meshes.iter_mut().filter(|e| &e.mesh == name) {
                 let k = e.interval_count();
                 let mut coord = Vec::with_capacity(e.coord_index.len());
                 let mut rows = Vec::with_capacity(e.displacements.len());
                 for (i, &v) in e.coord_index.iter().enumerate() {
-                    if p.vertices.binary_search(&v).is_err() {
+                    if m.vertices.binary_search(&v).is_err() {
                         coord.push(v);
                         rows.extend_from_slice(&e.displacements[i * k..(i + 1) * k]);
                     }

@@ -8,8 +8,9 @@
 //!   frame, and the face mesh and vertices it is bound to) and `fapu` (the five distances);
 //!   for faces with transforms or polygons other than triangles also `faceUnit`,
 //!   `transforms`, `meshes` (order, transform, polygon run lengths) and `transformTables`;
-//!   `nodeParts` for mesh parts a user's node turns (eyeballs in one primitive on the VRM
-//!   eye joints), whose rows are rebuilt from the recorded rotations.
+//!   `nodeParts` for mesh parts a user's node turns (eyeballs on the VRM eye joints, in one
+//!   primitive or over several: VRoid's eye white, iris and highlight), whose rows are
+//!   rebuilt from the recorded rotations.
 //!
 //! Reading back: a target's offsets divided by its span are the rates of its interval; the
 //! targets of one `(key, borders)` on one primitive make one `FaceDefMesh`.
@@ -25,7 +26,7 @@ use crate::fat::bake::on_borders;
 use crate::fat::{FaceDefMesh, FaceDefTable, FaceDefTransform, Fat, TableKey, TransformField};
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
 use crate::gltf::source::RestPose;
-use crate::rig::{Rig, RigError};
+use crate::rig::{Rig, RigError, RigMesh};
 
 /// The extras key fbakit's records live under, on meshes and scenes.
 pub const KEY: &str = "fbakit";
@@ -650,7 +651,7 @@ pub fn read_records(rig: &Rig) -> Result<Option<FaceRecords>> {
 }
 
 /// The per-vertex rows of the recorded `nodeParts` (mesh parts a user's node turns: eyeballs
-/// in one primitive on the VRM eye joints), added to `by_key`: each vertex's displacement at
+/// on the VRM eye joints, over one mesh or several), added to `by_key`: each vertex's displacement at
 /// each border is the recorded rotation about the recorded centre applied to its rest
 /// position (file world frame), and the rates between borders are in face units like the
 /// targets' rows.
@@ -668,33 +669,29 @@ fn read_node_parts(
         .enumerate()
     {
         let at = format!("{scene_at}.nodeParts[{i}]");
-        let mesh = p["mesh"]
-            .as_str()
-            .and_then(|n| rig.meshes.iter().find(|m| m.name == n))
-            .ok_or_else(|| bad(rig, &format!("{at}.mesh"), "must name a face mesh"))?;
-        let count = mesh.mesh.positions.len();
-        let vertices: Vec<u32> = p["vertices"]
-            .as_array()
-            .and_then(|a| {
-                a.iter()
-                    .map(|x| {
-                        x.as_u64()
-                            .filter(|&v| (v as usize) < count)
-                            .map(|v| v as u32)
-                    })
-                    .collect::<Option<Vec<u32>>>()
-            })
-            .ok_or_else(|| {
-                bad(
-                    rig,
-                    &format!("{at}.vertices"),
-                    "must be vertex indices of the mesh",
-                )
-            })?;
+        // Several meshes (`meshes[]`), or one (`mesh`, `vertices`: files before eyeballs
+        // over several primitives).
+        let listed: Vec<(&Value, String)> = match p["meshes"].as_array() {
+            Some(list) => list
+                .iter()
+                .enumerate()
+                .map(|(k, m)| (m, format!("{at}.meshes[{k}]")))
+                .collect(),
+            None => vec![(p, at.clone())],
+        };
+        let mut part: Vec<(&RigMesh, Vec<u32>)> = Vec::with_capacity(listed.len());
+        for (m, m_at) in listed {
+            part.push(part_mesh(rig, m, &m_at)?);
+        }
         let center = vec3_field(rig, p, &at, "center")?.as_dvec3();
-        let rest: Vec<DVec3> = vertices
+        let rests: Vec<Vec<DVec3>> = part
             .iter()
-            .map(|&v| mesh.mesh.positions[v as usize].as_dvec3())
+            .map(|(mesh, vertices)| {
+                vertices
+                    .iter()
+                    .map(|&v| mesh.mesh.positions[v as usize].as_dvec3())
+                    .collect()
+            })
             .collect();
         for (j, t) in p["tables"].as_array().into_iter().flatten().enumerate() {
             let at = format!("{at}.tables[{j}]");
@@ -730,43 +727,82 @@ fn read_node_parts(
                         "must be one quaternion per border",
                     )
                 })?;
-            // Each vertex's displacement at each border, then the rates between borders.
-            let at_border: Vec<Vec<DVec3>> = rotations
-                .iter()
-                .map(|q| {
-                    let r = q.as_dquat();
-                    rest.iter()
-                        .map(|&x| r * (x - center) + center - x)
-                        .collect()
-                })
-                .collect();
-            let unit = f64::from(face_unit);
-            let n = borders.len() - 1;
-            let displacements: Vec<Vec3> = (0..vertices.len())
-                .flat_map(|v| {
-                    let at_border = &at_border;
-                    let borders = &borders;
-                    (0..n).map(move |k| {
-                        ((at_border[k + 1][v] - at_border[k][v])
-                            / ((borders[k + 1] - borders[k]) * unit))
-                            .as_vec3()
-                    })
-                })
-                .collect();
             let table = by_key.entry(key).or_insert_with(|| FaceDefTable::new(key));
-            let entry = FaceDefMesh {
-                mesh: mesh.name.clone(),
-                interval_borders: borders,
-                coord_index: vertices.clone(),
-                displacements,
-            };
-            match table.meshes.iter_mut().find(|m| m.mesh == entry.mesh) {
-                Some(old) => *old = joined(old, &entry),
-                None => table.meshes.push(entry),
+            for ((mesh, vertices), rest) in part.iter().zip(&rests) {
+                let entry = FaceDefMesh {
+                    mesh: mesh.name.clone(),
+                    coord_index: vertices.clone(),
+                    displacements: turned_rows(rest, center, &rotations, &borders, face_unit),
+                    interval_borders: borders.clone(),
+                };
+                match table.meshes.iter_mut().find(|m| m.mesh == entry.mesh) {
+                    Some(old) => *old = joined(old, &entry),
+                    None => table.meshes.push(entry),
+                }
             }
         }
     }
     Ok(())
+}
+
+/// The face mesh and vertices one `nodeParts` entry names (`mesh`, `vertices` of `m`).
+fn part_mesh<'a>(rig: &'a Rig, m: &Value, at: &str) -> Result<(&'a RigMesh, Vec<u32>)> {
+    let mesh = m["mesh"]
+        .as_str()
+        .and_then(|n| rig.meshes.iter().find(|f| f.name == n))
+        .ok_or_else(|| bad(rig, &format!("{at}.mesh"), "must name a face mesh"))?;
+    let count = mesh.mesh.positions.len();
+    let vertices: Vec<u32> = m["vertices"]
+        .as_array()
+        .and_then(|a| {
+            a.iter()
+                .map(|x| {
+                    x.as_u64()
+                        .filter(|&v| (v as usize) < count)
+                        .map(|v| v as u32)
+                })
+                .collect::<Option<Vec<u32>>>()
+        })
+        .ok_or_else(|| {
+            bad(
+                rig,
+                &format!("{at}.vertices"),
+                "must be vertex indices of the mesh",
+            )
+        })?;
+    Ok((mesh, vertices))
+}
+
+/// The rows of vertices at `rest` (file world frame) turned about `center` by `rotations`,
+/// one per border: each vertex's displacement at each border, then the rates between
+/// borders in face units.
+fn turned_rows(
+    rest: &[DVec3],
+    center: DVec3,
+    rotations: &[Quat],
+    borders: &[f64],
+    face_unit: f32,
+) -> Vec<Vec3> {
+    let at_border: Vec<Vec<DVec3>> = rotations
+        .iter()
+        .map(|q| {
+            let r = q.as_dquat();
+            rest.iter()
+                .map(|&x| r * (x - center) + center - x)
+                .collect()
+        })
+        .collect();
+    let unit = f64::from(face_unit);
+    let n = borders.len() - 1;
+    (0..rest.len())
+        .flat_map(|v| {
+            let at_border = &at_border;
+            (0..n).map(move |k| {
+                ((at_border[k + 1][v] - at_border[k][v]) / ((borders[k + 1] - borders[k]) * unit))
+                    .as_vec3()
+            })
+        })
+        .collect()
 }
 
 /// Two entries of one mesh as one: both on the union of their borders, rates of a vertex in

@@ -12,7 +12,8 @@
 //!
 //! Other variants move the eyeballs onto nodes of their own ([`Options::eye_nodes`]) or skin
 //! them to eye joints ([`Options::skinned_eyes`]), or keep both eyeballs in `Body`'s `eyes`
-//! primitive skinned to two eye joints, the VRM / VRoid layout ([`Options::vrm_eyes`]).
+//! primitive skinned to two eye joints, the VRM / VRoid layout ([`Options::vrm_eyes`]), with
+//! an iris and a highlight primitive in front as VRoid has them ([`Options::vroid_eyes`]).
 //!
 //! The jaw's inverse bind matrix was taken half a centimetre higher than the jaw rests, so the
 //! mouth's vertices (weighted to jaw and head) are placed per vertex at rest; the other joints
@@ -106,6 +107,85 @@ pub struct Options {
     /// `Some(share)` weights each eyeball vertex to its eye joint by `share`, the rest to
     /// `Head`. Not with the other eye options.
     pub vrm_eyes: Option<f32>,
+    /// As [`Options::vrm_eyes`] with both eyeballs wholly on their eye joints, and two eye
+    /// layers in front of them as VRoid builds eyes: an `iris` primitive of `Body` (a cap
+    /// just outside each eye white) and a `highlight` (a small cap further out, above the
+    /// pupil), each holding both eyes and skinned to the same joints. Not with the other eye
+    /// options.
+    pub vroid_eyes: Option<VroidEyes>,
+}
+
+/// The eye layers of [`Options::vroid_eyes`].
+#[derive(Clone, Copy, Debug)]
+pub struct VroidEyes {
+    /// The highlight as a mesh `EyeHighlight` of its own (mesh 2, node [`HIGHLIGHT_NODE`],
+    /// skinned to the same joints) instead of a primitive of `Body`.
+    pub highlight_node: bool,
+    /// Share of each iris vertex's weight on its eye joint (the rest on `Head`).
+    pub iris_share: f32,
+}
+
+/// With [`VroidEyes::highlight_node`]: the highlight's node.
+pub const HIGHLIGHT_NODE: usize = 10;
+
+/// Eye layers of [`Options::vroid_eyes`]: radius (cm) of the iris and the highlight about
+/// the eye's centre (the eye white's is 1.2), and their caps' half angles (rad).
+const IRIS_RADIUS: f32 = 1.22;
+const IRIS_HALF_ANGLE: f32 = 0.5;
+const HIGHLIGHT_RADIUS: f32 = 1.27;
+const HIGHLIGHT_HALF_ANGLE: f32 = 0.12;
+
+/// The highlight's turn off the gaze: up and towards the face's right.
+fn highlight_tilt() -> glam::Quat {
+    glam::Quat::from_rotation_x(-0.3) * glam::Quat::from_rotation_y(-0.2)
+}
+
+/// An eye layer of [`Options::vroid_eyes`] named `name`: per eye (right, then left, as
+/// `eyes`), a cap of `half_angle` on a sphere of `radius` about the eye's centre, its pole
+/// turned by `tilt` off the gaze, weighted to the eye's joint by `share` (the rest to `Head`).
+pub fn eye_layer(
+    name: &'static str,
+    radius: f32,
+    half_angle: f32,
+    tilt: glam::Quat,
+    share: f32,
+) -> Prim {
+    let mut layer = Prim {
+        name,
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        triangles: vec![],
+        joints: vec![],
+    };
+    for (left, slot) in [(false, 5u8), (true, 4u8)] {
+        let (p, n, uv, t) = sphere(Vec3::ZERO, radius, 2, 8, half_angle);
+        let base = layer.positions.len() as u16;
+        layer
+            .triangles
+            .extend(t.iter().map(|tr| tr.map(|i| i + base)));
+        layer.joints.extend(std::iter::repeat_n(
+            [(slot, share), (2, 1.0 - share)],
+            p.len(),
+        ));
+        layer
+            .positions
+            .extend(p.iter().map(|&x| eye_centre(left) + tilt * x));
+        layer.normals.extend(n.iter().map(|&x| tilt * x));
+        layer.uvs.extend(uv);
+    }
+    layer
+}
+
+/// The highlight layer of [`Options::vroid_eyes`].
+pub fn highlight_layer() -> Prim {
+    eye_layer(
+        "highlight",
+        HIGHLIGHT_RADIUS,
+        HIGHLIGHT_HALF_ANGLE,
+        highlight_tilt(),
+        1.0,
+    )
 }
 
 /// With [`Options::skinned_eyes`]: the eye joints and the nodes of the eye meshes (indices).
@@ -288,13 +368,27 @@ pub fn teeth_fp_lines() -> String {
 /// The primitives of `Body` with `opts`.
 pub fn body_prims_with(opts: &Options) -> Vec<Prim> {
     let mut prims = body_prims();
-    if let Some(share) = opts.vrm_eyes {
+    let vrm_share = opts.vrm_eyes.or(opts.vroid_eyes.map(|_| 1.0));
+    if let Some(share) = vrm_share {
         // `eyes` holds the right eyeball, then the left ([`body_prims`]).
         let eyes = &mut prims[2];
         let half = eyes.positions.len() / 2;
         for (v, j) in eyes.joints.iter_mut().enumerate() {
             let slot = if v < half { 5u8 } else { 4u8 };
             *j = [(slot, share), (2, 1.0 - share)];
+        }
+    }
+    if let Some(v) = opts.vroid_eyes {
+        let iris = eye_layer(
+            "iris",
+            IRIS_RADIUS,
+            IRIS_HALF_ANGLE,
+            glam::Quat::IDENTITY,
+            v.iris_share,
+        );
+        prims.push(iris);
+        if !v.highlight_node {
+            prims.push(highlight_layer());
         }
     }
     if opts.teeth {
@@ -452,6 +546,55 @@ impl Bin {
     }
 }
 
+/// A skinned primitive of `p` (positions, normals, UVs, joints and weights, indices) with
+/// `material`, its data appended to `b`.
+fn skinned_primitive(b: &mut Bin, p: &Prim, material: usize) -> Value {
+    let pos = b.vec3(&p.positions, true);
+    let nrm = b.vec3(&p.normals, false);
+    let uv_bytes: Vec<u8> = p
+        .uvs
+        .iter()
+        .flat_map(|v| v.to_array())
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let uv_view = b.view(&uv_bytes, Some(34962));
+    let uv = b.acc(
+        json!({"bufferView": uv_view, "componentType": 5126, "count": p.uvs.len(), "type": "VEC2"}),
+    );
+    let jb: Vec<u8> = p
+        .joints
+        .iter()
+        .flat_map(|j| [j[0].0, j[1].0, 0, 0])
+        .collect();
+    let jv = b.view(&jb, Some(34962));
+    let joints = b.acc(
+        json!({"bufferView": jv, "componentType": 5121, "count": p.joints.len(), "type": "VEC4"}),
+    );
+    let wf: Vec<f32> = p
+        .joints
+        .iter()
+        .flat_map(|j| [j[0].1, j[1].1, 0.0, 0.0])
+        .collect();
+    let wb: Vec<u8> = wf.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let wv = b.view(&wb, Some(34962));
+    let weights = b.acc(
+        json!({"bufferView": wv, "componentType": 5126, "count": p.joints.len(), "type": "VEC4"}),
+    );
+    let ib: Vec<u8> = p
+        .triangles
+        .iter()
+        .flatten()
+        .flat_map(|i| i.to_le_bytes())
+        .collect();
+    let iv = b.view(&ib, Some(34963));
+    let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": p.triangles.len() * 3, "type": "SCALAR"}));
+    json!({
+        "attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv, "JOINTS_0": joints, "WEIGHTS_0": weights},
+        "indices": idx,
+        "material": material
+    })
+}
+
 /// A 4×4 checker PNG.
 fn png() -> Vec<u8> {
     let mut img = fbakit::render::Image::new(4, 4, [200, 160, 140, 255]);
@@ -491,39 +634,7 @@ pub fn build_with(opts: &Options) -> Avatar {
         if (opts.eye_nodes || opts.skinned_eyes.is_some()) && p.name == "eyes" {
             continue;
         }
-        let pos = b.vec3(&p.positions, true);
-        let nrm = b.vec3(&p.normals, false);
-        let uv_bytes: Vec<u8> = p
-            .uvs
-            .iter()
-            .flat_map(|v| v.to_array())
-            .flat_map(f32::to_le_bytes)
-            .collect();
-        let uv_view = b.view(&uv_bytes, Some(34962));
-        let uv = b.acc(json!({"bufferView": uv_view, "componentType": 5126, "count": p.uvs.len(), "type": "VEC2"}));
-        let jb: Vec<u8> = p
-            .joints
-            .iter()
-            .flat_map(|j| [j[0].0, j[1].0, 0, 0])
-            .collect();
-        let jv = b.view(&jb, Some(34962));
-        let joints = b.acc(json!({"bufferView": jv, "componentType": 5121, "count": p.joints.len(), "type": "VEC4"}));
-        let wf: Vec<f32> = p
-            .joints
-            .iter()
-            .flat_map(|j| [j[0].1, j[1].1, 0.0, 0.0])
-            .collect();
-        let wb: Vec<u8> = wf.iter().flat_map(|x| x.to_le_bytes()).collect();
-        let wv = b.view(&wb, Some(34962));
-        let weights = b.acc(json!({"bufferView": wv, "componentType": 5126, "count": p.joints.len(), "type": "VEC4"}));
-        let ib: Vec<u8> = p
-            .triangles
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
-        let iv = b.view(&ib, Some(34963));
-        let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": p.triangles.len() * 3, "type": "SCALAR"}));
+        let mut primitive = skinned_primitive(&mut b, p, k);
         // The user's own `Blink`: lashes move down, every other primitive stays (dense zeros).
         let blink: Vec<Vec3> = p
             .positions
@@ -537,13 +648,9 @@ pub fn build_with(opts: &Options) -> Avatar {
             })
             .collect();
         let blink = b.vec3(&blink, true);
-        primitives.push(json!({
-            "attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv, "JOINTS_0": joints, "WEIGHTS_0": weights},
-            "indices": idx,
-            "material": k,
-            "targets": [{"POSITION": blink}],
-            "extras": {"part": p.name}
-        }));
+        primitive["targets"] = json!([{"POSITION": blink}]);
+        primitive["extras"] = json!({"part": p.name});
+        primitives.push(primitive);
     }
     // Hat: a square pyramid above the head (not skinned, under the Head joint).
     let hat_p = vec![
@@ -593,7 +700,8 @@ pub fn build_with(opts: &Options) -> Avatar {
     // The eye meshes of `Options::skinned_eyes`: each sphere in the armature's centimetres
     // like `Body`, weighted to its eye joint (slot 4 left, 5 right) and the head (slot 2).
     assert!(
-        opts.vrm_eyes.is_none() || !(opts.eye_nodes || opts.skinned_eyes.is_some()),
+        (opts.vrm_eyes.is_none() && opts.vroid_eyes.is_none())
+            || !(opts.eye_nodes || opts.skinned_eyes.is_some()),
         "one eye layout"
     );
     if let Some(share) = opts.skinned_eyes {
@@ -633,6 +741,12 @@ pub fn build_with(opts: &Options) -> Avatar {
             }));
         }
     }
+    // The highlight mesh of `VroidEyes::highlight_node`, in the armature's centimetres like
+    // `Body`.
+    if opts.vroid_eyes.is_some_and(|v| v.highlight_node) {
+        let primitive = skinned_primitive(&mut b, &highlight_layer(), 2);
+        eye_meshes.push(json!({"name": "EyeHighlight", "primitives": [primitive]}));
+    }
     // Inverse bind matrices: each joint's world inverse times the armature (the mesh's bind
     // frame); the jaw's bind half a centimetre above its rest.
     let worlds = joint_worlds();
@@ -646,7 +760,7 @@ pub fn build_with(opts: &Options) -> Avatar {
         };
         ibm.extend((bind.inverse() * armature).to_cols_array());
     }
-    if opts.skinned_eyes.is_some() || opts.vrm_eyes.is_some() {
+    if opts.skinned_eyes.is_some() || opts.vrm_eyes.is_some() || opts.vroid_eyes.is_some() {
         for left in [true, false] {
             ibm.extend((eye_joint_world(left).inverse() * armature).to_cols_array());
         }
@@ -750,7 +864,11 @@ pub fn build_with(opts: &Options) -> Avatar {
             nodes.push(json!({"name": name, "mesh": mesh, "skin": 0}));
         }
         json["meshes"].as_array_mut().unwrap().extend(eye_meshes);
-    } else if opts.vrm_eyes.is_some() {
+    } else if opts.vrm_eyes.is_some() || opts.vroid_eyes.is_some() {
+        assert!(
+            opts.vrm_eyes.is_none() || opts.vroid_eyes.is_none(),
+            "one eye layout"
+        );
         json["nodes"][3]["children"] = json!([4, 6, LEFT_EYE_JOINT, RIGHT_EYE_JOINT]);
         json["skins"][0]["joints"] = json!([1, 2, 3, 4, LEFT_EYE_JOINT, RIGHT_EYE_JOINT]);
         let nodes = json["nodes"].as_array_mut().unwrap();
@@ -758,6 +876,11 @@ pub fn build_with(opts: &Options) -> Avatar {
             nodes.push(json!({"name": name,
                 "translation": eye_joint_translation(left).to_array(),
                 "rotation": eye_joint_rotation(left).to_array()}));
+        }
+        if !eye_meshes.is_empty() {
+            nodes.push(json!({"name": "EyeHighlight", "mesh": 2, "skin": 0}));
+            json["nodes"][0]["children"] = json!([1, 5, HIGHLIGHT_NODE]);
+            json["meshes"].as_array_mut().unwrap().extend(eye_meshes);
         }
     }
     let mut bin = b.bin;

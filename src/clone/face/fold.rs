@@ -18,7 +18,7 @@ use super::split::{mesh_pieces, SplitView};
 use super::{CloneReport, Part};
 use crate::error::{Diagnostic, Result};
 use crate::face::{FaceFrames, FaceModel};
-use crate::fat::bake::{bake_motion, on_borders, part_size, BakeRequest};
+use crate::fat::bake::{bake_motion, on_borders, part_size, BakeRequest, BakedMesh};
 use crate::fat::eval::{Activation, FatEvaluator};
 use crate::fat::morph::MorphTarget;
 use crate::fat::{FaceDefMesh, FaceDefTable, Fat, TableKey};
@@ -115,6 +115,30 @@ pub(super) fn fold_into_target(
         });
     }
     let ranges = covered_ranges(targets);
+    // The transform whose motion a view mesh's vertices are baked with, if any.
+    let baked_by = |m: &ViewMesh| -> Option<usize> {
+        m.part?;
+        let t = cloned.meshes[m.index].transform?;
+        hierarchy_ancestors(cloned, Some(t))
+            .iter()
+            .any(|&a| baked.contains(&cloned.transforms[a].name))
+            .then_some(t)
+    };
+    // Transforms baked into several cut meshes (VRoid's eye white, iris and highlight layers,
+    // each a primitive holding both eyes): their rows in every mesh share one set of borders,
+    // so the part reads back as one motion (each mesh's bisection alone ends elsewhere).
+    let mut cut_count: HashMap<usize, usize> = HashMap::new();
+    for cut in &cuts {
+        let ts: BTreeSet<usize> = cut.meshes.iter().filter_map(&baked_by).collect();
+        for t in ts {
+            *cut_count.entry(t).or_default() += 1;
+        }
+    }
+    let spread: BTreeSet<usize> = cut_count
+        .into_iter()
+        .filter(|&(_, n)| n > 1)
+        .map(|(t, _)| t)
+        .collect();
     let mut fat = Fat::default();
     for table in &cloned.fat.tables {
         let mut out = FaceDefTable::new(table.key);
@@ -124,6 +148,28 @@ pub(super) fn fold_into_target(
             .transforms
             .iter()
             .any(|t| baked.contains(&t.transform));
+        let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
+        // Per spread transform, the borders its meshes need together.
+        let mut shared: HashMap<usize, Vec<f64>> = HashMap::new();
+        if moves_baked && !spread.is_empty() {
+            for cut in &cuts {
+                let own = cut_borders(cloned, table, cut);
+                for m in &cut.meshes {
+                    let Some(t) = baked_by(m).filter(|t| spread.contains(t)) else {
+                        continue;
+                    };
+                    let motion = match &mut motion {
+                        Some(x) => x,
+                        None => motion.insert(TableMotion::new(cloned, table)?),
+                    };
+                    let (b, _) = bake_view_mesh(target, cut, m, motion, table.key, range, &own);
+                    shared
+                        .entry(t)
+                        .or_default()
+                        .extend(b.entry.interval_borders);
+                }
+            }
+        }
         // The table's entries not yet taken by a cut (cloned only once they are kept).
         let mut rest: Vec<&FaceDefMesh> = table.meshes.iter().collect();
         for cut in &cuts {
@@ -151,44 +197,23 @@ pub(super) fn fold_into_target(
                 }
             });
             if moves_baked {
-                let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
                 let borders: Vec<f64> = entries
                     .iter()
                     .flat_map(|e| e.interval_borders.iter().copied())
                     .collect();
-                let original = &target.meshes[cut.target].mesh.positions;
-                for m in cut.meshes.iter().filter(|m| m.part.is_some()) {
-                    let Some(t) = cloned.meshes[m.index].transform else {
+                for m in &cut.meshes {
+                    let Some(t) = baked_by(m) else {
                         continue;
                     };
-                    if !hierarchy_ancestors(cloned, Some(t))
-                        .iter()
-                        .any(|&a| baked.contains(&cloned.transforms[a].name))
-                    {
-                        continue;
-                    }
                     let motion = match &mut motion {
                         Some(x) => x,
                         None => motion.insert(TableMotion::new(cloned, table)?),
                     };
-                    let vertices = m.to_target;
-                    let neutral: Vec<Vec3> = vertices
-                        .iter()
-                        .map(|&v| original.get(v as usize).copied().unwrap_or(Vec3::ZERO))
-                        .collect();
-                    let size = part_size(&neutral);
+                    let mut borders = borders.clone();
+                    borders.extend(shared.get(&t).into_iter().flatten());
+                    let (b, size) =
+                        bake_view_mesh(target, cut, m, motion, table.key, range, &borders);
                     let tolerance = BAKE_TOLERANCE * size;
-                    let b = bake_motion(
-                        &BakeRequest {
-                            mesh: cut.name,
-                            vertices,
-                            neutral: &neutral,
-                            range,
-                            borders: &borders,
-                            tolerance,
-                        },
-                        |p| motion.in_mesh_frame(cut.home, m.index, table.key, p),
-                    );
                     if b.max_error > tolerance {
                         report.warnings.push(Diagnostic::warning(format!(
                             "{}: the baked motion of {} is off by {:.3} % of its size",
@@ -394,6 +419,53 @@ fn covered_ranges(targets: &[MorphTarget]) -> HashMap<TableKey, (f64, f64)> {
         }
     }
     out
+}
+
+/// The borders of `table`'s entries on the view meshes of `cut`.
+fn cut_borders(cloned: &FaceModel, table: &FaceDefTable, cut: &CutMeshes) -> Vec<f64> {
+    table
+        .meshes
+        .iter()
+        .filter(|e| {
+            cut.meshes
+                .iter()
+                .any(|m| cloned.meshes[m.index].name == e.mesh)
+        })
+        .flat_map(|e| e.interval_borders.iter().copied())
+        .collect()
+}
+
+/// The motion of view mesh `m` of `cut` under `key` (its transforms' motion, in the cut
+/// mesh's frame) baked over `range` on `borders` and those bisection adds, and the size of
+/// its vertices at rest.
+fn bake_view_mesh(
+    target: &FaceModel,
+    cut: &CutMeshes,
+    m: &ViewMesh,
+    motion: &mut TableMotion,
+    key: TableKey,
+    range: (f64, f64),
+    borders: &[f64],
+) -> (BakedMesh, f32) {
+    let original = &target.meshes[cut.target].mesh.positions;
+    let neutral: Vec<Vec3> = m
+        .to_target
+        .iter()
+        .map(|&v| original.get(v as usize).copied().unwrap_or(Vec3::ZERO))
+        .collect();
+    let size = part_size(&neutral);
+    let b = bake_motion(
+        &BakeRequest {
+            mesh: cut.name,
+            vertices: m.to_target,
+            neutral: &neutral,
+            range,
+            borders,
+            tolerance: BAKE_TOLERANCE * size,
+        },
+        |p| motion.in_mesh_frame(cut.home, m.index, key, p),
+    );
+    (b, size)
 }
 
 /// The transform motion of one table on the cloned view.

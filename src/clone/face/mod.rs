@@ -20,7 +20,10 @@
 //!    glTF primitive) holding the feature points of several parts — both pupils in one eyes
 //!    mesh, the upper and lower teeth points in one teeth mesh — is cut into one part each:
 //!    by connected pieces, a piece going to the part whose points it holds or lie nearest,
-//!    polygon by polygon when one piece holds several parts' points. Each eye then turns
+//!    polygon by polygon when one piece holds several parts' points. A mesh holding no
+//!    feature point whose every piece lies on an eyeball (within 1.3 radii of the centre of
+//!    the piece holding a pupil: VRoid's iris and highlight layers) is cut the same way, each
+//!    piece to the eye it lies on, so the layers turn with their eyeballs. Each eye then turns
 //!    about its own centre and the lower row follows the jaw; step 9 folds them back.
 //!    With `fit`, a target that is one mesh with the source's only skin mesh (the same
 //!    vertex count and polygons, but for a few quads split along the other diagonal: another

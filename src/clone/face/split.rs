@@ -4,7 +4,9 @@
 //! (both eyeballs in one mesh or glTF primitive, both rows of teeth), and a mesh holding both
 //! rows of teeth but no feature point (no 9.8–9.11, as iBUG-68 landmarks give): its pieces
 //! above the lip line (2.2/2.3) are the upper row, those below the lower
-//! ([`teeth_row_plans`]: the rule). The split is an internal view: its index maps
+//! ([`teeth_row_plans`]: the rule); and meshes without feature points lying wholly on the
+//! eyeballs, one piece per eye (VRoid's iris and highlight layers: [`eye_layer_plans`]) go
+//! to the eye each piece lies on. The split is an internal view: its index maps
 //! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -208,6 +210,8 @@ pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
     let mut plans: Vec<CutPlan> = chin.into_iter().collect();
     plans.extend(shared_part_plans(face, &frames, diag, chin_mesh));
     plans.extend(teeth_row_plans(face, &frames, diag, chin_mesh));
+    let planned: BTreeSet<usize> = plans.iter().map(|p| p.mesh).collect();
+    plans.extend(eye_layer_plans(face, &frames, diag, &planned));
     plans.retain(|p| !deformed.contains(face.meshes[p.mesh].name.as_str()));
     if plans.is_empty() {
         return None;
@@ -476,6 +480,128 @@ fn teeth_row_plans(
             mesh: mi,
             dest,
             rest: Some(Part::UpperTeeth),
+            pieces,
+        });
+    }
+    plans
+}
+
+/// Farthest a vertex of an eye layer may lie from its eyeball's centre, in eyeball radii.
+const EYE_LAYER_REACH: f32 = 1.3;
+
+/// Largest eyeball radius an eye layer is looked for around, in ES0 (an eyeball is about
+/// 0.2 ES0: a pupil on a bigger piece is on the skin, as on CANDIDE-3).
+const EYEBALL_MAX_RADIUS: f32 = 0.5;
+
+/// Meshes (or glTF primitives) holding no feature point whose connected pieces all lie on an
+/// eyeball — every vertex within [`EYE_LAYER_REACH`] radii of the centre of the piece holding
+/// a pupil (bounding-box centre and half extent) —: the iris and highlight layers VRoid puts
+/// in front of the eye white, each primitive holding both eyes. Each piece goes to the eye it
+/// lies on, so it turns with that eyeball; the first eye stays in the mesh. Meshes in
+/// `planned` are cut already.
+fn eye_layer_plans(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    diag: f32,
+    planned: &BTreeSet<usize>,
+) -> Vec<CutPlan> {
+    let Some(lm) = Landmarks::of(face) else {
+        return Vec::new();
+    };
+    let eps = diag * 1e-6;
+    let mut with_fp: BTreeSet<usize> = BTreeSet::new();
+    for fp in face.feature_points.iter() {
+        if let Some((mi, _)) = fp_mesh_vertex(face, frames, fp.id, diag * 1e-4) {
+            with_fp.insert(mi);
+        }
+    }
+    let candidates: Vec<usize> = (0..face.meshes.len())
+        .filter(|mi| !planned.contains(mi) && !with_fp.contains(mi))
+        .filter(|&mi| !face.meshes[mi].mesh.polygons.is_empty())
+        .collect();
+    if candidates.is_empty() {
+        return Vec::new();
+    }
+    // Each eyeball: (eye, centre, radius).
+    let mut balls: Vec<(Part, Vec3, f32)> = Vec::new();
+    for (part, id) in [
+        (Part::LeftEye, FeaturePointId::FP_3_5),
+        (Part::RightEye, FeaturePointId::FP_3_6),
+    ] {
+        let Some((mi, v)) = fp_mesh_vertex(face, frames, id, diag * 1e-4) else {
+            continue;
+        };
+        let world = face.mesh_world(frames, mi);
+        let (piece, _) = mesh_pieces(&face.meshes[mi].mesh, eps);
+        let Some(&k) = piece.get(v as usize) else {
+            continue;
+        };
+        let (lo, hi) = piece.iter().zip(&world).filter(|(p, _)| **p == k).fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), (_, &q)| (lo.min(q), hi.max(q)),
+        );
+        let radius = ((hi - lo) / 2.0).max_element();
+        if radius > 0.0 && radius < EYEBALL_MAX_RADIUS * lm.es {
+            balls.push((part, (lo + hi) / 2.0, radius));
+        }
+    }
+    if balls.is_empty() {
+        return Vec::new();
+    }
+    let mut plans = Vec::new();
+    // The eye whose eyeball a point lies on.
+    let on_ball = |q: Vec3| {
+        balls
+            .iter()
+            .filter(|b| q.distance(b.1) <= EYE_LAYER_REACH * b.2)
+            .min_by(|a, b| q.distance(a.1).total_cmp(&q.distance(b.1)))
+            .map(|b| b.0)
+    };
+    for mi in candidates {
+        let mesh = &face.meshes[mi].mesh;
+        let world = face.mesh_world(frames, mi);
+        let eyes: Option<Vec<(u32, Part)>> = mesh
+            .polygons
+            .indices()
+            .iter()
+            .map(|&v| Some((v, on_ball(*world.get(v as usize)?)?)))
+            .collect();
+        let Some(eyes) = eyes else { continue };
+        let (piece, count) = mesh_pieces(mesh, eps);
+        // Per piece, the eye it lies on: `None` not yet seen, `Some(None)` on both.
+        let mut eye: Vec<Option<Option<Part>>> = vec![None; count];
+        for (v, on) in eyes {
+            let Some(&k) = piece.get(v as usize) else {
+                continue;
+            };
+            eye[k] = Some(match eye[k] {
+                None => Some(on),
+                Some(seen) if seen == Some(on) => seen,
+                Some(_) => None,
+            });
+        }
+        let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
+        let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
+        let mut all_on = true;
+        for (pi, poly) in mesh.polygons.iter().enumerate() {
+            let Some(&k) = poly.first().and_then(|&v| piece.get(v as usize)) else {
+                continue;
+            };
+            let Some(Some(part)) = eye[k] else {
+                all_on = false;
+                break;
+            };
+            pieces.entry(part).or_default().insert(k);
+            dest.entry(Some(part)).or_default().push(pi);
+        }
+        if !all_on || dest.is_empty() {
+            continue;
+        }
+        let rest = dest.keys().next().copied().flatten();
+        plans.push(CutPlan {
+            mesh: mi,
+            dest,
+            rest,
             pieces,
         });
     }
