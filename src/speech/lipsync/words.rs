@@ -12,7 +12,7 @@
 //! |---|---|---|
 //! | the phone loop (the default) | 57.7 / 66.5 / 2.9 | 44.4 / 59.9 / 1.3 |
 //! | words, shared by typical lengths ([`WordPhones::Shared`]) | 47.4 / 57.7 / 4.0 | 45.9 / 57.5 / 3.6 |
-//! | words, force-aligned ([`WordPhones::Aligned`]) | 48.0 / 59.2 / 2.4 | 45.4 / 59.2 / 2.0 |
+//! | words, force-aligned ([`WordPhones::Aligned`]; measured as one piece per file, before `-remove_silence no`) | 48.0 / 59.2 / 2.4 | 45.4 / 59.2 / 2.0 |
 //! | words, the phone loop under words surer than 0.6 ([`WordPhones::Mixed`]) | 55.6 / 60.4 / 3.5 | 51.0 / 57.1 / 3.8 |
 //!
 //! Per Festival condition (phone loop → words force-aligned): kal at 20 dB SNR 69.4 / 70.4
@@ -38,7 +38,10 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::process::Command;
 
-use super::recognition::{in_pieces, model, model_dir, run_phone_loop, run_timed, PROGRAM};
+use super::pieces::{Piece, MIN_PIECE_SECONDS, PIECE_SECONDS};
+use super::recognition::{
+    arpabet_to_espeak, in_pieces, model, model_dir, run_phone_loop, run_timed, PROGRAM,
+};
 use super::AlignedPhone;
 use crate::error::{Error, Result};
 
@@ -55,8 +58,9 @@ const SILENCE: &str = "SIL";
 pub enum WordPhones {
     /// Each word's dictionary phones share its time by their typical lengths.
     Shared,
-    /// The recognised words are force-aligned to the recording as a transcript
-    /// ([`super::forced::align_file`]); shared as above when that fails.
+    /// The recognised words are force-aligned to the recording as a transcript, in pieces
+    /// cut at the pauses the word search heard ([`word_pieces`],
+    /// [`super::forced::align_pieces`]); a piece that does not fit keeps the shared phones.
     Aligned,
     /// Shared, but words less sure than [`MIXED_BELOW`] take the phone loop's phones.
     Mixed,
@@ -83,17 +87,10 @@ pub fn recognise_words_file(
         )));
     }
     let mut dict: Option<String> = None;
-    let mut said: Vec<String> = Vec::new();
     let mut run = |wav: &Path| -> Result<Vec<AlignedPhone>> {
         let mut cmd = Command::new(PROGRAM);
         cmd.arg("-lm").arg(&lm).arg("-dict").arg(&dict_path);
         let words = run_timed(cmd, wav, &hmm)?;
-        said.extend(words.iter().filter(|w| !filler(&w.symbol)).map(|w| {
-            w.symbol
-                .split_once('(')
-                .map_or(w.symbol.as_str(), |(h, _)| h)
-                .to_string()
-        }));
         if dict.is_none() {
             dict = Some(std::fs::read_to_string(&dict_path).map_err(|e| Error::io(&dict_path, e))?);
         }
@@ -106,26 +103,91 @@ pub fn recognise_words_file(
             let heard = run_phone_loop(wav, &hmm, &phone_lm)?;
             return Ok(mixed(&words, phones, &heard, MIXED_BELOW));
         }
+        if placing == WordPhones::Aligned {
+            return aligned(wav, &words, phones);
+        }
         Ok(phones)
     };
-    let phones = in_pieces(path, progress, &mut run)?;
-    if placing == WordPhones::Aligned && !said.is_empty() {
-        if let Some(placed) = super::forced::align_file(path, &said.join(" "))? {
-            // Back from espeak-ng's mnemonics, which every ARPAbet phone maps to one of.
-            return Ok(placed
-                .into_iter()
-                .map(|p| AlignedPhone {
-                    symbol: super::forced::espeak_to_arpabet(&p.symbol)
-                        .first()
-                        .copied()
-                        .unwrap_or(SILENCE)
-                        .to_string(),
-                    ..p
-                })
-                .collect());
+    in_pieces(path, progress, &mut run)
+}
+
+/// The recognised `words` of one recognition piece (the file `wav`) taken as its transcript
+/// and force-aligned there ([`super::forced::align_pieces`]), in pieces cut at the pauses
+/// the word search heard ([`word_pieces`]); a piece that does not fit keeps the `shared`
+/// phones.
+fn aligned(
+    wav: &Path,
+    words: &[AlignedPhone],
+    shared: Vec<AlignedPhone>,
+) -> Result<Vec<AlignedPhone>> {
+    let (text, pieces) = word_pieces(words);
+    if pieces.is_empty() {
+        return Ok(shared);
+    }
+    let pronounced = super::forced::pronounced_words(&text)?;
+    let fallback: Vec<AlignedPhone> = shared
+        .into_iter()
+        .map(|p| AlignedPhone {
+            symbol: arpabet_to_espeak(&p.symbol).to_string(),
+            ..p
+        })
+        .collect();
+    let placed = super::forced::align_pieces(wav, &pronounced, &pieces, &fallback)?;
+    // Back from espeak-ng's mnemonics, which every ARPAbet phone maps to one of.
+    Ok(placed
+        .phones
+        .into_iter()
+        .map(|p| AlignedPhone {
+            symbol: super::forced::espeak_to_arpabet(&p.symbol)
+                .first()
+                .copied()
+                .unwrap_or(SILENCE)
+                .to_string(),
+            ..p
+        })
+        .collect())
+}
+
+/// The spoken words as a transcript (variants' heads, spaces between) and its pieces for
+/// forced alignment: a piece ends in the middle of the first filler (a heard pause) after
+/// [`MIN_PIECE_SECONDS`], or at the first word gap after [`PIECE_SECONDS`]; the last piece
+/// runs to the end of the last word.
+pub fn word_pieces(words: &[AlignedPhone]) -> (String, Vec<Piece>) {
+    let mut text = String::new();
+    let mut pieces: Vec<Piece> = Vec::new();
+    let (mut start, mut from) = (0.0, 0usize);
+    for w in words {
+        let long = w.start - start;
+        let cut = if filler(&w.symbol) {
+            (long >= MIN_PIECE_SECONDS).then(|| 0.5 * (w.start + w.end))
+        } else {
+            (long >= PIECE_SECONDS).then_some(w.start)
+        };
+        if let Some(at) = cut.filter(|_| text.len() > from) {
+            pieces.push(Piece {
+                start,
+                end: at,
+                text: from..text.len(),
+            });
+            (start, from) = (at, text.len());
+        }
+        if !filler(&w.symbol) {
+            let head = w
+                .symbol
+                .split_once('(')
+                .map_or(w.symbol.as_str(), |(h, _)| h);
+            text.push_str(head);
+            text.push(' ');
         }
     }
-    Ok(phones)
+    if text.len() > from {
+        pieces.push(Piece {
+            start,
+            end: words.last().map_or(start, |w| w.end).max(start),
+            text: from..text.len(),
+        });
+    }
+    (text, pieces)
 }
 
 /// Whether a recognised word is a filler (silence, breath, noise) rather than speech.
@@ -279,6 +341,26 @@ mod tests {
         // 65 + 130 + 80 ms of typical length over 275 ms: one to one.
         assert!((p[1].end - 0.265).abs() < 1e-9 && (p[2].end - 0.395).abs() < 1e-9);
         assert!((p[3].end - 0.475).abs() < 1e-9 && (p[3].confidence - 0.8).abs() < 1e-9);
+    }
+
+    #[test]
+    fn heard_pauses_cut_the_words_into_pieces_with_their_text() {
+        let mut words = Vec::new();
+        let mut t = 0.0;
+        for k in 0..40 {
+            let w = if k % 10 == 9 { "<sil>" } else { "the(2)" };
+            words.push(heard(w, t, t + 1.0, 0.9));
+            t += 1.0;
+        }
+        let (text, pieces) = word_pieces(&words);
+        assert_eq!(text.matches("the ").count(), 36);
+        // Pauses at 9–10 s (too early), 19–20 s (cut at 19.5), 29–30 and 39–40 s (too soon
+        // after the cut): two pieces, the last to the end of the last word.
+        assert_eq!(pieces.len(), 2, "{pieces:?}");
+        assert_eq!((pieces[0].start, pieces[0].end), (0.0, 19.5));
+        assert_eq!((pieces[1].start, pieces[1].end), (19.5, 40.0));
+        assert_eq!(pieces[0].text, 0..18 * 4);
+        assert_eq!(pieces[1].text, 18 * 4..text.len());
     }
 
     #[test]
