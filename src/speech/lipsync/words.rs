@@ -159,7 +159,7 @@ pub fn word_pieces(words: &[AlignedPhone]) -> (String, Vec<Piece>) {
     for w in words {
         let long = w.start - start;
         let cut = if filler(&w.symbol) {
-            (long >= MIN_PIECE_SECONDS).then(|| 0.5 * (w.start + w.end))
+            (long >= MIN_PIECE_SECONDS).then_some(0.5 * (w.start + w.end))
         } else {
             (long >= PIECE_SECONDS).then_some(w.start)
         };
