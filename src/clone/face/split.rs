@@ -969,7 +969,9 @@ mod tests {
         let frames = face.frames();
         let (mi, v) = face.fp_vertex(FeaturePointId::FP_3_5).unwrap();
         let world = face.mesh_world(&frames, mi);
-        let lo = world.iter().fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
+        let lo = world
+            .iter()
+            .fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
         let hi = world
             .iter()
             .fold(Vec3::splat(f32::NEG_INFINITY), |a, &b| a.max(b));
