@@ -985,22 +985,28 @@ mod tests {
         let (mut face, centre, radius, gaze) = head();
         face.meshes
             .push(cap("iris_layer", centre, gaze, 1.02 * radius, 0.35));
-        // The same cap widened, its rim pulled onto the skin nearest each rim vertex: a shell
-        // closing the lid opening, as an eye occlusion mesh is.
-        let mut shell = cap("lid_layer", centre, gaze, 1.05 * radius, 0.8);
+        // The same cap widened, one rim vertex touching the skin: a lid resting on it (a
+        // sliver of skin from that vertex radially outwards, beyond the eyeball), as an eye
+        // occlusion shell's rim rests on the lids.
+        let shell = cap("lid_layer", centre, gaze, 1.05 * radius, 0.8);
+        let rim = shell.mesh.positions[1 + 2 * 12];
+        let out = (rim - centre).normalize();
+        let side = out.cross(gaze).normalize();
         let frames = face.frames();
-        let skin = face.mesh_world(&frames, 0);
-        let rim = 1 + 2 * 12..shell.mesh.positions.len();
-        for p in &mut shell.mesh.positions[rim] {
-            let q = *p;
-            *p = skin
-                .iter()
-                .copied()
-                .min_by(|a, b| a.distance(q).total_cmp(&b.distance(q)))
-                .unwrap();
+        let to_local = frames.meshes[0].inverse();
+        let skin = &mut face.meshes[0].mesh;
+        // The sliver has no UVs or normals: the skin drops its own.
+        (skin.uv_polygons, skin.normal_polygons) = (None, None);
+        skin.uvs.clear();
+        skin.normals.clear();
+        skin.colors.clear();
+        let n = skin.positions.len() as u32;
+        for w in [rim, rim + out * radius, rim + (out + side * 0.2) * radius] {
+            skin.positions.push(to_local.transform_point3(w));
         }
-        // Still wholly within the reach an eye layer is looked for in (so only the rim rule
-        // keeps it from the eye).
+        skin.polygons.push(&[n, n + 1, n + 2]);
+        // Wholly within the reach an eye layer is looked for in (so only the rim rule keeps
+        // it from the eye).
         let far = shell
             .mesh
             .positions
