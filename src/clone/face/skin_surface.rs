@@ -152,7 +152,7 @@ pub fn build_skin_surface_like(
             }
             (l.welded.clone(), surface_positions)
         }
-        _ => weld_outside_mouth(&positions, &triangles, eps, mouth),
+        _ => weld_outside_mouth(&positions, &triangles, &starts, eps, mouth),
     };
     let (member_start, members) = duplicate_lists(&welded, surface_positions.len());
     let tris: Vec<[u32; 3]> = triangles
@@ -259,14 +259,20 @@ fn framed_feature_points(
 /// and lower lips coincide and must stay apart, while seam duplicates there (a UV seam down the
 /// lips, the border between a skin and a mouth primitive) must not: coincident vertices in the
 /// box are welded unless one's polygons lie all above it and the other's all below (the
-/// opposite lips of the closed slit; `y` is up in the frame cloning works in). Returns the
-/// surface vertex of every input vertex and the surface positions.
+/// opposite lips of the closed slit; `y` is up in the frame cloning works in) — or they come
+/// from different meshes (`starts`: each mesh's first vertex), which meet there along a
+/// border: ICT's lips end on its mouth socket, the lip's polygons above the lower lip's inner
+/// edge and the socket's below; as two glTF primitives they parted there (a crack) while the
+/// one OBJ mesh holds one vertex. Returns the surface vertex of every input vertex and the
+/// surface positions.
 fn weld_outside_mouth(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
+    starts: &[usize],
     eps: f32,
     mouth: Option<Box3>,
 ) -> (Vec<u32>, Vec<Vec3>) {
+    let mesh_of = |v: u32| starts.partition_point(|&s| s <= v as usize);
     let coincident = find_coincident_vertices(positions, eps);
     let mut rep = coincident.representative.clone();
     let in_mouth: Vec<&Vec<u32>> = coincident
@@ -277,21 +283,27 @@ fn weld_outside_mouth(
     if !in_mouth.is_empty() {
         let side = lip_sides(positions, triangles);
         for cluster in in_mouth {
-            // Members join the first group whose side is compatible; a group takes the side
-            // of a sided member.
-            let mut groups: Vec<(u32, LipSide)> = Vec::new();
+            // Members join the first group whose side is compatible, else the first group
+            // holding no vertex of their own mesh; a group takes the side of a sided member.
+            let mut groups: Vec<(u32, LipSide, Vec<usize>)> = Vec::new();
             for &v in cluster {
-                let s = side[v as usize];
-                match groups.iter_mut().find(|(_, g)| g.compatible(s)) {
-                    Some((r, g)) => {
+                let (s, m) = (side[v as usize], mesh_of(v));
+                let join = groups
+                    .iter()
+                    .position(|(_, g, _)| g.compatible(s))
+                    .or_else(|| groups.iter().position(|(_, _, ms)| !ms.contains(&m)));
+                match join {
+                    Some(k) => {
+                        let (r, g, ms) = &mut groups[k];
                         rep[v as usize] = *r;
                         if *g == LipSide::Both {
                             *g = s;
                         }
+                        ms.push(m);
                     }
                     None => {
                         rep[v as usize] = v;
-                        groups.push((v, s));
+                        groups.push((v, s, vec![m]));
                     }
                 }
             }
@@ -412,4 +424,42 @@ fn mouth_box(fps: &BTreeMap<FeaturePointId, Vec3>, fapu: &Fapu) -> Option<Box3> 
         lo: Vec3::new(l.x.min(r.x) - 0.1 * mw, lip_y - 0.35 * mns, z - 0.5 * mw),
         hi: Vec3::new(l.x.max(r.x) + 0.1 * mw, lip_y + 0.35 * mns, f32::INFINITY),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Vertex 0 with a triangle above it, vertex 3 in the same place with a triangle below.
+    fn lips() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let positions = vec![
+            Vec3::ZERO,
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::ZERO,
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+        ];
+        (positions, vec![[0, 1, 2], [3, 4, 5]])
+    }
+
+    #[test]
+    fn opposite_sides_stay_apart_in_one_mesh_and_weld_across_meshes() {
+        let (positions, triangles) = lips();
+        let mouth = Some(Box3 {
+            lo: Vec3::splat(-0.5),
+            hi: Vec3::splat(0.5),
+        });
+        // One mesh: the closed slit's lips.
+        let (welded, surface) = weld_outside_mouth(&positions, &triangles, &[0], 1e-6, mouth);
+        assert_ne!(welded[0], welded[3]);
+        assert_eq!(surface.len(), 6);
+        // Two meshes meeting there (a lip ending on a mouth socket primitive): one vertex.
+        let (welded, surface) = weld_outside_mouth(&positions, &triangles, &[0, 3], 1e-6, mouth);
+        assert_eq!(welded[0], welded[3]);
+        assert_eq!(surface.len(), 5);
+        // Outside the mouth box duplicates weld anyway.
+        let (welded, _) = weld_outside_mouth(&positions, &triangles, &[0], 1e-6, None);
+        assert_eq!(welded[0], welded[3]);
+    }
 }

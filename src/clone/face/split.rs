@@ -6,12 +6,15 @@
 //! above the lip line (2.2/2.3) are the upper row, those below the lower
 //! ([`teeth_row_plans`]: the rule); and meshes without feature points lying wholly on the
 //! eyeballs, one piece per eye (VRoid's iris and highlight layers: [`eye_layer_plans`]) go
-//! to the eye each piece lies on. The split is an internal view: its index maps
+//! to the eye each piece lies on — unless its rim rests on the lids (an eye occlusion shell,
+//! a lacrimal film), which stays with the skin. The split is an internal view: its index maps
 //! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
 
 use std::collections::{BTreeMap, BTreeSet};
 
 use glam::Vec3;
+use parry3d::math::Vector as PVec;
+use parry3d::shape::{CompositeShapeRef, TriMesh};
 use serde::Serialize;
 
 use super::parts::{face_diagonal, fp_mesh_vertex};
@@ -497,8 +500,10 @@ const EYEBALL_MAX_RADIUS: f32 = 0.5;
 /// eyeball — every vertex within [`EYE_LAYER_REACH`] radii of the centre of the piece holding
 /// a pupil (bounding-box centre and half extent) —: the iris and highlight layers VRoid puts
 /// in front of the eye white, each primitive holding both eyes. Each piece goes to the eye it
-/// lies on, so it turns with that eyeball; the first eye stays in the mesh. Meshes in
-/// `planned` are cut already.
+/// lies on, so it turns with that eyeball; the first eye stays in the mesh. A piece whose rim
+/// comes within [`LID_CLEARANCE`] eyeball radii of the skin rests on the lids (ICT's eye
+/// occlusion, lacrimal film and corner blends): its mesh is left to the skin step, so it
+/// follows the lids and never the eye's turn. Meshes in `planned` are cut already.
 fn eye_layer_plans(
     face: &FaceModel,
     frames: &FaceFrames,
@@ -557,6 +562,7 @@ fn eye_layer_plans(
             .min_by(|a, b| q.distance(a.1).total_cmp(&q.distance(b.1)))
             .map(|b| b.0)
     };
+    let lids = LidSurface::of(face, frames, eps, &on_ball);
     for mi in candidates {
         let mesh = &face.meshes[mi].mesh;
         let world = face.mesh_world(frames, mi);
@@ -568,7 +574,8 @@ fn eye_layer_plans(
             .collect();
         let Some(eyes) = eyes else { continue };
         let (piece, count) = mesh_pieces(mesh, eps);
-        // Per piece, the eye it lies on: `None` not yet seen, `Some(None)` on both.
+        // Per piece, the eye it lies on: `None` not yet seen, `Some(None)` on both, or a
+        // piece whose rim rests on the lids.
         let mut eye: Vec<Option<Option<Part>>> = vec![None; count];
         for (v, on) in eyes {
             let Some(&k) = piece.get(v as usize) else {
@@ -579,6 +586,18 @@ fn eye_layer_plans(
                 Some(seen) if seen == Some(on) => seen,
                 Some(_) => None,
             });
+        }
+        if let Some(lids) = &lids {
+            for v in rim_vertices(mesh, eps) {
+                let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
+                    continue;
+                };
+                let Some(Some(part)) = eye[k] else { continue };
+                let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
+                if lids.within(q, LID_CLEARANCE * radius) {
+                    eye[k] = Some(None);
+                }
+            }
         }
         let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
         let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
@@ -606,6 +625,102 @@ fn eye_layer_plans(
         });
     }
     plans
+}
+
+/// Nearest an eye layer's rim may come to the skin, in eyeball radii: a rim closer than
+/// this rests on the lids. ICT's eye blend (corner wedges) comes to 0.013 radii of the
+/// skin and its eye occlusion and lacrimal film touch it (0); VRoid's iris and highlight
+/// caps float over the eye white, clear of the lids.
+const LID_CLEARANCE: f32 = 0.05;
+
+/// The skin around the eyes, to tell the layers that rest on the lids (an eye occlusion
+/// shell, a lacrimal film, corner blends: rigid with the lids, never turning with the eye)
+/// from the eye's own layers (iris, highlight): every mesh holding a skin feature point,
+/// without its pieces lying wholly on an eyeball (the eyeballs and layers of a one-mesh
+/// head).
+struct LidSurface {
+    mesh: TriMesh,
+}
+
+impl LidSurface {
+    /// `None` without skin triangles.
+    fn of(
+        face: &FaceModel,
+        frames: &FaceFrames,
+        eps: f32,
+        on_ball: &impl Fn(Vec3) -> Option<Part>,
+    ) -> Option<LidSurface> {
+        let diag = face_diagonal(face, frames);
+        let mut skin: BTreeSet<usize> = BTreeSet::new();
+        for fp in face.feature_points.iter() {
+            if Part::of_feature_point(fp.id).is_some() {
+                continue;
+            }
+            if let Some((mi, _)) = fp_mesh_vertex(face, frames, fp.id, diag * 1e-4) {
+                skin.insert(mi);
+            }
+        }
+        let mut points: Vec<PVec> = Vec::new();
+        let mut triangles: Vec<[u32; 3]> = Vec::new();
+        for mi in skin {
+            let mesh = &face.meshes[mi].mesh;
+            let world = face.mesh_world(frames, mi);
+            let (piece, count) = mesh_pieces(mesh, eps);
+            let mut off_ball = vec![false; count];
+            for (k, q) in piece.iter().zip(&world) {
+                if on_ball(*q).is_none() {
+                    off_ball[*k] = true;
+                }
+            }
+            let base = points.len() as u32;
+            points.extend(world.iter().map(|q| PVec::new(q.x, q.y, q.z)));
+            for t in mesh.triangles() {
+                if piece.get(t[0] as usize).is_some_and(|&k| off_ball[k]) {
+                    triangles.push(t.map(|v| v + base));
+                }
+            }
+        }
+        if triangles.is_empty() {
+            return None;
+        }
+        TriMesh::new(points, triangles)
+            .ok()
+            .map(|mesh| LidSurface { mesh })
+    }
+
+    /// Whether `q` lies within `gap` of the surface.
+    fn within(&self, q: Vec3, gap: f32) -> bool {
+        CompositeShapeRef(&self.mesh)
+            .project_local_point_and_get_location(PVec::new(q.x, q.y, q.z), gap, false)
+            .is_some()
+    }
+}
+
+/// Vertices on an open edge of `mesh` (an edge of one polygon; coincident vertices joined,
+/// so a UV seam is no rim): empty for closed shells.
+fn rim_vertices(mesh: &Mesh, eps: f32) -> Vec<u32> {
+    let rep = find_coincident_vertices(&mesh.positions, eps).representative;
+    let r = |v: u32| rep.get(v as usize).copied().unwrap_or(v);
+    let mut edges: BTreeMap<(u32, u32), (usize, [u32; 2])> = BTreeMap::new();
+    for poly in mesh.polygons.iter() {
+        for (i, &a) in poly.iter().enumerate() {
+            let b = poly[(i + 1) % poly.len()];
+            let (ra, rb) = (r(a), r(b));
+            if ra == rb {
+                continue;
+            }
+            let e = edges.entry((ra.min(rb), ra.max(rb))).or_insert((0, [a, b]));
+            e.0 += 1;
+        }
+    }
+    let mut out: Vec<u32> = edges
+        .values()
+        .filter(|e| e.0 == 1)
+        .flat_map(|e| e.1)
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// Cuts `plan`'s mesh in `out` (a copy of `face`): the rest keeps the mesh's place and name,
@@ -801,4 +916,145 @@ fn unique_mesh_name(face: &FaceModel, base: &str) -> String {
         name = format!("{base}_{k}");
     }
     name
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::{generate, HeadParams};
+
+    /// A cap of the sphere (`centre`, `radius`) about `axis` reaching `half_angle` from it:
+    /// a pole and `rings` rings of 12.
+    fn cap(name: &str, centre: Vec3, axis: Vec3, radius: f32, half_angle: f32) -> FaceMesh {
+        let rot = glam::Quat::from_rotation_arc(Vec3::Z, axis.normalize());
+        let (rings, segs) = (3u32, 12u32);
+        let mut positions = vec![centre + axis.normalize() * radius];
+        for i in 1..=rings {
+            let th = half_angle * i as f32 / rings as f32;
+            for j in 0..segs {
+                let ph = std::f32::consts::TAU * j as f32 / segs as f32;
+                let d = Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+                positions.push(centre + rot * d * radius);
+            }
+        }
+        let mut polygons = Polygons::new();
+        let at = |i: u32, j: u32| 1 + (i - 1) * segs + j % segs;
+        for j in 0..segs {
+            polygons.push(&[0, at(1, j), at(1, j + 1)]);
+        }
+        for i in 1..rings {
+            for j in 0..segs {
+                polygons.push(&[at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let mesh = Mesh {
+            name: name.into(),
+            positions,
+            polygons,
+            ..Mesh::default()
+        };
+        FaceMesh {
+            name: name.into(),
+            transform: None,
+            mesh,
+            color: None,
+        }
+    }
+
+    /// The synthetic head without its FAT, its left eyeball's centre and radius (as
+    /// [`eye_layer_plans`] finds them) and its gaze.
+    fn head() -> (FaceModel, Vec3, f32, Vec3) {
+        let mut face = generate(&HeadParams::alma()).to_face_model();
+        face.fat = Default::default();
+        let frames = face.frames();
+        let (mi, v) = face.fp_vertex(FeaturePointId::FP_3_5).unwrap();
+        let world = face.mesh_world(&frames, mi);
+        let lo = world
+            .iter()
+            .fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
+        let hi = world
+            .iter()
+            .fold(Vec3::splat(f32::NEG_INFINITY), |a, &b| a.max(b));
+        let centre = (lo + hi) / 2.0;
+        let radius = ((hi - lo) / 2.0).max_element();
+        (face, centre, radius, world[v as usize] - centre)
+    }
+
+    #[test]
+    fn a_cap_over_the_eye_turns_with_it_and_one_resting_on_the_lids_does_not() {
+        let (mut face, centre, radius, gaze) = head();
+        face.meshes
+            .push(cap("iris_layer", centre, gaze, 1.02 * radius, 0.35));
+        // The same cap widened, one rim vertex touching the skin: a lid resting on it (a
+        // sliver of skin from that vertex radially outwards, beyond the eyeball), as an eye
+        // occlusion shell's rim rests on the lids.
+        let shell = cap("lid_layer", centre, gaze, 1.05 * radius, 0.8);
+        let rim = shell.mesh.positions[1 + 2 * 12];
+        let out = (rim - centre).normalize();
+        let side = out.cross(gaze).normalize();
+        let frames = face.frames();
+        let to_local = frames.meshes[0].inverse();
+        let skin = &mut face.meshes[0].mesh;
+        // The sliver has no UVs or normals: the skin drops its own.
+        (skin.uv_polygons, skin.normal_polygons) = (None, None);
+        skin.uvs.clear();
+        skin.normals.clear();
+        skin.colors.clear();
+        let n = skin.positions.len() as u32;
+        for w in [rim, rim + out * radius, rim + (out + side * 0.2) * radius] {
+            skin.positions.push(to_local.transform_point3(w));
+        }
+        skin.polygons.push(&[n, n + 1, n + 2]);
+        // Wholly within the reach an eye layer is looked for in (so only the rim rule keeps
+        // it from the eye).
+        let far = shell
+            .mesh
+            .positions
+            .iter()
+            .map(|p| p.distance(centre) / radius)
+            .fold(0.0, f32::max);
+        assert!(far <= EYE_LAYER_REACH, "{far}");
+        face.meshes.push(shell);
+        let (_, parts) = split_embedded_parts(&face);
+        let from = |name: &str| {
+            parts
+                .iter()
+                .filter(|p| p.from == name)
+                .map(|p| p.part)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(from("iris_layer"), vec![Part::LeftEye], "{parts:?}");
+        assert_eq!(from("lid_layer"), Vec::<Part>::new(), "{parts:?}");
+    }
+
+    #[test]
+    fn a_closed_shell_has_no_rim_and_a_uv_seam_is_none() {
+        let (face, centre, radius, gaze) = head();
+        let eps = 1e-6;
+        let open = cap("c", centre, gaze, radius, 0.5);
+        let rim = rim_vertices(&open.mesh, eps);
+        assert_eq!(rim, (25..37).collect::<Vec<u32>>());
+        // The eyeball itself is closed.
+        let (mi, _) = face.fp_vertex(FeaturePointId::FP_3_5).unwrap();
+        assert!(rim_vertices(&face.meshes[mi].mesh, eps).is_empty());
+        // A seam: the cap's first quad strip given its own copies of the ring it shares with
+        // the next strip is still no rim there.
+        let mut seam = open.mesh.clone();
+        let n = seam.positions.len() as u32;
+        let copies: Vec<Vec3> = (13..25).map(|v| seam.positions[v as usize]).collect();
+        seam.positions.extend(copies);
+        let mut polygons = Polygons::new();
+        for (pi, poly) in seam.polygons.iter().enumerate() {
+            let p: Vec<u32> = if (12..24).contains(&pi) {
+                poly.iter()
+                    .map(|&v| if (13..25).contains(&v) { n + v - 13 } else { v })
+                    .collect()
+            } else {
+                poly.to_vec()
+            };
+            polygons.push(&p);
+        }
+        seam.polygons = polygons;
+        assert_eq!(rim_vertices(&seam, eps), rim);
+    }
 }
