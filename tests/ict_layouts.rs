@@ -4,7 +4,7 @@
 //! Blender's exporter makes; the skin's two materials share their seam vertices, so those
 //! come twice) — and each layout's cloned FAT checked part by part against the rules
 //! at every interval border and mid-interval value of the FAP's table: eyeballs move only
-//! for eyeball FAPs, rigidly; lower teeth (and in the OBJ the lower gums) follow the jaw,
+//! for eyeball FAPs, rigidly; lower teeth and the lower gums follow the jaw,
 //! upper teeth stay; lashes follow
 //! their lids; the see-through layers around the eye (eye occlusion, lacrimal fluid, eye
 //! blend) never turn with the eyeball; every layout gives the same motion per vertex; every
@@ -45,11 +45,15 @@ const VERTICES: usize = 26_719;
 /// [`GROUPS`], as a share of the FAP's peak motion at the FAP's extreme values. Measured:
 /// 0.000 % for skin, teeth, eyeballs, lacrimal fluid, eye occlusion and lashes (before the
 /// lips were welded to the mouth socket across primitives, the skin's seam twins parted by
-/// 8.8 % of `open_jaw`'s peak). Not compared (left): the gums and tongue (up to 100 %:
-/// still in the glTF layouts, see the jaw test) and the eye blend (87 % under the lid
+/// 8.8 % of `open_jaw`'s peak). The gums and tongue, a mesh of their own in the glTF layouts
+/// cut along the lip line as the OBJ's piece is: 13.8 % under `open_jaw` (the lower gums go
+/// down with the jaw in every layout, at ≥ 0.74 of the chin's motion; not traced: likely
+/// the lower jaw's rigid motion fitted over teeth and gums as one part mesh in the OBJ and
+/// as two in the glTF layouts; before they were cut there, up to 100 %: they stayed still).
+/// Not compared (left): the eye blend (87 % under the lid
 /// FAPs: a piece of the skin mesh in the OBJ, it moves with the lids; as a primitive of its
 /// own it rides on the closest skin, the eye socket, which stays).
-const LAYOUT_GAP: [f32; 8] = [1e-3, 1.0, 1e-3, 1e-3, 1e-3, 1.0, 1e-3, 1e-3];
+const LAYOUT_GAP: [f32; 8] = [1e-3, 0.15, 1e-3, 1e-3, 1e-3, 1.0, 1e-3, 1e-3];
 
 /// The OBJ as read: positions, polygons (OBJ vertex ids) and each polygon's material.
 struct Obj {
@@ -643,19 +647,13 @@ fn the_jaw_carries_the_lower_teeth_and_gums() {
                         l.name
                     );
                     // Gums joined to the tongue as a mesh of their own (the glTF layouts)
-                    // are not cut along the lip line: with no feature point and not joined
-                    // to the skin they cannot be told from a mouth interior (the test
-                    // avatar's `mouth` primitive is one), and stay still. Measured, not
-                    // asserted there: left.
-                    if l.name == "obj" {
-                        assert!(
-                            gums >= 0.4 * c,
-                            "{}: FAP {fap} = {value}: chin {c}, lower gums {gums}",
-                            l.name
-                        );
-                    } else {
-                        worst_gums = worst_gums.min(gums / c);
-                    }
+                    // are cut along the lip line like the one mesh's.
+                    assert!(
+                        gums >= 0.4 * c,
+                        "{}: FAP {fap} = {value}: chin {c}, lower gums {gums}",
+                        l.name
+                    );
+                    worst_gums = worst_gums.min(gums / c);
                     assert!(
                         up < 0.05 * c,
                         "{}: FAP {fap}: upper teeth {up} vs chin {c}",

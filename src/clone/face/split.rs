@@ -3,7 +3,8 @@
 //! move them (module docs of [`super`], step 1); so are part meshes holding several parts
 //! (both eyeballs in one mesh or glTF primitive, both rows of teeth), and a mesh holding both
 //! rows of teeth but no feature point (no 9.8–9.11, as iBUG-68 landmarks give): its pieces
-//! above the lip line (2.2/2.3) are the upper row, those below the lower
+//! above the lip line (2.2/2.3) are the upper row, those below the lower, and a piece free
+//! in the mouth reaching across the line (gums joined to a tongue) is cut along it
 //! ([`teeth_row_plans`]: the rule); and meshes without feature points lying wholly on the
 //! eyeballs, one piece per eye (VRoid's iris and highlight layers: [`eye_layer_plans`]) go
 //! to the eye each piece lies on — unless its rim rests on the lids (an eye occlusion shell,
@@ -402,14 +403,51 @@ fn shared_part_plans(
 /// above it behind the upper ones.
 const ROW_OVERLAP: f32 = 0.25;
 
+/// Whether every piece in `across` (pieces of `mesh` reaching across the lip line) is free in
+/// the mouth: open (it has a rim: gums end at the teeth and the mouth's floor) and with no rim
+/// vertex on the skin. A closed bag has no rim and a mouth interior hung from the lips has its
+/// rim on them; both deform with the skin rather than being cut into two rigid jaws, which
+/// would tear them where they cross the lip line.
+fn free_in_mouth(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    mesh: &Mesh,
+    world: &[Vec3],
+    piece: &[usize],
+    across: &BTreeSet<usize>,
+    diag: f32,
+) -> bool {
+    let eps = diag * 1e-6;
+    let rim = rim_vertices(mesh, eps);
+    let open: BTreeSet<usize> = rim
+        .iter()
+        .filter_map(|&v| piece.get(v as usize).copied())
+        .collect();
+    if !across.iter().all(|k| open.contains(k)) {
+        return false;
+    }
+    let Some(skin) = LidSurface::of(face, frames, eps, &|_| None) else {
+        return false;
+    };
+    // Seam vertices of an artist's mesh coincide with the skin's up to float rounding.
+    let touch = diag * 1e-5;
+    !rim.iter().any(|&v| {
+        piece.get(v as usize).is_some_and(|k| across.contains(k))
+            && world
+                .get(v as usize)
+                .is_some_and(|&q| skin.within(q, touch))
+    })
+}
+
 /// Meshes (or glTF primitives) holding both rows of teeth but no feature point at all (the
 /// face has no 9.8–9.11, as with iBUG-68 landmarks), recognised by place: the mesh lies in
 /// the mouth (centred between the lip corners, within 1.5 MNS0 of the lip line, behind the
 /// lips), and each of its connected pieces lies on one side of the lip line (the 2.2/2.3
 /// midline; its centroid there and at most [`ROW_OVERLAP`] MNS0 across), some above and
 /// some below. Pieces above are the upper row, below the lower; the upper row stays in the
-/// mesh. A piece reaching well across the lip line (a mouth interior, gums joined to a
-/// tongue) leaves the mesh uncut, as does a mesh of one row.
+/// mesh. A piece reaching well across the lip line is cut along it, polygon by polygon, when
+/// it is free in the mouth (gums joined to a tongue: [`free_in_mouth`]); a closed bag or a
+/// mouth interior hung from the lips leaves the mesh uncut, as does a mesh of one row.
 fn teeth_row_plans(
     face: &FaceModel,
     frames: &FaceFrames,
@@ -453,7 +491,7 @@ fn teeth_row_plans(
             s.3 = s.3.max(p.y);
         }
         let overlap = ROW_OVERLAP * lm.mns;
-        let rows: Option<Vec<Part>> = stats
+        let rows: Vec<Option<Part>> = stats
             .iter()
             .map(|&(sum, n, lo, hi)| {
                 let cy = sum.y / n.max(1) as f32;
@@ -466,15 +504,34 @@ fn teeth_row_plans(
                 }
             })
             .collect();
-        let Some(rows) = rows else { continue };
+        // Pieces across the lip line: gums joined to a tongue (ICT's, in a mesh of their own)
+        // are cut along it like a one-mesh head's; a closed bag or a piece whose rim is on
+        // the skin (a mouth interior hung from the lips) deforms with the skin instead.
+        let across: BTreeSet<usize> = (0..count).filter(|&k| rows[k].is_none()).collect();
+        if !across.is_empty() && !free_in_mouth(face, frames, mesh, &world, &piece, &across, diag) {
+            continue;
+        }
         let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
         let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
         for (pi, poly) in mesh.polygons.iter().enumerate() {
             let Some(&k) = poly.first().and_then(|&v| piece.get(v as usize)) else {
                 continue;
             };
-            pieces.entry(rows[k]).or_default().insert(k);
-            dest.entry(Some(rows[k])).or_default().push(pi);
+            let row = rows[k].unwrap_or_else(|| {
+                let y = poly
+                    .iter()
+                    .filter_map(|&v| world.get(v as usize))
+                    .map(|p| p.y)
+                    .sum::<f32>()
+                    / poly.len() as f32;
+                if y > lm.lip_y {
+                    Part::UpperTeeth
+                } else {
+                    Part::LowerTeeth
+                }
+            });
+            pieces.entry(row).or_default().insert(k);
+            dest.entry(Some(row)).or_default().push(pi);
         }
         if dest.len() < 2 {
             continue;
@@ -1056,5 +1113,41 @@ mod tests {
         }
         seam.polygons = polygons;
         assert_eq!(rim_vertices(&seam, eps), rim);
+    }
+
+    #[test]
+    fn gums_free_in_the_mouth_are_cut_along_the_lip_line_and_a_closed_bag_is_not() {
+        let (base, ..) = head();
+        let fp = |id| base.feature_points.position(id).unwrap();
+        let (u, lo) = (fp(FeaturePointId::FP_2_2), fp(FeaturePointId::FP_2_3));
+        let mns = base.fapu().unwrap().distances.mns0 as f32;
+        // Behind the lips, centred on the lip line, reaching 0.8 MNS0 up and down.
+        let centre = Vec3::new((u.x + lo.x) / 2.0, (u.y + lo.y) / 2.0, u.z.min(lo.z) - mns);
+        let cut_of = |mesh: FaceMesh| {
+            let mut face = base.clone();
+            face.meshes.push(mesh);
+            let (_, parts) = split_embedded_parts(&face);
+            let mut of: Vec<Part> = parts
+                .iter()
+                .filter(|p| p.from == "gums")
+                .map(|p| p.part)
+                .collect();
+            of.sort();
+            of
+        };
+        // An open sheet facing forward (gums and tongue): both jaws.
+        let open = cap("gums", centre, Vec3::Z, 0.8 * mns, 1.4);
+        assert_eq!(
+            cut_of(open),
+            vec![Part::UpperTeeth, Part::LowerTeeth]
+                .into_iter()
+                .collect::<BTreeSet<_>>()
+                .into_iter()
+                .collect::<Vec<_>>()
+        );
+        // The same place closed all round (a mouth bag): left to the skin.
+        let closed = cap("gums", centre, Vec3::Z, 0.8 * mns, std::f32::consts::PI);
+        assert!(rim_vertices(&closed.mesh, 1e-6).is_empty());
+        assert_eq!(cut_of(closed), Vec::<Part>::new());
     }
 }
