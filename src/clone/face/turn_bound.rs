@@ -74,11 +74,8 @@ fn sliver_apex(positions: &[Vec3], t: &[u32; 3]) -> Option<(u32, (u32, u32, f32)
     let e = p(b) - p(a);
     let l2 = e.length_squared().max(f32::MIN_POSITIVE);
     let height = e.cross(p(c) - p(a)).length() / l2.sqrt();
-    if !(height < SLIVER * l2.sqrt()) {
-        return None;
-    }
     let s = (p(c) - p(a)).dot(e) / l2;
-    Some((c, (a, b, s.clamp(0.0, 1.0))))
+    (height < SLIVER * l2.sqrt()).then_some((c, (a, b, s.clamp(0.0, 1.0))))
 }
 
 /// The harmonic fill of `d` over the `region` (every other vertex held): each vertex takes
@@ -598,6 +595,20 @@ mod tests {
         // The FAP still moves its point exactly.
         let d = crate::clone::quality::dense(&out[0], t.positions.len());
         assert_eq!(d[fp as usize], wanted);
+    }
+
+    #[test]
+    fn only_a_sliver_has_an_apex_that_follows() {
+        let p = [
+            Vec3::ZERO,
+            Vec3::new(4.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.1, 0.0),
+            Vec3::new(1.0, 2.0, 0.0),
+        ];
+        // Nearly collinear: vertex 2 follows the edge 0–1 at a quarter of its length.
+        assert_eq!(sliver_apex(&p, &[0, 1, 2]), Some((2, (0, 1, 0.25))));
+        // Well shaped (apex as high as half the longest edge): it stays in the fill.
+        assert_eq!(sliver_apex(&p, &[0, 1, 3]), None);
     }
 
     #[test]
