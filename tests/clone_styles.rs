@@ -216,14 +216,18 @@ fn print(p: &Pair) {
 /// left: the chin below it and the mouth socket's cut, 63–66°), alma → ict and → ict-rig
 /// 4.02 → 3.52 (`viseme_12`), bruno → ict 5.09 → 4.90 (`viseme_9` at ICT's inner lip
 /// corner, inside the held slit), the rest within 0.01.
+/// Since only slivers (apex under 0.2 of the longest edge over it) follow their base in
+/// `bound`'s later rounds, and its fills over-relax (2026-11-27): alma → ict and → ict-rig
+/// 3.52 → 3.17, bruno → ict 4.90 → 4.43 (a well-shaped triangle made to follow flattened its
+/// patch; now it stays in the fill), the rest within 0.01.
 const BOUNDS: [(&str, &str, f64, f64); 10] = [
-    ("alma", "ict", 0.015, 3.6),
-    ("bruno", "ict", 0.015, 5.0),
+    ("alma", "ict", 0.015, 3.2),
+    ("bruno", "ict", 0.015, 4.5),
     ("candide", "ict", 0.015, 9.7),
     ("ict", "alma", 0.015, 1.45),
     ("ict", "bruno", 0.01, 2.05),
     ("ict", "candide", 0.01, 1.45),
-    ("alma", "ict-rig", 0.015, 3.6),
+    ("alma", "ict-rig", 0.015, 3.2),
     ("candide", "ict-rig", 0.015, 9.7),
     ("ict-rig", "alma", 0.015, 1.45),
     ("ict-rig", "candide", 0.01, 1.45),

@@ -98,7 +98,7 @@
 //!    triangle turning more than 1.4× the source's largest turn (at least 1°; issue 21 asks
 //!    1.5×) is re-solved around those triangles — a harmonic fill (edges weighed by inverse
 //!    length) over their corners and a ring that grows each round, and in triangles still
-//!    above the bound the corner opposite the longest edge following that edge (a sliver
+//!    above the bound, if a sliver, the corner opposite the longest edge following that edge (a sliver
 //!    moves with its base) — feature points, the lips' and lids' margins held, the round turning least kept
 //!    if it turns less than the clone's own. It settles what `smooth`'s uniform steps cannot:
 //!    CANDIDE-3's slivers at the sides of the head under the brow FAPs, ICT's tenth-of-a-

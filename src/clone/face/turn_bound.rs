@@ -14,10 +14,10 @@
 //! Per motion whose target still has a triangle above the bound: the corners of those triangles
 //! and one ring around them are re-solved as a harmonic fill of the motion around them (edges
 //! weighed by inverse length, so close vertices move alike whatever the mesh's scale there),
-//! the rest held. Each further round, in every triangle still above the bound the corner
+//! the rest held. Each further round, in every sliver still above the bound the corner
 //! opposite the longest edge is made to *follow* that edge (its motion is the edge ends'
 //! motion interpolated at its foot on the edge: a sliver then moves with its base and keeps
-//! its shape, a tiny triangle between two lips moves with the lip it hangs on) and the
+//! its shape, a thin triangle between two lips moves with the lip it hangs on) and the
 //! region grows by one ring, up to `ROUNDS` rounds. Held, every motion as it was: the feature
 //! points (compliance is measured there), the lips' slit (the surface's borders near the
 //! mouth and two rings around them) and the lid margins: the slits' gaps and the lashes
@@ -43,14 +43,26 @@ pub(super) const BOUND: f64 = 1.4;
 const ROUNDS: usize = 4;
 /// Gauss–Seidel sweeps at most per harmonic fill.
 const SWEEPS: usize = 400;
+/// Over-relaxation of each Gauss–Seidel step (successive over-relaxation): a plain step (1)
+/// carries a change about one edge per sweep, and the fills are dozens of edges across
+/// (CANDIDE-3's chin on the dense ICT head under `open_jaw`: 1 400 vertices, which settles
+/// in about 50 sweeps over-relaxed).
+const RELAX: f32 = 1.8;
+/// A triangle whose apex (the corner opposite its longest edge) lies lower over that edge
+/// than this share of its length is a sliver, whose apex follows the edge (module docs).
+/// A well-shaped triangle keeps its apex in the fill: made to follow, a dense patch turning
+/// as a whole (the ICT head's chin under CANDIDE-3's `open_jaw`: 1 400 triangles) flattened
+/// into folds (93° → 167–174°) and its fills, over 1 000 followers, cost most of the step.
+const SLIVER: f32 = 0.2;
 
 /// A vertex that follows the edge opposite it in a triangle: its motion is the motion of the
 /// edge's ends interpolated at its foot on that edge (`a`, `b`, parameter `t`).
 type Follows = BTreeMap<u32, (u32, u32, f32)>;
 
 /// The vertex of triangle `t` opposite its longest edge, that edge's ends and the parameter
-/// of the vertex's foot on it (clamped to the edge).
-fn apex(positions: &[Vec3], t: &[u32; 3]) -> (u32, (u32, u32, f32)) {
+/// of the vertex's foot on it (clamped to the edge), when `t` is a sliver: the vertex's
+/// height over the edge under `SLIVER` × the edge's length.
+fn sliver_apex(positions: &[Vec3], t: &[u32; 3]) -> Option<(u32, (u32, u32, f32))> {
     let p = |v: u32| positions[v as usize];
     let k = (0..3)
         .max_by(|&i, &j| {
@@ -60,8 +72,10 @@ fn apex(positions: &[Vec3], t: &[u32; 3]) -> (u32, (u32, u32, f32)) {
         .unwrap_or(0);
     let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
     let e = p(b) - p(a);
-    let s = (p(c) - p(a)).dot(e) / e.length_squared().max(f32::MIN_POSITIVE);
-    (c, (a, b, s.clamp(0.0, 1.0)))
+    let l2 = e.length_squared().max(f32::MIN_POSITIVE);
+    let height = e.cross(p(c) - p(a)).length() / l2.sqrt();
+    let s = (p(c) - p(a)).dot(e) / l2;
+    (height < SLIVER * l2.sqrt()).then_some((c, (a, b, s.clamp(0.0, 1.0))))
 }
 
 /// The harmonic fill of `d` over the `region` (every other vertex held): each vertex takes
@@ -93,8 +107,9 @@ fn fill(positions: &[Vec3], adj: &[Vec<u32>], region: &[u32], follows: &Follows,
             let (sum, weight) = edges.iter().fold((Vec3::ZERO, 0.0f32), |(s, t), &(w, c)| {
                 (s + c * d[w as usize], t + c)
             });
-            let value = sum / weight;
-            change = change.max(value.distance(d[*v as usize]));
+            let old = d[*v as usize];
+            let value = old + RELAX * (sum / weight - old);
+            change = change.max(value.distance(old));
             d[*v as usize] = value;
         }
         for (&c, &(a, b, t)) in follows {
@@ -308,7 +323,9 @@ impl Bounds<'_> {
         for round in 0..ROUNDS {
             if round > 0 {
                 for &i in &bad {
-                    let (c, edge) = apex(pos, &tris[i as usize]);
+                    let Some((c, edge)) = sliver_apex(pos, &tris[i as usize]) else {
+                        continue;
+                    };
                     if !fixed[c as usize] && Some(c) != own_target {
                         follows.entry(c).or_insert(edge);
                     }
@@ -433,13 +450,17 @@ pub(super) fn bound_turns(
             // The FAP's own feature point keeps its motion (what the FAP defines, where
             // compliance is measured); other feature points are skin like any other. Held
             // as one vertex it can stand out as a spike, spread it can bend a wide ball:
-            // when a triangle at it turns over the bound both are tried, the better kept.
+            // when a triangle at it turns over the bound and holding it leaves the motion
+            // over the bound, the spread is tried too and the better kept. A held round
+            // that meets the bound is kept as it is: the spread's rounds cost as much again
+            // (the bound step 38 → 70–79 ms on dense CANDIDE-3 → ICT) for a motion that is
+            // already smooth enough.
             let own = fap_fp(src.key, source, target)
                 .map(|(fp, _)| (source.fp_vertices[&fp], target.fp_vertices[&fp]));
             let (held_round, at_own) =
                 bounds.rounds(&d, moving.clone(), cos_tau, own, false, own_cos);
             let floor = held_round.as_ref().map_or(own_cos, |r| r.worst);
-            let spread_round = if at_own {
+            let spread_round = if at_own && floor < cos_tau {
                 bounds.rounds(&d, moving, cos_tau, own, true, floor).0
             } else {
                 None
@@ -574,6 +595,20 @@ mod tests {
         // The FAP still moves its point exactly.
         let d = crate::clone::quality::dense(&out[0], t.positions.len());
         assert_eq!(d[fp as usize], wanted);
+    }
+
+    #[test]
+    fn only_a_sliver_has_an_apex_that_follows() {
+        let p = [
+            Vec3::ZERO,
+            Vec3::new(4.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.1, 0.0),
+            Vec3::new(1.0, 2.0, 0.0),
+        ];
+        // Nearly collinear: vertex 2 follows the edge 0–1 at a quarter of its length.
+        assert_eq!(sliver_apex(&p, &[0, 1, 2]), Some((2, (0, 1, 0.25))));
+        // Well shaped (apex as high as half the longest edge): it stays in the fill.
+        assert_eq!(sliver_apex(&p, &[0, 1, 3]), None);
     }
 
     #[test]
