@@ -403,14 +403,22 @@ fn shared_part_plans(
 /// above it behind the upper ones.
 const ROW_OVERLAP: f32 = 0.25;
 
+/// How far behind the lips gums joined to a tongue reach at least, in MW0 (ICT's: 2.0 MW0,
+/// back to the throat; the test avatar's mouth cap: about 0.5).
+const GUMS_DEPTH: f32 = 1.0;
+
 /// Whether every piece in `across` (pieces of `mesh` reaching across the lip line) is free in
-/// the mouth: open (it has a rim: gums end at the teeth and the mouth's floor) and with no rim
-/// vertex on the skin. A closed bag has no rim and a mouth interior hung from the lips has its
-/// rim on them; both deform with the skin rather than being cut into two rigid jaws, which
-/// would tear them where they cross the lip line.
+/// the mouth: open (it has a rim: gums end at the teeth and the mouth's floor), running back
+/// along the jaws at least [`GUMS_DEPTH`] behind the lips, and with no rim vertex on the skin.
+/// A closed bag has no rim, a mouth interior hung from the lips has its rim on them, and a
+/// shallow cap just behind the lips (the test avatar's `mouth`) is no jaw; they deform with
+/// the skin rather than being cut into two rigid jaws, which would tear them where they cross
+/// the lip line.
+#[allow(clippy::too_many_arguments)]
 fn free_in_mouth(
     face: &FaceModel,
     frames: &FaceFrames,
+    lm: &Landmarks,
     mesh: &Mesh,
     world: &[Vec3],
     piece: &[usize],
@@ -418,6 +426,16 @@ fn free_in_mouth(
     diag: f32,
 ) -> bool {
     let eps = diag * 1e-6;
+    let back = lm.lip_z - GUMS_DEPTH * lm.mw;
+    let deep: BTreeSet<usize> = piece
+        .iter()
+        .zip(world)
+        .filter(|(_, q)| q.z < back)
+        .map(|(&k, _)| k)
+        .collect();
+    if !across.iter().all(|k| deep.contains(k)) {
+        return false;
+    }
     let rim = rim_vertices(mesh, eps);
     let open: BTreeSet<usize> = rim
         .iter()
@@ -508,7 +526,9 @@ fn teeth_row_plans(
         // are cut along it like a one-mesh head's; a closed bag or a piece whose rim is on
         // the skin (a mouth interior hung from the lips) deforms with the skin instead.
         let across: BTreeSet<usize> = (0..count).filter(|&k| rows[k].is_none()).collect();
-        if !across.is_empty() && !free_in_mouth(face, frames, mesh, &world, &piece, &across, diag) {
+        if !across.is_empty()
+            && !free_in_mouth(face, frames, &lm, mesh, &world, &piece, &across, diag)
+        {
             continue;
         }
         let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
@@ -1120,7 +1140,8 @@ mod tests {
         let (base, ..) = head();
         let fp = |id| base.feature_points.position(id).unwrap();
         let (u, lo) = (fp(FeaturePointId::FP_2_2), fp(FeaturePointId::FP_2_3));
-        let mns = base.fapu().unwrap().distances.mns0 as f32;
+        let d = base.fapu().unwrap().distances;
+        let (mns, mw) = (d.mns0 as f32, d.mw0 as f32);
         // Behind the lips, centred on the lip line, reaching 0.8 MNS0 up and down.
         let centre = Vec3::new((u.x + lo.x) / 2.0, (u.y + lo.y) / 2.0, u.z.min(lo.z) - mns);
         let cut_of = |mesh: FaceMesh| {
@@ -1135,8 +1156,12 @@ mod tests {
             of.sort();
             of
         };
-        // An open sheet facing forward (gums and tongue): both jaws.
-        let open = cap("gums", centre, Vec3::Z, 0.8 * mns, 1.4);
+        // An open sheet facing forward, running back along the jaws (gums and tongue): both
+        // jaws.
+        let open = cap("gums", centre - Vec3::Z * 1.2 * mw, Vec3::Z, 0.8 * mns, 1.4);
+        // The same sheet close behind the lips (a mouth interior's front): not a jaw.
+        let shallow = cap("gums", centre, Vec3::Z, 0.8 * mns, 1.4);
+        assert_eq!(cut_of(shallow), Vec::<Part>::new());
         assert_eq!(
             cut_of(open),
             vec![Part::UpperTeeth, Part::LowerTeeth]
