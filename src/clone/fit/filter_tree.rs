@@ -202,7 +202,7 @@ impl FilterTree {
     /// `bit` (`on_side`) is accepted too. The answer is then the nearest point of the side
     /// when that lies within `free`, else the nearest point `allowed` accepts — what a
     /// search of the side within `free` followed by a filtered search would find, in one
-    /// walk of the tree (`free` = 0: the plain filtered search).
+    /// walk of the tree (`free` = 0: the plain filtered search; `free` at most `max_dist`).
     #[allow(clippy::too_many_arguments)]
     pub fn closest(
         &self,
@@ -426,7 +426,10 @@ mod tests {
             let near = CompositeShapeRef(&side)
                 .project_local_point_and_get_location(pp, free * 1.001, false)
                 .filter(|h| (h.1.point - pp).length() <= free);
-            let want = near.or(want);
+            let max = max.max(free);
+            let want = near.or_else(|| {
+                CompositeShapeRef(&view).project_local_point_and_get_location(pp, max, false)
+            });
             let got = tree.closest(&mesh, pp, max, free, bit, normal.as_ref(), allowed, on_side);
             assert_eq!(
                 want.map(|w| (w.0, w.1.point)),
