@@ -18,6 +18,7 @@
 pub mod components;
 mod error;
 pub mod geometry;
+pub mod morton;
 pub mod obj;
 pub mod obj_patch;
 pub mod orient;

@@ -11,6 +11,7 @@
 use std::collections::{BTreeSet, HashMap};
 
 use glam::{Affine3A, Vec3};
+use rayon::prelude::*;
 
 use super::mouth_fill::HarmonicFill;
 use super::rigid::hierarchy_ancestors;
@@ -139,112 +140,123 @@ pub(super) fn fold_into_target(
         .filter(|&(_, n)| n > 1)
         .map(|(t, _)| t)
         .collect();
-    let mut fat = Fat::default();
-    for table in &cloned.fat.tables {
-        let mut out = FaceDefTable::new(table.key);
-        let mut merged = Vec::new();
-        let mut motion: Option<TableMotion> = None;
-        let moves_baked = table
-            .transforms
-            .iter()
-            .any(|t| baked.contains(&t.transform));
-        let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
-        // Per spread transform, the borders its meshes need together.
-        let mut shared: HashMap<usize, Vec<f64>> = HashMap::new();
-        if moves_baked && !spread.is_empty() {
+    // Tables fold independently (one core each); warnings and tables keep table order.
+    let folded: Vec<Result<(Option<FaceDefTable>, Vec<Diagnostic>)>> = cloned
+        .fat
+        .tables
+        .par_iter()
+        .map(|table| {
+            let mut warnings: Vec<Diagnostic> = Vec::new();
+            let mut out = FaceDefTable::new(table.key);
+            let mut merged = Vec::new();
+            let mut motion: Option<TableMotion> = None;
+            let moves_baked = table
+                .transforms
+                .iter()
+                .any(|t| baked.contains(&t.transform));
+            let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
+            // Per spread transform, the borders its meshes need together.
+            let mut shared: HashMap<usize, Vec<f64>> = HashMap::new();
+            if moves_baked && !spread.is_empty() {
+                for cut in &cuts {
+                    let own = cut_borders(cloned, table, cut);
+                    for m in &cut.meshes {
+                        let Some(t) = baked_by(m).filter(|t| spread.contains(t)) else {
+                            continue;
+                        };
+                        let motion = match &mut motion {
+                            Some(x) => x,
+                            None => motion.insert(TableMotion::new(cloned, table)?),
+                        };
+                        let (b, _) = bake_view_mesh(target, cut, m, motion, table.key, range, &own);
+                        shared
+                            .entry(t)
+                            .or_default()
+                            .extend(b.entry.interval_borders);
+                    }
+                }
+            }
+            // The table's entries not yet taken by a cut (cloned only once they are kept).
+            let mut rest: Vec<&FaceDefMesh> = table.meshes.iter().collect();
             for cut in &cuts {
-                let own = cut_borders(cloned, table, cut);
-                for m in &cut.meshes {
-                    let Some(t) = baked_by(m).filter(|t| spread.contains(t)) else {
-                        continue;
-                    };
-                    let motion = match &mut motion {
-                        Some(x) => x,
-                        None => motion.insert(TableMotion::new(cloned, table)?),
-                    };
-                    let (b, _) = bake_view_mesh(target, cut, m, motion, table.key, range, &own);
-                    shared
-                        .entry(t)
-                        .or_default()
-                        .extend(b.entry.interval_borders);
+                let mut entries: Vec<FaceDefMesh> = Vec::new();
+                rest.retain(|e| {
+                    match cut
+                        .meshes
+                        .iter()
+                        .find(|m| cloned.meshes[m.index].name == e.mesh)
+                    {
+                        Some(m) => {
+                            entries.push(FaceDefMesh {
+                                mesh: cut.name.to_string(),
+                                coord_index: e
+                                    .coord_index
+                                    .iter()
+                                    .map(|&v| m.to_target.get(v as usize).copied().unwrap_or(v))
+                                    .collect(),
+                                interval_borders: e.interval_borders.clone(),
+                                displacements: e.displacements.clone(),
+                            });
+                            false
+                        }
+                        None => true,
+                    }
+                });
+                if moves_baked {
+                    let borders: Vec<f64> = entries
+                        .iter()
+                        .flat_map(|e| e.interval_borders.iter().copied())
+                        .collect();
+                    for m in &cut.meshes {
+                        let Some(t) = baked_by(m) else {
+                            continue;
+                        };
+                        let motion = match &mut motion {
+                            Some(x) => x,
+                            None => motion.insert(TableMotion::new(cloned, table)?),
+                        };
+                        let mut borders = borders.clone();
+                        borders.extend(shared.get(&t).into_iter().flatten());
+                        let (b, size) =
+                            bake_view_mesh(target, cut, m, motion, table.key, range, &borders);
+                        let tolerance = BAKE_TOLERANCE * size;
+                        if b.max_error > tolerance {
+                            warnings.push(Diagnostic::warning(format!(
+                                "{}: the baked motion of {} is off by {:.3} % of its size",
+                                table.key,
+                                cloned.meshes[m.index].name,
+                                100.0 * b.max_error / size.max(f32::MIN_POSITIVE)
+                            )));
+                        }
+                        // A part this table does not move adds no entry.
+                        if b.entry.displacements.iter().any(|d| *d != Vec3::ZERO) {
+                            entries.push(b.entry);
+                        }
+                    }
                 }
+                let entry = merge_entries(entries, &cut.multiplicity);
+                merged.extend(match (entry, &cut.band) {
+                    (Some(e), Some(band)) => Some(band.smooth(e)),
+                    (e, _) => e,
+                });
             }
-        }
-        // The table's entries not yet taken by a cut (cloned only once they are kept).
-        let mut rest: Vec<&FaceDefMesh> = table.meshes.iter().collect();
-        for cut in &cuts {
-            let mut entries: Vec<FaceDefMesh> = Vec::new();
-            rest.retain(|e| {
-                match cut
-                    .meshes
-                    .iter()
-                    .find(|m| cloned.meshes[m.index].name == e.mesh)
-                {
-                    Some(m) => {
-                        entries.push(FaceDefMesh {
-                            mesh: cut.name.to_string(),
-                            coord_index: e
-                                .coord_index
-                                .iter()
-                                .map(|&v| m.to_target.get(v as usize).copied().unwrap_or(v))
-                                .collect(),
-                            interval_borders: e.interval_borders.clone(),
-                            displacements: e.displacements.clone(),
-                        });
-                        false
-                    }
-                    None => true,
-                }
-            });
-            if moves_baked {
-                let borders: Vec<f64> = entries
-                    .iter()
-                    .flat_map(|e| e.interval_borders.iter().copied())
-                    .collect();
-                for m in &cut.meshes {
-                    let Some(t) = baked_by(m) else {
-                        continue;
-                    };
-                    let motion = match &mut motion {
-                        Some(x) => x,
-                        None => motion.insert(TableMotion::new(cloned, table)?),
-                    };
-                    let mut borders = borders.clone();
-                    borders.extend(shared.get(&t).into_iter().flatten());
-                    let (b, size) =
-                        bake_view_mesh(target, cut, m, motion, table.key, range, &borders);
-                    let tolerance = BAKE_TOLERANCE * size;
-                    if b.max_error > tolerance {
-                        report.warnings.push(Diagnostic::warning(format!(
-                            "{}: the baked motion of {} is off by {:.3} % of its size",
-                            table.key,
-                            cloned.meshes[m.index].name,
-                            100.0 * b.max_error / size.max(f32::MIN_POSITIVE)
-                        )));
-                    }
-                    // A part this table does not move adds no entry.
-                    if b.entry.displacements.iter().any(|d| *d != Vec3::ZERO) {
-                        entries.push(b.entry);
-                    }
-                }
-            }
-            let entry = merge_entries(entries, &cut.multiplicity);
-            merged.extend(match (entry, &cut.band) {
-                (Some(e), Some(band)) => Some(band.smooth(e)),
-                (e, _) => e,
-            });
-        }
-        out.meshes = merged;
-        out.meshes.extend(rest.into_iter().cloned());
-        out.transforms = table
-            .transforms
-            .iter()
-            .filter(|t| !baked.contains(&t.transform))
-            .cloned()
-            .collect();
-        if !out.meshes.is_empty() || !out.transforms.is_empty() {
-            fat.tables.push(out);
-        }
+            out.meshes = merged;
+            out.meshes.extend(rest.into_iter().cloned());
+            out.transforms = table
+                .transforms
+                .iter()
+                .filter(|t| !baked.contains(&t.transform))
+                .cloned()
+                .collect();
+            let keep = !out.meshes.is_empty() || !out.transforms.is_empty();
+            Ok((keep.then_some(out), warnings))
+        })
+        .collect();
+    let mut fat = Fat::default();
+    for f in folded {
+        let (table, mut warnings) = f?;
+        report.warnings.append(&mut warnings);
+        fat.tables.extend(table);
     }
     let face = layout_face(cloned, target, &baked, fat);
     correct_report(report, &baked);

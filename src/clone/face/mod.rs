@@ -340,16 +340,14 @@ pub fn clone_face(
         .timings
         .push("motions", clock.elapsed().as_secs_f64());
     // 5, 6. Surface method and FAPU rescale.
-    let mut cloned_motions =
+    let (mut cloned_motions, [tmargins, smargins]) =
         clone_skin_motions(&ssurf, &tsurf, &motions, &alignment, opts, &mut report)?;
     // Lashes ride on their own lid's margin: rows that are pieces of the skin take its
     // motion here, rows of their own mesh in step 8. A source with rows of lashes in its own
     // skin has them mapped onto the target's by the surface method, like for like (and a
     // target one mesh with the source keeps the source's lash motion vertex to vertex).
-    let margins =
-        lid_margin::LidMargins::of(&tsurf.surface).with_eyeballs(target, &tparts, &alignment);
-    let source_rows =
-        lid_margin::SkinRows::of(source, &ssurf, &lid_margin::LidMargins::of(&ssurf.surface));
+    let margins = tmargins.with_eyeballs(target, &tparts, &alignment);
+    let source_rows = lid_margin::SkinRows::of(source, &ssurf, &smargins);
     if !whole && source_rows.is_empty() {
         lid_margin::SkinRows::of(target, &tsurf, &margins).carry(&mut cloned_motions);
     }
@@ -488,7 +486,8 @@ pub fn clone_face(
 
 /// Steps 5 and 6: the surface method on the motions that move the skin, then (RBF) the FAPU
 /// rescale, the guard, `smooth` and `gain` (which turns the wanted motions by the
-/// `alignment`'s rotation). Returns one cloned motion per moving source motion.
+/// `alignment`'s rotation). Returns one cloned motion per moving source motion, and the lid
+/// margins of the target's and the source's skin (found while the surface method runs).
 fn clone_skin_motions(
     ssurf: &SkinSurface,
     tsurf: &SkinSurface,
@@ -496,20 +495,26 @@ fn clone_skin_motions(
     alignment: &Similarity,
     opts: &CloneOptions,
     report: &mut CloneReport,
-) -> Result<Vec<SurfaceMotion>> {
+) -> Result<(Vec<SurfaceMotion>, [lid_margin::LidMargins; 2])> {
     // Only motions that move the skin.
     let moving: Vec<SurfaceMotion> = motions
         .iter()
         .filter(|m| !m.offsets.is_empty())
         .cloned()
         .collect();
-    // What `smooth` and `mouth` read of the neutral surfaces is built while the surface
-    // method runs: its sequential steps (`fit`'s factorisations) leave a core free.
-    let (result, (topology, interior)) = rayon::join(
+    // What `smooth`, `mouth`, `bound` and the lashes read of the neutral surfaces (lid
+    // margins found once for all of them) is built while the surface method runs: its
+    // sequential steps (`fit`'s factorisations) leave a core free.
+    let (result, ((topology, margins), interior)) = rayon::join(
         || clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts),
         || {
             rayon::join(
-                || SmoothTopology::new(&ssurf.surface, &moving, &tsurf.surface),
+                || {
+                    (
+                        SmoothTopology::new(&ssurf.surface, &moving, &tsurf.surface),
+                        [&tsurf.surface, &ssurf.surface].map(lid_margin::LidMargins::of),
+                    )
+                },
                 || {
                     // A source with a mouth interior of its own (a rig head) hands on its
                     // real motion there.
@@ -627,9 +632,7 @@ fn clone_skin_motions(
     // Last, an explicit bound on the skin's turn: what `smooth`'s uniform steps could not
     // settle (tiny or sliver triangles) is re-solved around it.
     let clock = Instant::now();
-    let lids: Vec<u32> = lid_margin::LidMargins::of(&tsurf.surface)
-        .margin_vertices()
-        .collect();
+    let lids: Vec<u32> = margins[0].margin_vertices().collect();
     for (k, n) in turn_bound::bound_turns(
         &topology,
         &ssurf.surface,
@@ -641,7 +644,7 @@ fn clone_skin_motions(
         *report.smoothed.entry(k).or_default() += n;
     }
     report.timings.push("bound", clock.elapsed().as_secs_f64());
-    Ok(result.motions)
+    Ok((result.motions, margins))
 }
 
 /// Whether `target` is one mesh with the source's only skin mesh: the same vertex count and

@@ -190,17 +190,15 @@ pub(crate) fn correspond(
                 h
             } else if nrm == Vec3::ZERO {
                 source.closest_within(p, plain, far_probe)?
-            } else if let Some(h) = source
-                .closest_within(p, plain, snap * 1.001)
-                .filter(|h| h.point.distance(p) <= snap)
-            {
-                h
             } else {
                 let oriented = Filter {
                     bit,
                     normal: Some((nrm, cos)),
                     crease: creases.get(i).copied().flatten(),
                 };
+                // The side's nearest point within `snap` (a point on the surface), else the
+                // compatible one; either is taken below when within `near`.
+                let compatible = source.closest_snapping(p, oriented, snap, far_probe);
                 // A vertex lying on the source (within `near`) whose compatible points are all
                 // farther than `near` beyond its closest point sits where the normals mislead
                 // (a lid margin's fold): its closest point stands in.
@@ -210,7 +208,7 @@ pub(crate) fn correspond(
                         .closest_within(p, plain, near * 1.001)
                         .filter(|h| h.point.distance(p) <= near)
                 };
-                match source.closest_within(p, oriented, far_probe) {
+                match compatible {
                     Some(h) if h.point.distance(p) <= near => h,
                     Some(h) => match on_source() {
                         Some(c) if h.point.distance(p) > c.point.distance(p) + near => c,

@@ -197,33 +197,44 @@ impl FilterTree {
     /// The triangle nearest to `point` that `allowed` accepts, if nearer than `max_dist`:
     /// parry's `project_local_point_and_get_location` on the filtered mesh (not solid),
     /// with subtrees that fail `bit` or `normal` skipped (module docs).
+    ///
+    /// Within `free` of `point` the normal test is waived: a triangle there that passes
+    /// `bit` (`on_side`) is accepted too. The answer is then the nearest point of the side
+    /// when that lies within `free`, else the nearest point `allowed` accepts — what a
+    /// search of the side within `free` followed by a filtered search would find, in one
+    /// walk of the tree (`free` = 0: the plain filtered search; `free` at most `max_dist`).
+    #[allow(clippy::too_many_arguments)]
     pub fn closest(
         &self,
         mesh: &TriMesh,
         point: PVec,
         max_dist: f32,
+        free: f32,
         bit: TriMask,
         normal: Option<&NormalTest>,
         allowed: impl Fn(u32) -> bool,
+        on_side: impl Fn(u32) -> bool,
     ) -> Option<(u32, PointProjection, TrianglePointLocation)> {
         // A node at or beyond the best distance is not entered anyway: the filter test is
         // only needed nearer.
         let cost = |n: &Node, best: f32| -> f32 {
             let d = n.aabb.distance_to_local_point(point, true);
-            if d < best && n.rejects(bit, normal) {
+            if d < best && n.rejects(bit, if d <= free { None } else { normal }) {
                 f32::MAX
             } else {
                 d
             }
         };
         let leaf = |tri: u32| -> Option<(f32, (PointProjection, TrianglePointLocation))> {
-            if !allowed(tri) {
+            let full = allowed(tri);
+            if !full && !(free > 0.0 && on_side(tri)) {
                 return None;
             }
             let proj = mesh
                 .triangle(tri)
                 .project_local_point_and_get_location(point, false);
-            Some(((proj.0.point - point).length(), proj))
+            let d = (proj.0.point - point).length();
+            (full || d <= free).then_some((d, proj))
         };
         let mut stack: Vec<u32> = Vec::with_capacity(32);
         let mut best: Option<(PointProjection, TrianglePointLocation)> = None;
@@ -396,11 +407,34 @@ mod tests {
             let pp = PVec::new(p.x, p.y, p.z);
             let want =
                 CompositeShapeRef(&view).project_local_point_and_get_location(pp, max, false);
-            let got = tree.closest(&mesh, pp, max, bit, normal.as_ref(), allowed);
+            let got = tree.closest(&mesh, pp, max, 0.0, bit, normal.as_ref(), allowed, |_| {
+                false
+            });
             assert_eq!(
                 want.map(|w| (w.0, w.1.point)),
                 got.map(|g| (g.0, g.1.point)),
                 "query {q}"
+            );
+            // With the normal test waived near the point: the side's nearest point when it
+            // lies that near, else the filtered search's answer.
+            let on_side = |i: u32| mask_passes(masks[i as usize], bit);
+            let free = [0.02, 0.1, 0.4][q as usize % 3];
+            let side = FilteredTriMesh {
+                mesh: &mesh,
+                allowed: on_side,
+            };
+            let near = CompositeShapeRef(&side)
+                .project_local_point_and_get_location(pp, free * 1.001, false)
+                .filter(|h| (h.1.point - pp).length() <= free);
+            let max = max.max(free);
+            let want = near.or_else(|| {
+                CompositeShapeRef(&view).project_local_point_and_get_location(pp, max, false)
+            });
+            let got = tree.closest(&mesh, pp, max, free, bit, normal.as_ref(), allowed, on_side);
+            assert_eq!(
+                want.map(|w| (w.0, w.1.point)),
+                got.map(|g| (g.0, g.1.point)),
+                "query {q}, free {free}"
             );
         }
         // `any` answers what a scan answers.

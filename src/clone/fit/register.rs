@@ -147,6 +147,10 @@ pub(crate) fn register(
     let mut reach = limit;
     // Each vertex's last matched triangle: its distance bounds the next search.
     let mut previous: Vec<Option<u32>> = vec![None; n];
+    // Searches run in a spatial order of the vertices: queries one after the other walk the
+    // same part of the tree (the vertex order may scatter them, module docs of
+    // [`crate::mesh::morton`]).
+    let order = crate::mesh::morton::morton_order(m.positions);
     let (mut matched, mut mean_gap) = (0.0, 0.0);
     for &alpha in &opts.stiffness {
         for _ in 0..opts.iterations.max(1) {
@@ -163,8 +167,14 @@ pub(crate) fn register(
                     previous[i],
                 )
             };
-            let mut hits: Vec<Option<(Vec3, f32, u32)>> =
-                (0..n).into_par_iter().map(|i| search(i, reach)).collect();
+            let found: Vec<Option<(Vec3, f32, u32)>> = order
+                .par_iter()
+                .map(|&i| search(i as usize, reach))
+                .collect();
+            let mut hits: Vec<Option<(Vec3, f32, u32)>> = vec![None; n];
+            for (&i, h) in order.iter().zip(found) {
+                hits[i as usize] = h;
+            }
             // Outliers: farther than the limit, or than a few times the typical gap.
             let (median, mut cut) = outlier_cut(&hits, limit);
             if reach < limit && (median > reach || cut > reach) {
@@ -241,10 +251,10 @@ struct Bounds {
 /// compatible point lies within `b.reach` (an outlier that still counts in the median gap),
 /// or `None` (no match at all, or a hit on the fixed surface's border).
 ///
-/// The nearest point of the side comes first, searched only within the snap distance (a
+/// The nearest point of the side comes first when it lies within the snap distance (a
 /// point on the surface matches there, whatever a crease's normals say); otherwise the
-/// nearest normal-compatible point, searched only within `b.reach` and within the distance
-/// to `previous`, the triangle matched in the step before, when the filter still allows it
+/// nearest normal-compatible point (both in one search), searched only within `b.reach` and
+/// within the distance to `previous`, the triangle matched in the step before, when the filter still allows it
 /// (the nearest point is no farther than that triangle). The bounds keep the BVH from
 /// scanning the fixed surface for triangles the normal filter rejects.
 fn match_point(
@@ -262,21 +272,18 @@ fn match_point(
     };
     let h = if nrm == Vec3::ZERO {
         fixed.closest(x, plain)?
-    } else if let Some(h) = fixed
-        .closest_within(x, plain, b.snap * 1.001)
-        .filter(|h| h.point.distance(x) <= b.snap)
-    {
-        h
     } else {
         let oriented = Filter {
             bit,
             normal: Some((nrm, b.cos)),
             crease: None,
         };
+        // The previous triangle bounds the compatible point, and the nearest point of the
+        // side too (within the snap distance it wins, whatever its normal).
         let warm = previous
             .and_then(|t| fixed.distance_to(x, oriented, t))
             .map_or(f32::INFINITY, |d| d * 1.0001 + 0.01 * b.snap);
-        match fixed.closest_within(x, oriented, warm.min(b.reach * 1.001)) {
+        match fixed.closest_snapping(x, oriented, b.snap, warm.min(b.reach * 1.001)) {
             Some(h) => h,
             None => return Some((x, f32::INFINITY, u32::MAX)),
         }

@@ -137,21 +137,69 @@ impl QuerySurface {
     /// bound prunes the BVH search: a query whose nearby triangles the filter rejects stops
     /// at `max_dist` instead of searching the whole surface.
     pub fn closest_within(&self, p: Vec3, filter: Filter, max_dist: f32) -> Option<Hit> {
+        self.closest_snapping(p, filter, 0.0, max_dist)
+    }
+
+    /// The closest point to `p` of the filter's side when it lies within `snap` of `p`
+    /// (whatever the normals: a point on the surface matches there), else the closest point
+    /// the whole filter allows nearer than `max_dist` (at least `snap`). One walk of the
+    /// tree: the answer of a search of the side within `snap` followed by
+    /// [`closest_within`](Self::closest_within).
+    pub fn closest_snapping(
+        &self,
+        p: Vec3,
+        filter: Filter,
+        snap: f32,
+        max_dist: f32,
+    ) -> Option<Hit> {
         let mesh = self.mesh.as_ref()?;
         if !p.is_finite() {
             return None;
         }
         let allowed = |i| self.allowed(filter, i);
+        let plain = Filter {
+            normal: None,
+            crease: None,
+            ..filter
+        };
+        let on_side = |i| self.allowed(plain, i);
         let q = PVec::new(p.x, p.y, p.z);
+        let max_dist = if snap > 0.0 {
+            max_dist.max(snap)
+        } else {
+            max_dist
+        };
         let (tri, proj, _) = match &self.tree {
             Some(tree) => {
                 let normal = filter
                     .normal
                     .map(|(n, c)| NormalTest::new(n, filter.crease, c));
-                tree.closest(mesh, q, max_dist, filter.bit, normal.as_ref(), allowed)?
+                tree.closest(
+                    mesh,
+                    q,
+                    max_dist,
+                    snap,
+                    filter.bit,
+                    normal.as_ref(),
+                    allowed,
+                    on_side,
+                )?
             }
-            None => CompositeShapeRef(&FilteredTriMesh { mesh, allowed })
-                .project_local_point_and_get_location(q, max_dist, false)?,
+            None => {
+                let side = CompositeShapeRef(&FilteredTriMesh {
+                    mesh,
+                    allowed: on_side,
+                });
+                let near = (snap > 0.0)
+                    .then(|| side.project_local_point_and_get_location(q, snap * 1.001, false))
+                    .flatten()
+                    .filter(|h| (h.1.point - q).length() <= snap);
+                match near {
+                    Some(h) => h,
+                    None => CompositeShapeRef(&FilteredTriMesh { mesh, allowed })
+                        .project_local_point_and_get_location(q, max_dist, false)?,
+                }
+            }
         };
         let point = Vec3::new(proj.point.x, proj.point.y, proj.point.z);
         let t = self.triangles.get(tri as usize)?;
