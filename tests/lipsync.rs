@@ -558,7 +558,10 @@ fn hostile_compressed_files_exit_2_naming_the_file_and_write_nothing() {
 /// below what was measured. Recognising words rather than phones
 /// (`speech::lipsync::words`) was measured on the whole evaluation and was no better here.
 // Measured on this subset (3 Festival conditions × 4 sentences, the phone loop): closures
-// 0.333 (26/78), agreement 0.537, false closures 0.011; 19 s in release.
+// 0.333 (26/78), agreement 0.537, false closures 0.011; 19 s in release. With the empty top
+// band of the 8 kHz voice mirrored before recognition (`speech::lipsync::enhance`): 0.513
+// (40/78), 0.597, 0.014 (35 s in release on a loaded machine); the bounds now fail on the
+// figures before it.
 #[test]
 fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
     let name = "without_a_transcript_the_figures_hold_on_real_speakers_voices";
@@ -609,6 +612,6 @@ fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
     );
 }
 
-const FESTIVAL_RECOGNISED_CLOSURES: f64 = 0.28;
-const FESTIVAL_RECOGNISED_AGREEMENT: f64 = 0.50;
+const FESTIVAL_RECOGNISED_CLOSURES: f64 = 0.46;
+const FESTIVAL_RECOGNISED_AGREEMENT: f64 = 0.57;
 const FESTIVAL_RECOGNISED_FALSE: f64 = 0.025;
