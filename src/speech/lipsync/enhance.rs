@@ -16,7 +16,8 @@
 //! - The top band mirrored for audio sampled below 16 kHz (at 0.95 of its Nyquist
 //!   frequency, half the amplitude): 58.7 / 68.9 / 3.2 | 56.6 / 65.2 / 1.5 | unchanged
 //!   (Festival ked at 8 kHz 18.4 / 42.2 / 1.2 → 67.3 / 63.6 / 2.1). The recogniser's default
-//!   ([`super::recognition`]).
+//!   ([`super::recognition`]). It also puts more PP on other consonants (espeak-ng's 8 kHz
+//!   voice 12.9 → 17.0 %; all espeak-ng voices 10.9 → 12.0 %, Festival's 12.1 → 13.5 %).
 //! - Noise reduced, gain floor 0.1 (−20 dB): 54.1 / 58.7 / 2.4 | 58.2 / 65.2 / 1.5 | 83.0 /
 //!   80.1 / 3.7; floor 0.3: 58.2 / 61.7 / 2.9 | 56.1 / 62.5 / 1.8 | 85.7 / 79.8 / 4.0. Festival's
 //!   noisy voices gain (slt at 15 dB closures 26.5 → 53.1 %) but espeak-ng's lose up to 13
