@@ -287,9 +287,8 @@ fn without_a_transcript_english_phones_are_recognised() {
 // with PocketSphinx's phones alone to 53 %, and 58 % with the f's and v's. With the empty
 // top band of 8 kHz audio mirrored before recognition (`speech::lipsync::enhance`): 0.526,
 // 0.652–0.669, 0.031–0.032, 0.157–0.165 beside the file's other no-transcript tests (two
-// runs); the mirror puts more PP
-// on the 8 kHz voice's other consonants (whole evaluation, that voice: 12.9 → 17.0 %, its
-// agreement 54.7 → 63.2 %), so that bound went 0.14 → 0.18.
+// runs); the mirror puts more PP on the 8 kHz voice's other consonants (whole evaluation,
+// that voice: 12.9 → 17.0 %, its agreement 54.7 → 63.2 %), so that bound went 0.14 → 0.18.
 const BOUND_CLOSURES: f64 = 0.33;
 const BOUND_AGREEMENT: f64 = 0.55;
 const BOUND_FALSE: f64 = 0.035;
