@@ -184,6 +184,45 @@ pub fn conditions() -> Vec<Condition> {
     ]
 }
 
+/// Clean real-speaker conditions (Festival voices, no noise, 16 kHz mono): the held-out
+/// check is clean read speech, so these are reported on their own, apart from the degraded
+/// conditions' totals.
+pub fn clean_conditions() -> Vec<Condition> {
+    let clean = |seed| Degradation {
+        sample_rate: 16_000,
+        channels: 1,
+        snr_db: None,
+        lead_in: 0.3,
+        seed,
+    };
+    vec![
+        Condition {
+            name: "Festival kal (diphone), 16 kHz, clean",
+            synth: Synth::Festival,
+            voice: "kal_diphone",
+            rate: 0,
+            degradation: clean(21),
+            mp3: false,
+        },
+        Condition {
+            name: "Festival slt (HTS), 16 kHz, clean",
+            synth: Synth::Festival,
+            voice: "cmu_us_slt_arctic_hts",
+            rate: 0,
+            degradation: clean(22),
+            mp3: false,
+        },
+        Condition {
+            name: "Festival ked (diphone), 16 kHz, clean",
+            synth: Synth::Festival,
+            voice: "ked_diphone",
+            rate: 0,
+            degradation: clean(23),
+            mp3: false,
+        },
+    ]
+}
+
 /// Whether Festival and its voice `voice` are installed.
 pub fn festival_voice_available(voice: &str) -> bool {
     festival_run(&format!("(voice_{voice})\n(format t \"ready\\n\")\n"))
@@ -621,6 +660,92 @@ fn long_main(seconds: f64) {
     );
 }
 
+/// The figures without a transcript only (`LIPSYNC_EVAL_NOSCRIPT_ONLY=1`): every condition,
+/// the clean Festival ones apart, with the CPU time of the recognition (this process and
+/// the recogniser's).
+fn noscript_main() {
+    let have_ffmpeg = ffmpeg_available();
+    let mut groups: [(&str, Totals); 3] = [
+        ("all espeak-ng conditions", Totals::default()),
+        ("all Festival conditions", Totals::default()),
+        ("clean Festival conditions", Totals::default()),
+    ];
+    let all: Vec<(usize, Condition)> = conditions()
+        .into_iter()
+        .map(|c| (if c.synth == Synth::Espeak { 0 } else { 1 }, c))
+        .chain(clean_conditions().into_iter().map(|c| (2, c)))
+        .collect();
+    for (group, c) in all {
+        if (c.mp3 && !have_ffmpeg)
+            || (c.synth == Synth::Festival && !festival_voice_available(c.voice))
+        {
+            println!(
+                "{}: skipped (ffmpeg, Festival or its voice is missing)",
+                c.name
+            );
+            continue;
+        }
+        let mut sum = Totals::default();
+        for text in SENTENCES {
+            let made = make_recording(text, &c);
+            let Ok((_dir, path, truth)) = made else {
+                println!("  {text}: {:?}", made.err());
+                continue;
+            };
+            let before = cpu_seconds();
+            let result = (|| {
+                let rec = analyse_file(&path, &mut |_| {})?;
+                let phones = recognise_file_with(&path, recogniser(), &mut |_| {})?;
+                let sync = lipsync_recognised(&rec, phones, 25.0)?;
+                Ok::<_, fbakit::error::Error>((
+                    rec.seconds,
+                    score(&truth, &frames_of(&sync.keys, rec.seconds, 25.0), 25.0),
+                ))
+            })();
+            match result {
+                Ok((seconds, s)) => {
+                    sum.recognised.add(&s);
+                    sum.aligned.add(&s);
+                    sum.audio += seconds;
+                    sum.work_recognised += cpu_seconds() - before;
+                    if std::env::var_os("VERBOSE").is_some() {
+                        line(text, &s);
+                    }
+                }
+                Err(e) => println!("  {text}: {e}"),
+            }
+        }
+        println!("{}", c.name);
+        line("recognised", &sum.recognised);
+        groups[group].1.add(&sum);
+    }
+    for (name, t) in &groups {
+        println!("{name}");
+        line("recognised", &t.recognised);
+        println!(
+            "  {:.1} s of audio in {:.2} s of CPU: {:.1}x real time",
+            t.audio,
+            t.work_recognised,
+            t.audio / t.work_recognised.max(1e-9)
+        );
+    }
+}
+
+/// CPU seconds used so far by this process and its waited-for children (the recogniser),
+/// from `/proc/self/stat` (clock ticks of 10 ms); 0 where there is none.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // After the command name in parentheses: state is field 3, utime..cstime fields 14..17.
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .skip(11)
+        .take(4)
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    f.iter().sum::<f64>() / 100.0
+}
+
 fn line(name: &str, s: &LipsyncScore) {
     println!(
         "  {name:<10} closures {:>5.1} % ({}/{})  agreement {:>5.1} %  false closures {:>4.1} %  ({} speech frames; PP on other consonants {:>4.1} %)",
@@ -679,6 +804,10 @@ fn main() {
         .and_then(|s| s.parse::<f64>().ok())
     {
         long_main(seconds);
+        return;
+    }
+    if std::env::var_os("LIPSYNC_EVAL_NOSCRIPT_ONLY").is_some() {
+        noscript_main();
         return;
     }
     // LIPSYNC_EVAL_TRANSCRIPT_ONLY skips the (slow) figures without a transcript.

@@ -284,11 +284,15 @@ fn without_a_transcript_english_phones_are_recognised() {
 // alone; 0.410, 0.583, 0.027, 0.112 beside the other tests of this file (espeak-ng's
 // renditions then differ a little: its engine is shared). Before the heard f's and v's:
 // 0.410, 0.600, 0.027, 0.091 alone. On the whole evaluation the closures shown went from 26 %
-// with PocketSphinx's phones alone to 53 %, and 58 % with the f's and v's.
+// with PocketSphinx's phones alone to 53 %, and 58 % with the f's and v's. With the empty
+// top band of 8 kHz audio mirrored before recognition (`speech::lipsync::enhance`): 0.526,
+// 0.652–0.669, 0.031–0.032, 0.157–0.165 beside the file's other no-transcript tests (two
+// runs); the mirror puts more PP on the 8 kHz voice's other consonants (whole evaluation,
+// that voice: 12.9 → 17.0 %, its agreement 54.7 → 63.2 %), so that bound went 0.14 → 0.18.
 const BOUND_CLOSURES: f64 = 0.33;
 const BOUND_AGREEMENT: f64 = 0.55;
 const BOUND_FALSE: f64 = 0.035;
-const BOUND_CONSONANT: f64 = 0.14;
+const BOUND_CONSONANT: f64 = 0.18;
 
 #[test]
 fn without_a_transcript_the_figures_hold() {
@@ -558,7 +562,10 @@ fn hostile_compressed_files_exit_2_naming_the_file_and_write_nothing() {
 /// below what was measured. Recognising words rather than phones
 /// (`speech::lipsync::words`) was measured on the whole evaluation and was no better here.
 // Measured on this subset (3 Festival conditions × 4 sentences, the phone loop): closures
-// 0.333 (26/78), agreement 0.537, false closures 0.011; 19 s in release.
+// 0.333 (26/78), agreement 0.537, false closures 0.011; 19 s in release. With the empty top
+// band of the 8 kHz voice mirrored before recognition (`speech::lipsync::enhance`): 0.513
+// (40/78), 0.597, 0.014 (35 s in release on a loaded machine); the bounds now fail on the
+// figures before it.
 #[test]
 fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
     let name = "without_a_transcript_the_figures_hold_on_real_speakers_voices";
@@ -609,6 +616,6 @@ fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
     );
 }
 
-const FESTIVAL_RECOGNISED_CLOSURES: f64 = 0.28;
-const FESTIVAL_RECOGNISED_AGREEMENT: f64 = 0.50;
+const FESTIVAL_RECOGNISED_CLOSURES: f64 = 0.46;
+const FESTIVAL_RECOGNISED_AGREEMENT: f64 = 0.57;
 const FESTIVAL_RECOGNISED_FALSE: f64 = 0.025;

@@ -243,14 +243,14 @@ pub fn normalise(frames: &[FeatureFrame]) -> Vec<[f32; CEPS - 1]> {
 
 /// An in-place radix-2 complex FFT of a fixed power-of-two size.
 #[derive(Clone, Debug)]
-struct Fft {
+pub(super) struct Fft {
     n: usize,
     cos: Vec<f32>,
     sin: Vec<f32>,
 }
 
 impl Fft {
-    fn new(n: usize) -> Fft {
+    pub(super) fn new(n: usize) -> Fft {
         let cos = (0..n / 2)
             .map(|k| (2.0 * std::f64::consts::PI * k as f64 / n as f64).cos() as f32)
             .collect();
@@ -260,7 +260,7 @@ impl Fft {
         Fft { n, cos, sin }
     }
 
-    fn run(&self, re: &mut [f32], im: &mut [f32]) {
+    pub(super) fn run(&self, re: &mut [f32], im: &mut [f32]) {
         let n = self.n;
         let bits = n.trailing_zeros();
         for i in 0..n {

@@ -27,7 +27,8 @@
 //! time on a 24 s recording, 76× → 16× on 97 s (the warp still runs, for the confidence).
 //!
 //! Without a transcript (English only), PocketSphinx recognises the phones
-//! ([`recognition`]) and [`closures`] adds the lip closures the sound shows that the phones
+//! ([`recognition`]; audio sampled below 16 kHz has its empty top band filled first,
+//! [`enhance`]) and [`closures`] adds the lip closures the sound shows that the phones
 //! miss ([`lipsync_recognised`]). Recognising words instead ([`words`]) was measured and is
 //! no better on the evaluation, and slower.
 //!
@@ -48,6 +49,7 @@ pub mod activity;
 pub mod alignment;
 pub mod closures;
 pub mod coarticulation;
+pub mod enhance;
 pub mod evaluation;
 pub mod features;
 pub mod forced;
