@@ -227,7 +227,8 @@ impl FilterTree {
         };
         let leaf = |tri: u32| -> Option<(f32, (PointProjection, TrianglePointLocation))> {
             let full = allowed(tri);
-            if !full && !(free > 0.0 && on_side(tri)) {
+            // Neither normal-compatible nor a candidate for the snap on the point's side.
+            if !(full || (free > 0.0 && on_side(tri))) {
                 return None;
             }
             let proj = mesh
