@@ -23,7 +23,11 @@
 //!    polygon by polygon when one piece holds several parts' points. A mesh holding no
 //!    feature point whose every piece lies on an eyeball (within 1.3 radii of the centre of
 //!    the piece holding a pupil: VRoid's iris and highlight layers) is cut the same way, each
-//!    piece to the eye it lies on, so the layers turn with their eyeballs. Each eye then turns
+//!    piece to the eye it lies on, so the layers turn with their eyeballs — unless a piece's
+//!    rim rests on the lids (an eye occlusion shell, a lacrimal film), which stays with the
+//!    skin. A mesh without feature points behind the lips whose rows lie on either side of
+//!    the lip line is cut by rows, and gums joined to a tongue in a mesh of their own (open,
+//!    running back along the jaws) along the line, as in a one-mesh head. Each eye then turns
 //!    about its own centre and the lower row follows the jaw; step 9 folds them back.
 //!    With `fit`, a target that is one mesh with the source's only skin mesh (the same
 //!    vertex count and polygons, but for a few quads split along the other diagonal: another
@@ -43,8 +47,9 @@
 //!    (within 1e-6 of the face's size) so seams do not cut the surface — except, inside the
 //!    mouth box (between the lip corners, ±0.35 MNS0 around the lip line), a closed mouth's
 //!    upper and lower lip vertices, which coincide and must stay apart: there duplicates are
-//!    welded unless one's polygons lie all above it and the other's all below (a seam down
-//!    the lips or a skin / mouth primitive border is welded, the slit is not). A target that is one
+//!    welded unless one's polygons lie all above it and the other's all below, or they come
+//!    from different meshes (a seam down the lips or a skin / mouth primitive border, such as
+//!    ICT's lips on its mouth socket, is welded; the slit within one mesh is not). A target that is one
 //!    mesh with the source (same vertex counts and polygons) is welded exactly as the source
 //!    ([`build_skin_surface_like`]). Results on a welded vertex go back to every duplicate that
 //!    is a corner of some polygon: a vertex in no polygon is invisible and never moves
