@@ -122,6 +122,22 @@ impl Landmarks {
         })
     }
 
+    /// The jaw a polygon of a piece cut along the lip line goes to: by the side of the lip
+    /// line its mean height lies on.
+    fn jaw_of(&self, poly: &[u32], world: &[Vec3]) -> Part {
+        let y = poly
+            .iter()
+            .filter_map(|&v| world.get(v as usize))
+            .map(|p| p.y)
+            .sum::<f32>()
+            / poly.len() as f32;
+        if y > self.lip_y {
+            Part::UpperTeeth
+        } else {
+            Part::LowerTeeth
+        }
+    }
+
     /// Eyeball: a roughly spherical piece (distance to its centroid varying < 35 %) whose
     /// centroid is within 0.4 ES0 of a pupil. Mouth: a piece centred between the lip corners,
     /// within 1.5 MNS0 of the lip line and behind the lips: teeth or gums, by side of the lip
@@ -273,19 +289,7 @@ fn chin_plan(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Option<CutPlan
         let part = match fates[k] {
             Fate::Skin => None,
             Fate::Part(p) => Some(p),
-            Fate::Jaws => {
-                let y = poly
-                    .iter()
-                    .filter_map(|&v| world.get(v as usize))
-                    .map(|p| p.y)
-                    .sum::<f32>()
-                    / poly.len() as f32;
-                Some(if y > lm.lip_y {
-                    Part::UpperTeeth
-                } else {
-                    Part::LowerTeeth
-                })
-            }
+            Fate::Jaws => Some(lm.jaw_of(poly, &world)),
         };
         if let Some(p) = part {
             pieces.entry(p).or_default().insert(k);
@@ -537,19 +541,7 @@ fn teeth_row_plans(
             let Some(&k) = poly.first().and_then(|&v| piece.get(v as usize)) else {
                 continue;
             };
-            let row = rows[k].unwrap_or_else(|| {
-                let y = poly
-                    .iter()
-                    .filter_map(|&v| world.get(v as usize))
-                    .map(|p| p.y)
-                    .sum::<f32>()
-                    / poly.len() as f32;
-                if y > lm.lip_y {
-                    Part::UpperTeeth
-                } else {
-                    Part::LowerTeeth
-                }
-            });
+            let row = rows[k].unwrap_or_else(|| lm.jaw_of(poly, &world));
             pieces.entry(row).or_default().insert(k);
             dest.entry(Some(row)).or_default().push(pi);
         }
