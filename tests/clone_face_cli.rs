@@ -51,6 +51,25 @@ fn clone_writes_a_face_and_reports() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
+    // A face without any feature points: exit 2 saying what to give, nothing written.
+    let bare = dir.path().join("bare.wrl");
+    let mut none = fbakit::synth::bruno().to_face_model();
+    none.fat = Default::default();
+    none.feature_points = Default::default();
+    write_face_file(&bare, &none).unwrap();
+    let fresh = dir.path().join("fresh.wrl");
+    let o = fbakit()
+        .args(["clone", a.to_str().unwrap(), bare.to_str().unwrap(), "-o"])
+        .arg(&fresh)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("bare.wrl: the face has no feature points") && err.contains("--fp-target"),
+        "{err}"
+    );
+    assert!(!fresh.exists());
     let o = fbakit().args(["clone", "--help"]).output().unwrap();
     assert!(String::from_utf8_lossy(&o.stdout).contains("Examples"));
 }

@@ -230,7 +230,17 @@ fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
             path.display()
         )));
     }
-    super::inputs::read_face(path, fp)
+    let face = super::inputs::read_face(path, fp)?;
+    // A glTF or VRML face without feature points would fail later as "no skin mesh";
+    // say what is missing and how to give it.
+    if fp.is_none() && face.feature_points.iter().len() == 0 {
+        return Err(Error::Usage(format!(
+            "{}: the face has no feature points; give them with --fp-source, --fp-target, --fp-truth or --fp FILE \
+             (CSV `fp,x,y,z` or vertex ids, or the XML; `fbakit fp from-landmarks` makes one)",
+            path.display()
+        )));
+    }
+    Ok(face)
 }
 
 fn bar(steps: u64) -> ProgressBar {
