@@ -134,6 +134,11 @@ pub fn lipsync_keys(
     }
     keys.sort_by(|x, y| x.time.total_cmp(&y.time));
     quick_closure_edges(&mut keys, &closures, frame);
+    let mut keys = merge_close_keys(keys, frame);
+    // Merging drops a shape closer than a frame to a closure, which leaves a blend from PP
+    // to the key beyond it, two frames or more away: half of that gap showed PP on the
+    // vowel there. The edges are set again against what is left.
+    quick_closure_edges(&mut keys, &closures, frame);
     (merge_close_keys(keys, frame), unmapped)
 }
 
@@ -345,6 +350,23 @@ mod tests {
             .collect();
         assert!(!pp.is_empty(), "{shown:?}");
         assert!(pp.iter().all(|t| (0.36..=0.52).contains(t)), "{shown:?}");
+    }
+
+    #[test]
+    fn a_vowel_merged_away_beside_a_closure_does_not_leave_it_pp() {
+        // A short p, then a one-frame vowel (its key falls within a frame of the closure's
+        // and is merged away) and an r: PP on the p's frame only, not on the vowel's.
+        let ph = vec![
+            p("A:", 0.9, 1.062),
+            p("p", 1.062, 1.09),
+            p("E", 1.09, 1.13),
+            p("r", 1.13, 1.19),
+            p("A:", 1.19, 1.5),
+        ];
+        let (keys, _) = lipsync_keys(&ph, 1.5, &[], 25.0);
+        let shown: Vec<u8> = (0..38).map(|n| dominant_at(&keys, n, 25.0)).collect();
+        assert_eq!(shown[27], 1, "{shown:?}");
+        assert!(shown[28] != 1 && shown[26] != 1, "{shown:?}");
     }
 
     #[test]
