@@ -60,6 +60,15 @@
 //! keys they pass all three (86.4 / 80.1 / 2.5 %), and espeak-ng's voices measure 2.0 %.
 //! Noise reduction before the recogniser: see [`super::enhance`].
 //!
+//! Speed, CPU time of `fbakit lipsync REC.wav -o out.fap` and the recogniser on one core
+//! (`taskset -c 0`, `/usr/bin/time`, a loaded machine), Festival kal: 4.8 s at 16 kHz 0.31 s
+//! (15×), 154 s 6.8–7.0 s (22×); at 44.1 kHz stereo 0.49 s (9.7×) and 12.1 s (12.7×) before
+//! the resampler's kernel was tabulated ([`crate::speech::audio`]; its sine and cosine per tap
+//! were ~39 % of the CPU), 0.34 s (14×) and 7.4–7.8 s (20×) since. The recogniser's start-up
+//! (model load) is ~0.1 s of it, ~0.045 s per second of audio the rest, so files shorter than
+//! about 2 s miss 10× on that alone. It already runs once per piece of up to
+//! [`SEGMENT_SECONDS`], not per sentence. Max RSS 37–38 MB (the recogniser's).
+//!
 //! The phone lattice (for phone posteriors) is not available: `pocketsphinx_batch
 //! -outlatdir` gives none for the phone-loop search (`-allphone`).
 
