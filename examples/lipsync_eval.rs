@@ -675,6 +675,8 @@ fn noscript_main() {
         .map(|c| (if c.synth == Synth::Espeak { 0 } else { 1 }, c))
         .chain(clean_conditions().into_iter().map(|c| (2, c)))
         .collect();
+    let tracing = std::env::var_os("LIPSYNC_EVAL_TRACE").is_some();
+    let mut traces = [FalseClosureTrace::default(); 3];
     for (group, c) in all {
         if (c.mp3 && !have_ffmpeg)
             || (c.synth == Synth::Festival && !festival_voice_available(c.voice))
@@ -686,6 +688,7 @@ fn noscript_main() {
             continue;
         }
         let mut sum = Totals::default();
+        let mut trace = FalseClosureTrace::default();
         for text in SENTENCES {
             let made = make_recording(text, &c);
             let Ok((_dir, path, truth)) = made else {
@@ -696,11 +699,13 @@ fn noscript_main() {
             let result = (|| {
                 let rec = analyse_file(&path, &mut |_| {})?;
                 let phones = recognise_file_with(&path, recogniser(), &mut |_| {})?;
-                let sync = lipsync_recognised(&rec, phones, 25.0)?;
-                Ok::<_, fbakit::error::Error>((
-                    rec.seconds,
-                    score(&truth, &frames_of(&sync.keys, rec.seconds, 25.0), 25.0),
-                ))
+                let sync = lipsync_recognised(&rec, phones.clone(), 25.0)?;
+                let frames = frames_of(&sync.keys, rec.seconds, 25.0);
+                if tracing {
+                    let t = trace_false_closures(&truth, &rec, &phones, &sync, &frames, 25.0);
+                    trace.add(&t);
+                }
+                Ok::<_, fbakit::error::Error>((rec.seconds, score(&truth, &frames, 25.0)))
             })();
             match result {
                 Ok((seconds, s)) => {
@@ -717,11 +722,18 @@ fn noscript_main() {
         }
         println!("{}", c.name);
         line("recognised", &sum.recognised);
+        if tracing {
+            trace.print();
+            traces[group].add(&trace);
+        }
         groups[group].1.add(&sum);
     }
-    for (name, t) in &groups {
+    for (k, (name, t)) in groups.iter().enumerate() {
         println!("{name}");
         line("recognised", &t.recognised);
+        if tracing {
+            traces[k].print();
+        }
         println!(
             "  {:.1} s of audio in {:.2} s of CPU: {:.1}x real time",
             t.audio,
@@ -729,6 +741,162 @@ fn noscript_main() {
             t.audio / t.work_recognised.max(1e-9)
         );
     }
+}
+
+/// Where a stream's closure came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClosureOrigin {
+    /// An m, b or p the recogniser heard.
+    Heard = 0,
+    /// A dark dip in the high-frequency energy (`closures::acoustic_closures`).
+    Dip = 1,
+    /// An f or v heard on a deep gap (`closures::fricative_closures`).
+    Fricative = 2,
+}
+
+/// The false closures of streams (PP on frames of open or rounded vowels) by what put them
+/// there (`LIPSYNC_EVAL_TRACE=1`; `=2` also prints each): `[origin][where][near]`, where is
+/// 0 on a frame the closure holds (between its PP keys) and 1 on a frame the blend into the
+/// next shape leaves PP (spread), near is 1 when a real m/b/p lies within ±40 ms (the
+/// closure is real but a frame off), 0 when none does.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FalseClosureTrace {
+    /// Counts as described above.
+    pub frames: [[[usize; 2]; 2]; 3],
+    /// Of the held frames, those whose closure phone is longer than 60 ms.
+    pub long_phone: usize,
+}
+
+impl FalseClosureTrace {
+    fn add(&mut self, o: &FalseClosureTrace) {
+        for (a, b) in self
+            .frames
+            .iter_mut()
+            .flatten()
+            .zip(o.frames.iter().flatten())
+        {
+            a[0] += b[0];
+            a[1] += b[1];
+        }
+        self.long_phone += o.long_phone;
+    }
+
+    fn print(&self) {
+        let total: usize = self.frames.iter().flatten().flatten().sum();
+        let f = |o: usize, w: usize| {
+            let [far, near] = self.frames[o][w];
+            format!("{} ({} near a real one)", far + near, near)
+        };
+        println!(
+            "  false closure frames {total}: heard m/b/p held {}, spread {}; dip held {}, spread {}; f/v held {}, spread {}; held from a phone > 60 ms {}",
+            f(0, 0), f(0, 1), f(1, 0), f(1, 1), f(2, 0), f(2, 1), self.long_phone
+        );
+    }
+}
+
+/// Traces the false closures of `frames` (the stream of `sync`, made from the recogniser's
+/// `heard` phones and the recording `rec`) against `truth`.
+pub fn trace_false_closures(
+    truth: &[TimedPhoneme],
+    rec: &fbakit::speech::lipsync::RecordingAnalysis,
+    heard: &[fbakit::speech::lipsync::AlignedPhone],
+    sync: &fbakit::speech::lipsync::Lipsync,
+    frames: &[VisemeParams],
+    fps: f64,
+) -> FalseClosureTrace {
+    use fbakit::speech::lipsync::closures::{acoustic_closures, fricative_closures};
+    use fbakit::speech::lipsync::coarticulation::{dominant, is_closure, MouthClass};
+    let dips = acoustic_closures(&rec.frames, heard);
+    let fricatives = fricative_closures(&rec.frames, heard, &rec.activity.silences, &dips);
+    let origin = |p: &fbakit::speech::lipsync::AlignedPhone| {
+        let mid = 0.5 * (p.start + p.end);
+        let at = |ts: &[f64]| ts.iter().any(|&t| (t - mid).abs() < 1e-6);
+        if p.symbol == "B" && at(&dips) {
+            ClosureOrigin::Dip
+        } else if p.symbol == "B" && at(&fricatives) {
+            ClosureOrigin::Fricative
+        } else {
+            ClosureOrigin::Heard
+        }
+    };
+    let closures: Vec<&fbakit::speech::lipsync::AlignedPhone> = sync
+        .phones
+        .iter()
+        .filter(|p| is_closure(arpabet_to_espeak(&p.symbol)))
+        .collect();
+    // The spans the closures hold: runs of PP keys.
+    let mut held: Vec<(f64, f64)> = Vec::new();
+    let mut run: Option<(f64, f64)> = None;
+    for k in &sync.keys {
+        if k.viseme.number() == 1 {
+            run = Some(run.map_or((k.time, k.time), |(a, _)| (a, k.time)));
+        } else if let Some(r) = run.take() {
+            held.push(r);
+        }
+    }
+    held.extend(run);
+    let mut out = FalseClosureTrace::default();
+    for (n, f) in frames.iter().enumerate() {
+        let t = n as f64 / fps;
+        if dominant(f).number() != 1 {
+            continue;
+        }
+        let Some(p) = truth.iter().find(|p| p.start <= t && t < p.end) else {
+            continue;
+        };
+        let class = match fbakit::speech::phonemes::PhonemeVisemeTable::standard().lookup(&p.symbol)
+        {
+            Some(fbakit::speech::phonemes::VisemeTarget::Single(v)) => MouthClass::of(v),
+            Some(fbakit::speech::phonemes::VisemeTarget::Glide(a, b)) => {
+                MouthClass::of(if t - p.start < 0.5 * (p.end - p.start) {
+                    a
+                } else {
+                    b
+                })
+            }
+            _ => continue,
+        };
+        if !matches!(class, MouthClass::Open | MouthClass::Rounded) {
+            continue;
+        }
+        let distance =
+            |q: &fbakit::speech::lipsync::AlignedPhone| (q.start - t).max(t - q.end).max(0.0);
+        let Some(c) = closures
+            .iter()
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+        else {
+            continue;
+        };
+        let inside = held.iter().any(|&(a, b)| a - 1e-6 <= t && t <= b + 1e-6);
+        let near = truth
+            .iter()
+            .any(|q| is_closure(&q.symbol) && q.start - 0.04 <= t && t <= q.end + 0.04);
+        let o = origin(c);
+        out.frames[o as usize][usize::from(!inside)][usize::from(near)] += 1;
+        if inside && c.end - c.start > 0.06 {
+            out.long_phone += 1;
+        }
+        if std::env::var("LIPSYNC_EVAL_TRACE").as_deref() == Ok("2") {
+            let around: Vec<String> = heard
+                .iter()
+                .filter(|q| q.end > t - 0.15 && q.start < t + 0.15)
+                .map(|q| format!("{}@{:.2}-{:.2}", q.symbol, q.start, q.end))
+                .collect();
+            println!(
+                "    PP at {t:.2} on {} ({:.2}-{:.2}): {o:?} {}@{:.3}-{:.3}, {}, real {}; heard {}",
+                p.symbol,
+                p.start,
+                p.end,
+                c.symbol,
+                c.start,
+                c.end,
+                if inside { "held" } else { "spread" },
+                if near { "near" } else { "none" },
+                around.join(" ")
+            );
+        }
+    }
+    out
 }
 
 /// CPU seconds used so far by this process and its waited-for children (the recogniser),

@@ -289,9 +289,12 @@ fn without_a_transcript_english_phones_are_recognised() {
 // 0.652–0.669, 0.031–0.032, 0.157–0.165 beside the file's other no-transcript tests (two
 // runs); the mirror puts more PP on the 8 kHz voice's other consonants (whole evaluation,
 // that voice: 12.9 → 17.0 %, its agreement 54.7 → 63.2 %), so that bound went 0.14 → 0.18.
+// With the closure edges set again after merging keys (`speech::lipsync::coarticulation`):
+// 0.487, 0.658, 0.025, 0.106 (with the file's other no-transcript tests, one at a time); the
+// false-closure bound went 0.035 → 0.03 (the issue's target; 0.031–0.032 before).
 const BOUND_CLOSURES: f64 = 0.33;
 const BOUND_AGREEMENT: f64 = 0.55;
-const BOUND_FALSE: f64 = 0.035;
+const BOUND_FALSE: f64 = 0.03;
 const BOUND_CONSONANT: f64 = 0.18;
 
 #[test]
@@ -565,7 +568,9 @@ fn hostile_compressed_files_exit_2_naming_the_file_and_write_nothing() {
 // 0.333 (26/78), agreement 0.537, false closures 0.011; 19 s in release. With the empty top
 // band of the 8 kHz voice mirrored before recognition (`speech::lipsync::enhance`): 0.513
 // (40/78), 0.597, 0.014 (35 s in release on a loaded machine); the bounds now fail on the
-// figures before it.
+// figures before it. With the closure edges set again after merging keys
+// (`speech::lipsync::coarticulation`): 0.513, 0.601, 0.008; the false-closure bound went
+// 0.025 → 0.012, which the 0.014 before fails.
 #[test]
 fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
     let name = "without_a_transcript_the_figures_hold_on_real_speakers_voices";
@@ -618,4 +623,51 @@ fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
 
 const FESTIVAL_RECOGNISED_CLOSURES: f64 = 0.46;
 const FESTIVAL_RECOGNISED_AGREEMENT: f64 = 0.57;
-const FESTIVAL_RECOGNISED_FALSE: f64 = 0.025;
+const FESTIVAL_RECOGNISED_FALSE: f64 = 0.012;
+
+/// The figures without a transcript on Festival's real speakers' voices, clean at 16 kHz
+/// (the nearest stand-in for the held-out clean read speech; all eight sentences): the
+/// issue's no-transcript targets, 80 % closures, 70 % agreement, at most 3 % false closures.
+// Measured (`LIPSYNC_EVAL_NOSCRIPT_ONLY=1 cargo run --release --example lipsync_eval`, the
+// same recordings): 0.864 (127/147), 0.801, 0.038 before the closure edges were set again
+// after merging keys (`speech::lipsync::coarticulation`), so the false-closure bound fails
+// on the code before it; 0.864, 0.801, 0.025 with them.
+#[test]
+fn without_a_transcript_clean_real_speakers_meet_the_targets() {
+    let name = "without_a_transcript_clean_real_speakers_meet_the_targets";
+    if skip(name) {
+        return;
+    }
+    let conditions = lipsync_eval::clean_conditions();
+    if !recognition_available()
+        || !conditions
+            .iter()
+            .all(|c| lipsync_eval::festival_voice_available(c.voice))
+    {
+        eprintln!(
+            "skip {name}: needs pocketsphinx pocketsphinx-en-us festival festvox-kallpc16k \
+             festvox-kdlpc16k festvox-us-slt-hts"
+        );
+        return;
+    }
+    let mut total = LipsyncScore::default();
+    for c in &conditions {
+        for text in lipsync_eval::SENTENCES {
+            total.add(&lipsync_eval::run_recognised(text, c, 25.0).unwrap());
+        }
+    }
+    eprintln!(
+        "recognised, clean: closures {:.3} ({}/{}), agreement {:.3}, false closures {:.3} ({}/{})",
+        total.closure_rate(),
+        total.closures_shown,
+        total.closures,
+        total.agreement(),
+        total.false_closure_rate(),
+        total.false_closures,
+        total.speech_frames
+    );
+    assert!(total.closures >= 120, "{total:?}");
+    assert!(total.closure_rate() >= 0.80, "{total:?}");
+    assert!(total.agreement() >= 0.70, "{total:?}");
+    assert!(total.false_closure_rate() <= 0.03, "{total:?}");
+}

@@ -59,6 +59,35 @@
 //! it) rather than a depth kept as many other consonants as closures. Taking a th heard so
 //! too (the recogniser also hears noisy b's and p's as th): espeak-ng 61.2 %, 66.3 %, 3.1 %
 //! false; Festival 49.5 %, 60.7 %, 1.5 %: past 3 % again, so not kept.
+//!
+//! Where the false closures without a transcript come from (PP on an open or rounded
+//! vowel's frame; `LIPSYNC_EVAL_TRACE=1` on `examples/lipsync_eval.rs` puts each on the
+//! nearest closure phone, held when the frame lies between that closure's PP keys, spread
+//! when only the blend to the next shape leaves PP there). Frames, with those within ±40 ms
+//! of a real m/b/p in brackets:
+//!
+//! | | heard m/b/p held | heard spread | dip held | dip spread | f/v held | f/v spread | total |
+//! |---|---|---|---|---|---|---|---|
+//! | espeak-ng, before | 30 (19) | 14 (9) | 7 (6) | 13 (11) | 1 (1) | 0 | 65 of 2017 |
+//! | Festival degraded, before | 16 (10) | 7 (4) | 0 | 4 (3) | 0 | 2 (2) | 29 of 1926 |
+//! | Festival clean, before | 29 (26) | 21 (15) | 1 (1) | 2 (1) | 1 (0) | 1 (0) | 55 of 1451 |
+//! | espeak-ng, edges set after merging | 30 (19) | 3 (3) | 7 (6) | 0 | 1 (1) | 0 | 41 |
+//! | Festival degraded, so | 16 (10) | 3 (3) | 0 | 0 | 0 | 0 | 19 |
+//! | Festival clean, so | 29 (26) | 5 (5) | 1 (1) | 0 | 1 (0) | 0 | 36 |
+//!
+//! Clean Festival per voice: kal 14 → 10, slt 19 → 13, ked 22 → 13. The spread ones were the
+//! blend left by a merged-away key ([`super::coarticulation`]). What is left is an m, b or p
+//! heard a frame off a real closure (26 of 36 on clean Festival) or heard where there is none
+//! (espeak-ng: 11 of its 30; 15 of the 30 from a heard phone longer than 60 ms); the dips and
+//! the heard f's and v's put few.
+//!
+//! Tried on top of that and not kept: each heard closure (and each added one) moved onto the
+//! video frames where the sound is quietest within it (±20 ms, frames within 6 dB of the
+//! quietest held): espeak-ng 59.7 / 69.2 / 2.6 %, Festival degraded 58.2 / 64.7 / 3.4 %,
+//! clean 86.4 / 79.6 / 5.2 % — the quietest frame is often the pause or the stop's silent
+//! gap beside the closure, not the closure; with a heard closure also dropped where its
+//! quietest frame lies less than 3 dB below the louder frames around it: clean Festival
+//! closures 86.4 → 71.4 % (2.9 % false), Festival degraded 58.2 → 47.4 %.
 
 use super::features::{frame_at, frame_time, FeatureFrame};
 use super::AlignedPhone;

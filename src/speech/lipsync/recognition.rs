@@ -42,6 +42,7 @@
 //! | triphones (`-allphone_ci no`) pruned: `-maxhmmpf 3000 -topn 2 -beam 1e-10 -pbeam 1e-10 -ds 2` | 56.1 / 63.9 / 4.4 | 46.9 / 60.7 / 2.3 | 88.4 / 80.4 / 3.3 |
 //! | `-lw 0.5` and the mirrored band (next row) together | 59.2 / 68.7 / 3.3 | 59.2 / 65.0 / 1.4 | 86.4 / 80.4 / 3.9 |
 //! | the empty top band of sub-16 kHz audio mirrored ([`super::enhance`]) | 58.7 / 68.9 / 3.2 | 56.6 / 65.2 / 1.5 | 86.4 / 80.1 / 3.8 |
+//! | and the closure edges set again after merging keys ([`super::coarticulation`]) | 58.2 / 68.8 / 2.0 | 56.1 / 65.3 / 1.0 | 86.4 / 80.1 / 2.5 |
 //!
 //! (The phone insertion penalty does not act on the phone loop.) The pruned triphone search
 //! ran at 2× real time in CPU (the loop here ~10× on these 3–5 s sentences under load) and
@@ -54,9 +55,19 @@
 //! 1.2 to 67.3 / 63.6 / 2.1, espeak-ng's 8 kHz voice from 53.1 / 54.7 / 3.8 to 57.1 / 63.2
 //! / 3.8; nothing else changes. The espeak-ng false closures measure 3.2 % with the unchanged
 //! default here, in every run (2.9 % in earlier notes). The clean Festival voices, the
-//! nearest to the held-out clean read speech, pass 80 / 70 on closures and agreement but not
-//! ≤ 3 % false closures (slt 4.0, ked 4.5 %).
+//! nearest to the held-out clean read speech, passed 80 / 70 on closures and agreement but not
+//! ≤ 3 % false closures (slt 4.0, ked 4.5 %); with the closure edges set again after merging
+//! keys they pass all three (86.4 / 80.1 / 2.5 %), and espeak-ng's voices measure 2.0 %.
 //! Noise reduction before the recogniser: see [`super::enhance`].
+//!
+//! Speed, CPU time of `fbakit lipsync REC.wav -o out.fap` and the recogniser on one core
+//! (`taskset -c 0`, `/usr/bin/time`, a loaded machine), Festival kal: 4.8 s at 16 kHz 0.31 s
+//! (15×), 154 s 6.8–7.0 s (22×); at 44.1 kHz stereo 0.49 s (9.7×) and 12.1 s (12.7×) before
+//! the resampler's kernel was tabulated ([`crate::speech::audio`]; its sine and cosine per tap
+//! were ~39 % of the CPU), 0.34 s (14×) and 7.4–7.8 s (20×) since. The recogniser's start-up
+//! (model load) is ~0.1 s of it, ~0.045 s per second of audio the rest, so files shorter than
+//! about 2 s miss 10× on that alone. It already runs once per piece of up to
+//! [`SEGMENT_SECONDS`], not per sentence. Max RSS 37–38 MB (the recogniser's).
 //!
 //! The phone lattice (for phone posteriors) is not available: `pocketsphinx_batch
 //! -outlatdir` gives none for the phone-loop search (`-allphone`).
