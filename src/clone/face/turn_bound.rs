@@ -82,20 +82,24 @@ fn sliver_apex(positions: &[Vec3], t: &[u32; 3]) -> Option<(u32, (u32, u32, f32)
 /// the inverse-length weighted mean of its neighbours, each follower (module docs) the motion
 /// of its edge.
 fn fill(positions: &[Vec3], adj: &[Vec<u32>], region: &[u32], follows: &Follows, d: &mut [Vec3]) {
-    let free: Vec<(u32, Vec<(u32, f32)>)> = region
-        .iter()
-        .filter(|v| !follows.contains_key(v) && !adj[**v as usize].is_empty())
-        .map(|&v| {
-            let edges = adj[v as usize]
-                .iter()
-                .map(|&w| {
-                    let l = positions[v as usize].distance(positions[w as usize]);
-                    (w, 1.0 / l.max(1e-9))
-                })
-                .collect();
-            (v, edges)
-        })
-        .collect();
+    // The sweeps are most of the step's time: each free vertex's edges and weights are laid
+    // out once in one array, and the sum of its weights taken once (in the order a sweep
+    // would add them, so every sweep computes the very same values).
+    let mut free: Vec<(u32, usize, f32)> = Vec::with_capacity(region.len());
+    let mut edges: Vec<(u32, f32)> = Vec::new();
+    for &v in region {
+        if follows.contains_key(&v) || adj[v as usize].is_empty() {
+            continue;
+        }
+        let start = edges.len();
+        edges.extend(adj[v as usize].iter().map(|&w| {
+            let l = positions[v as usize].distance(positions[w as usize]);
+            (w, 1.0 / l.max(1e-9))
+        }));
+        let weight = edges[start..].iter().fold(0.0f32, |t, &(_, c)| t + c);
+        free.push((v, edges.len(), weight));
+    }
+    let followers: Vec<(u32, (u32, u32, f32))> = follows.iter().map(|(&c, &e)| (c, e)).collect();
     let scale = region
         .iter()
         .map(|&v| d[v as usize].length())
@@ -103,16 +107,18 @@ fn fill(positions: &[Vec3], adj: &[Vec<u32>], region: &[u32], follows: &Follows,
         .max(1e-12);
     for _ in 0..SWEEPS {
         let mut change = 0.0f32;
-        for (v, edges) in &free {
-            let (sum, weight) = edges.iter().fold((Vec3::ZERO, 0.0f32), |(s, t), &(w, c)| {
-                (s + c * d[w as usize], t + c)
-            });
-            let old = d[*v as usize];
+        let mut start = 0;
+        for &(v, end, weight) in &free {
+            let sum = edges[start..end]
+                .iter()
+                .fold(Vec3::ZERO, |s, &(w, c)| s + c * d[w as usize]);
+            start = end;
+            let old = d[v as usize];
             let value = old + RELAX * (sum / weight - old);
             change = change.max(value.distance(old));
-            d[*v as usize] = value;
+            d[v as usize] = value;
         }
-        for (&c, &(a, b, t)) in follows {
+        for &(c, (a, b, t)) in &followers {
             let value = (1.0 - t) * d[a as usize] + t * d[b as usize];
             change = change.max(value.distance(d[c as usize]));
             d[c as usize] = value;
@@ -457,13 +463,38 @@ pub(super) fn bound_turns(
             // already smooth enough.
             let own = fap_fp(src.key, source, target)
                 .map(|(fp, _)| (source.fp_vertices[&fp], target.fp_vertices[&fp]));
-            let (held_round, at_own) =
-                bounds.rounds(&d, moving.clone(), cos_tau, own, false, own_cos);
-            let floor = held_round.as_ref().map_or(own_cos, |r| r.worst);
-            let spread_round = if at_own && floor < cos_tau {
-                bounds.rounds(&d, moving, cos_tau, own, true, floor).0
+            // When a triangle at the point turns over the bound from the start, the held
+            // and the spread rounds run side by side: one motion's rounds (CANDIDE-3's
+            // `open_jaw` on the dense ICT head: 2 900 vertices re-solved, most of the step)
+            // otherwise keep one core busy long after the other motions are done. The spread
+            // is then judged as if it had run after the held rounds: its best round beats
+            // the clone's own and the held one's, or it is dropped (its best round is the
+            // same whichever of the two it was told to beat).
+            let starts_at_own = own.is_some_and(|(_, tv)| {
+                moving.iter().any(|&i| {
+                    let t = &tris[i as usize];
+                    t.contains(&tv) && rough(pos, &d, t, tn[i as usize], cos_tau)
+                })
+            });
+            let (held_round, spread_round) = if starts_at_own {
+                let held_moving = moving.clone();
+                let (held, spread) = rayon::join(
+                    || bounds.rounds(&d, held_moving, cos_tau, own, false, own_cos),
+                    || bounds.rounds(&d, moving, cos_tau, own, true, own_cos).0,
+                );
+                let floor = held.0.as_ref().map_or(own_cos, |r| r.worst);
+                let spread = spread.filter(|r| floor < cos_tau && r.worst > floor);
+                (held.0, spread)
             } else {
-                None
+                let (held, at_own) =
+                    bounds.rounds(&d, moving.clone(), cos_tau, own, false, own_cos);
+                let floor = held.as_ref().map_or(own_cos, |r| r.worst);
+                let spread = if at_own && floor < cos_tau {
+                    bounds.rounds(&d, moving, cos_tau, own, true, floor).0
+                } else {
+                    None
+                };
+                (held, spread)
             };
             let kept = spread_round.or(held_round)?;
             // The clone's own motion with the best round's region put back.
