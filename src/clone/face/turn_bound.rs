@@ -733,4 +733,92 @@ mod tests {
         assert_eq!(d[0], slope(&t)[0].1);
         assert_eq!(d[80], slope(&t)[80].1);
     }
+
+    /// The sweeps as written on three-component vectors, one edge list per vertex: what
+    /// `fill` computes, kept here to pin that its flat tables and four lanes change no bit.
+    fn plain_fill(
+        positions: &[Vec3],
+        adj: &[Vec<u32>],
+        region: &[u32],
+        follows: &Follows,
+        d: &mut [Vec3],
+    ) {
+        let free: Vec<(u32, Vec<(u32, f32)>)> = region
+            .iter()
+            .filter(|v| !follows.contains_key(v) && !adj[**v as usize].is_empty())
+            .map(|&v| {
+                let edges = adj[v as usize]
+                    .iter()
+                    .map(|&w| {
+                        (
+                            w,
+                            1.0 / positions[v as usize]
+                                .distance(positions[w as usize])
+                                .max(1e-9),
+                        )
+                    })
+                    .collect();
+                (v, edges)
+            })
+            .collect();
+        let scale = region
+            .iter()
+            .map(|&v| d[v as usize].length())
+            .fold(0.0f32, f32::max)
+            .max(1e-12);
+        for _ in 0..SWEEPS {
+            let mut change = 0.0f32;
+            for (v, edges) in &free {
+                let (sum, weight) = edges.iter().fold((Vec3::ZERO, 0.0f32), |(s, t), &(w, c)| {
+                    (s + c * d[w as usize], t + c)
+                });
+                let old = d[*v as usize];
+                let value = old + RELAX * (sum / weight - old);
+                change = change.max(value.distance(old));
+                d[*v as usize] = value;
+            }
+            for (&c, &(a, b, t)) in follows {
+                let value = (1.0 - t) * d[a as usize] + t * d[b as usize];
+                change = change.max(value.distance(d[c as usize]));
+                d[c as usize] = value;
+            }
+            if change < 1e-5 * scale {
+                break;
+            }
+        }
+    }
+
+    #[test]
+    fn the_fill_computes_the_plain_sweeps_bit_for_bit() {
+        // An uneven grid (edge weights all different) with a wavy motion, the middle re-solved
+        // and one vertex following an edge.
+        let mut s = grid(9);
+        for (v, p) in s.positions.iter_mut().enumerate() {
+            let f = v as f32;
+            *p += Vec3::new(
+                0.3 * (1.7 * f).sin(),
+                0.3 * (2.3 * f).cos(),
+                0.2 * (0.9 * f).sin(),
+            );
+        }
+        let src = vec![motion(slope(&s))];
+        let adj = SmoothTopology::new(&s, &src, &s).adj;
+        let d0: Vec<Vec3> = s
+            .positions
+            .iter()
+            .map(|p| Vec3::new((p.x * 0.7).sin(), (p.y * 1.3).cos(), p.x * p.y * 0.01))
+            .collect();
+        let region: Vec<u32> = (0..81u32)
+            .filter(|v| (2..7).contains(&(v % 9)) && (2..7).contains(&(v / 9)))
+            .collect();
+        let follows = Follows::from([(40, (39, 41, 0.4))]);
+        let (mut a, mut b) = (d0.clone(), d0.clone());
+        fill(&s.positions, &adj, &region, &follows, &mut a);
+        plain_fill(&s.positions, &adj, &region, &follows, &mut b);
+        let bits = |d: &[Vec3]| -> Vec<[u32; 3]> {
+            d.iter().map(|v| v.to_array().map(f32::to_bits)).collect()
+        };
+        assert_ne!(bits(&a), bits(&d0));
+        assert_eq!(bits(&a), bits(&b));
+    }
 }
