@@ -11,9 +11,9 @@
 //! in the same minutes: at load 7.5, 5-sample medians 1.04 / 1.10 / 1.14 s → 0.94 / 0.95 /
 //! 0.96 s, the bound step 219 / 209 / 199 → 171 / 155 / 110 ms; with one thread
 //! (`RAYON_NUM_THREADS=1`, load ~8, six runs each) the bound step's median 217 → 150 ms.
-//! Most of that step on this pair is one motion (`open_jaw`: 2 900 vertices re-solved, its
-//! held rounds ~60 % and its never-kept spread rounds ~40 % of the step's work). Not
-//! re-measured on a quiet machine.
+//! Most of that step's work on this pair is one motion (`open_jaw`: 2 900 vertices
+//! re-solved; under load its held rounds 109 ms and its spread rounds, never kept here, 75 ms,
+//! of ~250 ms for all twelve motions bounded). Not re-measured on a quiet machine.
 
 use std::path::Path;
 use std::sync::OnceLock;
