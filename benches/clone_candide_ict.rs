@@ -2,6 +2,18 @@
 //! 46 tables) onto the bundled real head `ict` (24 591 vertices, one mesh), per method.
 //! Skipped when `../shared/data/candide3` is absent. Each method's step timings (one run)
 //! and the process's peak memory are printed before the measured runs.
+//!
+//! Figures for `fit` (issue 21's target: ≤ 0.3 s, ≤ 200 MB, release, 2 cores). Stop 31, quiet
+//! machine (load < 1.5): 356–362 ms median; step split register ~150, bound 76–84, parts 21,
+//! fold 17–22 ms; peak memory 97 MB. Helper `speed5` (the bound step's fills on flat tables
+//! and four-lane vectors, a motion's held and spread rounds side by side; outputs bit for bit
+//! the same), measured on a machine shared by four sessions, old and new binaries alternated
+//! in the same minutes: at load 7.5, 5-sample medians 1.04 / 1.10 / 1.14 s → 0.94 / 0.95 /
+//! 0.96 s, the bound step 219 / 209 / 199 → 171 / 155 / 110 ms; with one thread
+//! (`RAYON_NUM_THREADS=1`, load ~8, six runs each) the bound step's median 217 → 150 ms.
+//! Most of that step's work on this pair is one motion (`open_jaw`: 2 900 vertices
+//! re-solved; under load its held rounds 109 ms and its spread rounds, never kept here, 75 ms,
+//! of ~250 ms for all twelve motions bounded). Not re-measured on a quiet machine.
 
 use std::path::Path;
 use std::sync::OnceLock;
