@@ -46,14 +46,15 @@ const VERTICES: usize = 26_719;
 /// 0.000 % for skin, teeth, eyeballs, lacrimal fluid, eye occlusion and lashes (before the
 /// lips were welded to the mouth socket across primitives, the skin's seam twins parted by
 /// 8.8 % of `open_jaw`'s peak). The gums and tongue, a mesh of their own in the glTF layouts
-/// cut along the lip line as the OBJ's piece is: 13.8 % under `open_jaw` (the lower gums go
-/// down with the jaw in every layout, at ≥ 0.74 of the chin's motion; not traced: likely
-/// the lower jaw's rigid motion fitted over teeth and gums as one part mesh in the OBJ and
-/// as two in the glTF layouts; before they were cut there, up to 100 %: they stayed still).
+/// cut along the lip line as the OBJ's piece is: 0.000 % (13.8 % under `open_jaw` while the
+/// band blending both jaws across the cut was measured from the cut's vertices: the OBJ's
+/// quads and the glTF's triangles are cut a polygon apart, so the bands differed by a vertex;
+/// now measured from the lip line; before they were cut there, up to 100 %: they stayed
+/// still).
 /// The eye blend: 0.000 % (a piece of the skin mesh in the OBJ, it moves with the lids; as a
 /// primitive of its own, touching no skin vertex, it rode on the closest skin, the still eye
 /// socket, 87 % of the lid FAPs' peak off, until layers resting on the lids became skin).
-const LAYOUT_GAP: [f32; 8] = [1e-3, 0.15, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3];
+const LAYOUT_GAP: [f32; 8] = [1e-3; 8];
 
 /// The OBJ as read: positions, polygons (OBJ vertex ids) and each polygon's material.
 struct Obj {

@@ -154,7 +154,7 @@
 //!    internal view only. Entries on the view's skin and part meshes go back to the target
 //!    mesh's own vertex numbers through the cut's index maps (a vertex on the cut along the
 //!    lip line, in both jaws, takes the mean of both, and — when the `mouth` step ran —
-//!    within ½ MNS0 of that cut every table's motion is the harmonic blend of both sides':
+//!    within ½ MNS0 of the lip line every table's motion is the harmonic blend of both sides':
 //!    no step), and transforms created in step 7 for
 //!    cut parts alone are baked into per-vertex displacements of those vertices
 //!    ([`crate::fat::bake`]: piecewise linear over the table's intervals, borders added until
