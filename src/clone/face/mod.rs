@@ -154,8 +154,8 @@
 //!    internal view only. Entries on the view's skin and part meshes go back to the target
 //!    mesh's own vertex numbers through the cut's index maps (a vertex on the cut along the
 //!    lip line, in both jaws, takes the mean of both, and — when the `mouth` step ran —
-//!    within ½ MNS0 of the lip line every table's motion is the harmonic blend of both sides':
-//!    no step), and transforms created in step 7 for
+//!    within ½ MNS0 of where the cut pieces cross the lip line every table's motion is the
+//!    harmonic blend of both sides': no step), and transforms created in step 7 for
 //!    cut parts alone are baked into per-vertex displacements of those vertices
 //!    ([`crate::fat::bake`]: piecewise linear over the table's intervals, borders added until
 //!    within 1 % of the part's size at every FAP value the source's table covers, both signs
