@@ -49,8 +49,8 @@ const VERTICES: usize = 26_719;
 /// cut along the lip line as the OBJ's piece is: 0.000 % (13.8 % under `open_jaw` while the
 /// band blending both jaws across the cut was measured from the cut's vertices: the OBJ's
 /// quads and the glTF's triangles are cut a polygon apart, so the bands differed by a vertex;
-/// now measured from the lip line; before they were cut there, up to 100 %: they stayed
-/// still).
+/// now measured from where the pieces cross the lip line; before they were cut there, up to
+/// 100 %: they stayed still).
 /// The eye blend: 0.000 % (a piece of the skin mesh in the OBJ, it moves with the lids; as a
 /// primitive of its own, touching no skin vertex, it rode on the closest skin, the still eye
 /// socket, 87 % of the lid FAPs' peak off, until layers resting on the lids became skin).
