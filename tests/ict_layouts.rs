@@ -46,14 +46,15 @@ const VERTICES: usize = 26_719;
 /// 0.000 % for skin, teeth, eyeballs, lacrimal fluid, eye occlusion and lashes (before the
 /// lips were welded to the mouth socket across primitives, the skin's seam twins parted by
 /// 8.8 % of `open_jaw`'s peak). The gums and tongue, a mesh of their own in the glTF layouts
-/// cut along the lip line as the OBJ's piece is: 13.8 % under `open_jaw` (the lower gums go
-/// down with the jaw in every layout, at ≥ 0.74 of the chin's motion; not traced: likely
-/// the lower jaw's rigid motion fitted over teeth and gums as one part mesh in the OBJ and
-/// as two in the glTF layouts; before they were cut there, up to 100 %: they stayed still).
-/// Not compared (left): the eye blend (87 % under the lid
-/// FAPs: a piece of the skin mesh in the OBJ, it moves with the lids; as a primitive of its
-/// own it rides on the closest skin, the eye socket, which stays).
-const LAYOUT_GAP: [f32; 8] = [1e-3, 0.15, 1e-3, 1e-3, 1e-3, 1.0, 1e-3, 1e-3];
+/// cut along the lip line as the OBJ's piece is: 0.000 % (13.8 % under `open_jaw` while the
+/// band blending both jaws across the cut was measured from the cut's vertices: the OBJ's
+/// quads and the glTF's triangles are cut a polygon apart, so the bands differed by a vertex;
+/// now measured from where the pieces cross the lip line; before they were cut there, up to
+/// 100 %: they stayed still).
+/// The eye blend: 0.000 % (a piece of the skin mesh in the OBJ, it moves with the lids; as a
+/// primitive of its own, touching no skin vertex, it rode on the closest skin, the still eye
+/// socket, 87 % of the lid FAPs' peak off, until layers resting on the lids became skin).
+const LAYOUT_GAP: [f32; 8] = [1e-3; 8];
 
 /// The OBJ as read: positions, polygons (OBJ vertex ids) and each polygon's material.
 struct Obj {
@@ -726,6 +727,8 @@ fn the_layouts_move_alike_and_seam_twins_together() {
     let obj = &s.layouts[0];
     // Per group: worst per-vertex gap to the OBJ's motion, as a share of the FAP's peak.
     let mut worst: Vec<(f32, u8, &str)> = vec![(0.0, 0, ""); GROUPS.len()];
+    // Per group: where the worst gap is (OBJ vertex, the OBJ's motion and the layout's).
+    let mut at: Vec<(usize, Vec3, Vec3)> = vec![(0, Vec3::ZERO, Vec3::ZERO); GROUPS.len()];
     for fap in faps(s) {
         let values = all_values(s, fap);
         let (lo, hi) = values
@@ -748,22 +751,23 @@ fn the_layouts_move_alike_and_seam_twins_together() {
                     l.name
                 );
                 for (g, (_, range)) in GROUPS.iter().enumerate() {
-                    let gap = range
+                    let (v, gap) = range
                         .clone()
-                        .map(|v| d[v].distance(base[v]))
-                        .fold(0.0, f32::max)
-                        / peak;
+                        .map(|v| (v, d[v].distance(base[v]) / peak))
+                        .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
                     if gap > worst[g].0 {
                         worst[g] = (gap, fap, l.name);
+                        at[g] = (v, base[v], d[v]);
                     }
                 }
             }
         }
     }
-    for ((name, _), (gap, fap, layout)) in GROUPS.iter().zip(&worst) {
+    for (((name, _), (gap, fap, layout)), (v, obj_d, d)) in GROUPS.iter().zip(&worst).zip(&at) {
         eprintln!(
-            "{name}: worst gap to the OBJ {:.3} % of the FAP's peak (FAP {fap}, {layout})",
-            gap * 100.0
+            "{name}: worst gap to the OBJ {:.3} % of the FAP's peak (FAP {fap}, {layout}; vertex {v} at {:?}: OBJ {obj_d:?}, layout {d:?})",
+            gap * 100.0,
+            s.obj.positions[*v]
         );
     }
     for ((name, _), (gap, fap, layout), bound) in GROUPS

@@ -25,7 +25,7 @@ use crate::fat::morph::MorphTarget;
 use crate::fat::{FaceDefMesh, FaceDefTable, Fat, TableKey};
 use crate::mesh::geometry::{adjacency, triangulate};
 use crate::mesh::VertexIndex;
-use crate::spec::Directionality;
+use crate::spec::{Directionality, FeaturePointId};
 
 /// Share of a part's size a baked motion may be off by.
 pub(super) const BAKE_TOLERANCE: f32 = 0.01;
@@ -268,7 +268,8 @@ const CUT_BAND: f32 = 0.5;
 
 /// The vertices of a target mesh's pieces cut along the lip line (ICT's gums, tongue and
 /// mouth socket: one piece reaching into both jaws) that lie within [`CUT_BAND`] × MNS0 of
-/// the cut, and the harmonic fill over them. Each side of the cut takes its own jaw's motion
+/// where they cross the lip line (the height between 2.2 and 2.3), and the harmonic fill
+/// over them. Each side of the cut takes its own jaw's motion
 /// (the upper still, the lower with the jaw), so the cut was a step: its vertices took the
 /// mean of both sides, and the band of triangles beside it creased and folded (CANDIDE →
 /// ict `open_jaw`: 151°). In the band, every table's motion is instead the harmonic blend of
@@ -290,18 +291,35 @@ impl CutBand {
             return None;
         }
         let reach = CUT_BAND * target.fapu().ok()?.distances.mns0 as f32;
+        let fp = |id| target.feature_points.position(id);
+        let lip_y = (fp(FeaturePointId::FP_2_2)?.y + fp(FeaturePointId::FP_2_3)?.y) / 2.0;
         let world = target.mesh_world(&target.frames(), mesh);
-        let index = VertexIndex::new(
-            &on_cut
-                .iter()
-                .map(|&v| world[v as usize])
-                .collect::<Vec<_>>(),
-        );
         let (piece, count) = mesh_pieces(m, 1e-6 * part_size(&world).max(f32::MIN_POSITIVE));
         let mut cut_piece = vec![false; count];
         for &v in &on_cut {
             cut_piece[piece[v as usize]] = true;
         }
+        // The band is measured from where the cut pieces' triangles cross the lip line, not
+        // from the cut's vertices: which side a polygon goes to depends on how it is split (a
+        // quad or its two triangles), so the same head as quads (an OBJ) and as triangles (a
+        // glTF) was cut a polygon apart and got bands a vertex apart (ICT's gums: 13.8 % of
+        // `open_jaw`'s peak). The triangles here are the same in both (a convex quad is split
+        // as a fan, as exporters do).
+        let (triangles, _) = triangulate(&m.positions, &m.polygons);
+        let adj = adjacency(m.positions.len(), &triangles);
+        let mut crossings: Vec<Vec3> = Vec::new();
+        for (a, next) in adj.iter().enumerate() {
+            if !cut_piece[piece[a]] {
+                continue;
+            }
+            for &b in next.iter().filter(|&&b| b as usize > a) {
+                let (ya, yb) = (world[a].y - lip_y, world[b as usize].y - lip_y);
+                if (ya <= 0.0) != (yb <= 0.0) {
+                    crossings.push(world[a].lerp(world[b as usize], ya / (ya - yb)));
+                }
+            }
+        }
+        let index = VertexIndex::new(&crossings);
         let inside: Vec<bool> = (0..m.positions.len())
             .map(|v| {
                 cut_piece[piece[v]]
@@ -310,8 +328,7 @@ impl CutBand {
                         .is_some_and(|(_, d)| d <= reach)
             })
             .collect();
-        let (triangles, _) = triangulate(&m.positions, &m.polygons);
-        let fill = HarmonicFill::new(&adjacency(m.positions.len(), &triangles), &world, &inside)?;
+        let fill = HarmonicFill::new(&adj, &world, &inside)?;
         Some(CutBand { fill })
     }
 

@@ -24,8 +24,9 @@
 //!    feature point whose every piece lies on an eyeball (within 1.3 radii of the centre of
 //!    the piece holding a pupil: VRoid's iris and highlight layers) is cut the same way, each
 //!    piece to the eye it lies on, so the layers turn with their eyeballs — unless a piece's
-//!    rim rests on the lids (an eye occlusion shell, a lacrimal film), which stays with the
-//!    skin. A mesh without feature points behind the lips whose rows lie on either side of
+//!    rim rests on the lids (an eye occlusion shell, a lacrimal film, an eye blend): such a
+//!    mesh is skin even when it shares no vertex with the skin, as it is in a one-mesh head,
+//!    so it moves with the lids. A mesh without feature points behind the lips whose rows lie on either side of
 //!    the lip line is cut by rows, and gums joined to a tongue in a mesh of their own (open,
 //!    running back along the jaws) along the line, as in a one-mesh head. Each eye then turns
 //!    about its own centre and the lower row follows the jaw; step 9 folds them back.
@@ -153,8 +154,8 @@
 //!    internal view only. Entries on the view's skin and part meshes go back to the target
 //!    mesh's own vertex numbers through the cut's index maps (a vertex on the cut along the
 //!    lip line, in both jaws, takes the mean of both, and — when the `mouth` step ran —
-//!    within ½ MNS0 of that cut every table's motion is the harmonic blend of both sides':
-//!    no step), and transforms created in step 7 for
+//!    within ½ MNS0 of where the cut pieces cross the lip line every table's motion is the
+//!    harmonic blend of both sides': no step), and transforms created in step 7 for
 //!    cut parts alone are baked into per-vertex displacements of those vertices
 //!    ([`crate::fat::bake`]: piecewise linear over the table's intervals, borders added until
 //!    within 1 % of the part's size at every FAP value the source's table covers, both signs

@@ -149,7 +149,8 @@ pub(super) fn face_diagonal(face: &FaceModel, frames: &FaceFrames) -> f32 {
 }
 
 /// Sorts a face's meshes into skin and rigid parts from its feature points (module docs,
-/// step 1).
+/// step 1). A mesh without feature points lying on an eyeball with its rim on the lids (an
+/// eye blend, occlusion or tear film of its own) is skin too.
 pub fn identify_parts(face: &FaceModel) -> FaceParts {
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
@@ -168,6 +169,12 @@ pub fn identify_parts(face: &FaceModel) -> FaceParts {
         }
     }
     let mut is_skin = has_skin_fp.clone();
+    // Layers resting on the lids are skin, as they are in a one-mesh head.
+    for m in super::split::lid_layers(face, &frames, diag) {
+        if part_of[m].is_none() {
+            is_skin[m] = true;
+        }
+    }
     let mut queue: Vec<usize> = (0..n).filter(|&m| is_skin[m]).collect();
     while let Some(m) = queue.pop() {
         for &o in &adjacent[m] {

@@ -8,7 +8,7 @@
 //! ([`teeth_row_plans`]: the rule); and meshes without feature points lying wholly on the
 //! eyeballs, one piece per eye (VRoid's iris and highlight layers: [`eye_layer_plans`]) go
 //! to the eye each piece lies on — unless its rim rests on the lids (an eye occlusion shell,
-//! a lacrimal film), which stays with the skin. The split is an internal view: its index maps
+//! a lacrimal film, an eye blend): such a mesh is skin ([`lid_layers`]). The split is an internal view: its index maps
 //! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -565,20 +565,40 @@ const EYE_LAYER_REACH: f32 = 1.3;
 /// 0.2 ES0: a pupil on a bigger piece is on the skin, as on CANDIDE-3).
 const EYEBALL_MAX_RADIUS: f32 = 0.5;
 
+/// Where a connected piece of a mesh lying on the eyeballs goes ([`eye_layers`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LayerPiece {
+    /// Lies on this eye's eyeball, clear of the lids: turns with it.
+    Eye(Part),
+    /// Its rim rests on the lids: moves with them, never with the eye.
+    OnLids,
+    /// Reaches over both eyeballs: neither.
+    BothEyes,
+}
+
+/// A mesh holding no feature point whose every vertex lies on an eyeball, with the fate of
+/// each of its connected pieces.
+struct EyeLayer {
+    /// The mesh (index in the face).
+    mesh: usize,
+    /// The piece of every vertex ([`mesh_pieces`]).
+    piece: Vec<usize>,
+    /// Per piece (`None`: a piece of no polygon).
+    fate: Vec<Option<LayerPiece>>,
+}
+
 /// Meshes (or glTF primitives) holding no feature point whose connected pieces all lie on an
 /// eyeball — every vertex within [`EYE_LAYER_REACH`] radii of the centre of the piece holding
-/// a pupil (bounding-box centre and half extent) —: the iris and highlight layers VRoid puts
-/// in front of the eye white, each primitive holding both eyes. Each piece goes to the eye it
-/// lies on, so it turns with that eyeball; the first eye stays in the mesh. A piece whose rim
+/// a pupil (bounding-box centre and half extent) —, each piece sorted: a piece whose rim
 /// comes within [`LID_CLEARANCE`] eyeball radii of the skin rests on the lids (ICT's eye
-/// occlusion, lacrimal film and corner blends): its mesh is left to the skin step, so it
-/// follows the lids and never the eye's turn. Meshes in `planned` are cut already.
-fn eye_layer_plans(
+/// occlusion, lacrimal film and corner blends), any other goes to the eye it lies on (VRoid's
+/// iris and highlight layers). Meshes in `planned` (cut already) are left out.
+fn eye_layers(
     face: &FaceModel,
     frames: &FaceFrames,
     diag: f32,
     planned: &BTreeSet<usize>,
-) -> Vec<CutPlan> {
+) -> Vec<EyeLayer> {
     let Some(lm) = Landmarks::of(face) else {
         return Vec::new();
     };
@@ -622,7 +642,6 @@ fn eye_layer_plans(
     if balls.is_empty() {
         return Vec::new();
     }
-    let mut plans = Vec::new();
     // The eye whose eyeball a point lies on.
     let on_ball = |q: Vec3| {
         balls
@@ -632,6 +651,7 @@ fn eye_layer_plans(
             .map(|b| b.0)
     };
     let lids = LidSurface::of(face, frames, eps, &on_ball);
+    let mut out = Vec::new();
     for mi in candidates {
         let mesh = &face.meshes[mi].mesh;
         let world = face.mesh_world(frames, mi);
@@ -643,17 +663,15 @@ fn eye_layer_plans(
             .collect();
         let Some(eyes) = eyes else { continue };
         let (piece, count) = mesh_pieces(mesh, eps);
-        // Per piece, the eye it lies on: `None` not yet seen, `Some(None)` on both, or a
-        // piece whose rim rests on the lids.
-        let mut eye: Vec<Option<Option<Part>>> = vec![None; count];
+        let mut fate: Vec<Option<LayerPiece>> = vec![None; count];
         for (v, on) in eyes {
             let Some(&k) = piece.get(v as usize) else {
                 continue;
             };
-            eye[k] = Some(match eye[k] {
-                None => Some(on),
-                Some(seen) if seen == Some(on) => seen,
-                Some(_) => None,
+            fate[k] = Some(match fate[k] {
+                None => LayerPiece::Eye(on),
+                Some(LayerPiece::Eye(seen)) if seen == on => LayerPiece::Eye(on),
+                Some(_) => LayerPiece::BothEyes,
             });
         }
         if let Some(lids) = &lids {
@@ -661,21 +679,44 @@ fn eye_layer_plans(
                 let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
                     continue;
                 };
-                let Some(Some(part)) = eye[k] else { continue };
+                let Some(LayerPiece::Eye(part)) = fate[k] else {
+                    continue;
+                };
                 let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
                 if lids.within(q, LID_CLEARANCE * radius) {
-                    eye[k] = Some(None);
+                    fate[k] = Some(LayerPiece::OnLids);
                 }
             }
         }
+        out.push(EyeLayer {
+            mesh: mi,
+            piece,
+            fate,
+        });
+    }
+    out
+}
+
+/// [`eye_layers`] whose every piece goes to an eye, cut one piece per eye so each turns with
+/// its eyeball; the first eye stays in the mesh. A mesh with a piece resting on the lids is
+/// left whole (all of it on the lids: [`lid_layers`]).
+fn eye_layer_plans(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    diag: f32,
+    planned: &BTreeSet<usize>,
+) -> Vec<CutPlan> {
+    let mut plans = Vec::new();
+    for layer in eye_layers(face, frames, diag, planned) {
+        let mesh = &face.meshes[layer.mesh].mesh;
         let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
         let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
         let mut all_on = true;
         for (pi, poly) in mesh.polygons.iter().enumerate() {
-            let Some(&k) = poly.first().and_then(|&v| piece.get(v as usize)) else {
+            let Some(&k) = poly.first().and_then(|&v| layer.piece.get(v as usize)) else {
                 continue;
             };
-            let Some(Some(part)) = eye[k] else {
+            let Some(LayerPiece::Eye(part)) = layer.fate[k] else {
                 all_on = false;
                 break;
             };
@@ -687,13 +728,34 @@ fn eye_layer_plans(
         }
         let rest = dest.keys().next().copied().flatten();
         plans.push(CutPlan {
-            mesh: mi,
+            mesh: layer.mesh,
             dest,
             rest,
             pieces,
         });
     }
     plans
+}
+
+/// Meshes holding no feature point whose every piece lies on an eyeball with its rim resting
+/// on the lids ([`eye_layers`]): an eye blend, occlusion shell or lacrimal film given as a mesh
+/// or primitive of its own. They are skin ([`super::identify_parts`]), as they are when pieces
+/// of a one-mesh head's skin: the surface method moves them with the lids. Left to ride on
+/// the closest skin point, a band between the lid and the eye (ICT's eye blend) took the
+/// still eye socket's motion.
+pub(super) fn lid_layers(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Vec<usize> {
+    eye_layers(face, frames, diag, &BTreeSet::new())
+        .into_iter()
+        .filter(|l| {
+            let mesh = &face.meshes[l.mesh].mesh;
+            mesh.polygons.iter().all(|poly| {
+                poly.first()
+                    .and_then(|&v| l.piece.get(v as usize))
+                    .is_some_and(|&k| l.fate[k] == Some(LayerPiece::OnLids))
+            })
+        })
+        .map(|l| l.mesh)
+        .collect()
 }
 
 /// Nearest an eye layer's rim may come to the skin, in eyeball radii: a rim closer than
@@ -989,6 +1051,7 @@ fn unique_mesh_name(face: &FaceModel, base: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::super::identify_parts;
     use super::*;
     use crate::synth::{generate, HeadParams};
 
@@ -1049,15 +1112,11 @@ mod tests {
         (face, centre, radius, world[v as usize] - centre)
     }
 
-    #[test]
-    fn a_cap_over_the_eye_turns_with_it_and_one_resting_on_the_lids_does_not() {
-        let (mut face, centre, radius, gaze) = head();
-        face.meshes
-            .push(cap("iris_layer", centre, gaze, 1.02 * radius, 0.35));
-        // The same cap widened, one rim vertex touching the skin: a lid resting on it (a
-        // sliver of skin from that vertex radially outwards, beyond the eyeball), as an eye
-        // occlusion shell's rim rests on the lids.
-        let shell = cap("lid_layer", centre, gaze, 1.05 * radius, 0.8);
+    /// A sliver of skin from `gap` eyeball radii beyond a rim vertex of `shell` radially
+    /// outwards: a lid resting on the shell, as an eye occlusion's or eye blend's rim rests
+    /// on the lids (touching them, or just clear of them).
+    fn rest_on_lids(face: &mut FaceModel, shell: &FaceMesh, eye: (Vec3, f32, Vec3), gap: f32) {
+        let (centre, radius, gaze) = eye;
         let rim = shell.mesh.positions[1 + 2 * 12];
         let out = (rim - centre).normalize();
         let side = out.cross(gaze).normalize();
@@ -1070,10 +1129,60 @@ mod tests {
         skin.normals.clear();
         skin.colors.clear();
         let n = skin.positions.len() as u32;
-        for w in [rim, rim + out * radius, rim + (out + side * 0.2) * radius] {
+        let root = rim + out * gap * radius;
+        for w in [
+            root,
+            root + out * radius,
+            root + (out + side * 0.2) * radius,
+        ] {
             skin.positions.push(to_local.transform_point3(w));
         }
         skin.polygons.push(&[n, n + 1, n + 2]);
+    }
+
+    #[test]
+    fn a_cap_over_the_eye_turns_with_it_and_one_resting_on_the_lids_is_skin() {
+        // A cap clear of the lids turns with its eye; the same cap with a lid resting on its
+        // rim (touching it, or 0.02 radii short of it, under the clearance, sharing no
+        // vertex: ICT's eye blend comes to 0.013) is skin; 0.1 radii off it is clear again.
+        for (gap, rests) in [
+            (None, false),
+            (Some(0.0), true),
+            (Some(0.02), true),
+            (Some(0.1), false),
+        ] {
+            let (mut face, centre, radius, gaze) = head();
+            let layer = cap("layer", centre, gaze, 1.02 * radius, 0.35);
+            if let Some(gap) = gap {
+                rest_on_lids(&mut face, &layer, (centre, radius, gaze), gap);
+            }
+            face.meshes.push(layer);
+            let frames = face.frames();
+            let diag = face_diagonal(&face, &frames);
+            let mi = face.mesh_index("layer").unwrap();
+            let (_, parts) = split_embedded_parts(&face);
+            let cut: Vec<Part> = parts
+                .iter()
+                .filter(|p| p.from == "layer")
+                .map(|p| p.part)
+                .collect();
+            let skin = identify_parts(&face).skin.contains(&mi);
+            let lids = lid_layers(&face, &frames, diag);
+            if rests {
+                assert!(
+                    cut.is_empty() && skin && lids == vec![mi],
+                    "{gap:?}: {cut:?} {skin} {lids:?}"
+                );
+            } else {
+                assert!(
+                    cut == vec![Part::LeftEye] && !skin && lids.is_empty(),
+                    "{gap:?}: {cut:?} {skin} {lids:?}"
+                );
+            }
+        }
+        // A wider shell comes within the clearance of the synthetic head's own lids.
+        let (mut face, centre, radius, gaze) = head();
+        let shell = cap("shell", centre, gaze, 1.05 * radius, 0.8);
         // Wholly within the reach an eye layer is looked for in (so only the rim rule keeps
         // it from the eye).
         let far = shell
@@ -1085,15 +1194,9 @@ mod tests {
         assert!(far <= EYE_LAYER_REACH, "{far}");
         face.meshes.push(shell);
         let (_, parts) = split_embedded_parts(&face);
-        let from = |name: &str| {
-            parts
-                .iter()
-                .filter(|p| p.from == name)
-                .map(|p| p.part)
-                .collect::<Vec<_>>()
-        };
-        assert_eq!(from("iris_layer"), vec![Part::LeftEye], "{parts:?}");
-        assert_eq!(from("lid_layer"), Vec::<Part>::new(), "{parts:?}");
+        assert!(parts.iter().all(|p| p.from != "shell"), "{parts:?}");
+        let mi = face.mesh_index("shell").unwrap();
+        assert!(identify_parts(&face).skin.contains(&mi));
     }
 
     #[test]
