@@ -201,6 +201,7 @@ mod assemble;
 mod attached;
 mod fold;
 mod jaw_follow;
+mod lid_close;
 mod lid_margin;
 mod motions;
 mod mouth_fill;
@@ -575,13 +576,15 @@ fn clone_skin_motions(
     }
     report.timings.push("guard", clock.elapsed().as_secs_f64());
     // No crease, fold or spike the source does not have; then each feature point moves by
-    // its FAPU.
+    // its FAPU. The lid margins are held: the slits' gaps are `lid_close`'s.
+    let lids: Vec<u32> = margins[0].margin_vertices().collect();
     let clock = Instant::now();
     report.smoothed = smooth_motions(
         &topology,
         &ssurf.surface,
         &moving,
         &tsurf.surface,
+        &lids,
         &mut result.motions,
     );
     report.timings.push("smooth", clock.elapsed().as_secs_f64());
@@ -607,6 +610,18 @@ fn clone_skin_motions(
         );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
+    // The slits close band by band where the source's does (the margins `smooth` held).
+    let clock = Instant::now();
+    lid_close::close_lids(
+        &ssurf.surface,
+        &moving,
+        &tsurf.surface,
+        [&margins[0], &margins[1]],
+        &mut result.motions,
+    );
+    report
+        .timings
+        .push("lid_close", clock.elapsed().as_secs_f64());
     // The gain's bump changes the motion after `smooth` looked at it (bruno → ict's lip
     // corner under `viseme_1` turned 12× the source's): the same rule once more. A smooth
     // motion is not changed. Not after the mouth fill: smoothing the uniform-Laplacian way
@@ -617,6 +632,7 @@ fn clone_skin_motions(
         &ssurf.surface,
         &moving,
         &tsurf.surface,
+        &lids,
         &mut result.motions,
     ) {
         *report.smoothed.entry(k).or_default() += n;
@@ -637,7 +653,6 @@ fn clone_skin_motions(
     // Last, an explicit bound on the skin's turn: what `smooth`'s uniform steps could not
     // settle (tiny or sliver triangles) is re-solved around it.
     let clock = Instant::now();
-    let lids: Vec<u32> = margins[0].margin_vertices().collect();
     for (k, n) in turn_bound::bound_turns(
         &topology,
         &ssurf.surface,
