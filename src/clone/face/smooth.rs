@@ -7,7 +7,12 @@
 //!
 //! Per motion, with `θ_s` the source's largest normal turn
 //! ([`crate::clone::quality::max_normal_turn`]) and `τ = 1.25 · max(θ_s, 1°)`: every target
-//! triangle turning more than `τ` is *rough*. Its corners and one ring of neighbours around
+//! triangle turning more than `τ` is *rough*. The same holds at a quarter and a half of the
+//! motion ([`SHARES`]), against the larger of the source's turn there and that share of
+//! `θ_s`: a FAT interpolates between its borders, and a lid turning about its eyeball (alma's:
+//! 170° at ±1024, beyond any slack) is checked on the way — cloned onto ICT it folded at the
+//! eye corners at 256 and 512 (87.6° and 167.2° under `close_t_l_eyelid`, ICT's own FAT 63.5°
+//! and 97.3°; now 73.1° and 102.7°). Its corners and one ring of neighbours around
 //! them are smoothed by damped Laplacian steps (`d_v ← ½ d_v + ½ · mean of its mesh
 //! neighbours`, [`SWEEPS`] of them, everything else held), the rough triangles found again,
 //! and so on up to [`ROUNDS`] times. Small steps take out a spike or a crease (high
@@ -228,7 +233,6 @@ pub(super) fn smooth_motions(
     source: &CloneSurface,
     motions: &[SurfaceMotion],
     target: &CloneSurface,
-    held: &[u32],
     out: &mut [SurfaceMotion],
 ) -> BTreeMap<String, usize> {
     let n = target.positions.len();
@@ -291,11 +295,6 @@ pub(super) fn smooth_motions(
             }
             // A FAP's own feature point keeps its motion: it is what the FAP defines.
             let mut pinned = vec![false; n];
-            for &v in held {
-                if let Some(p) = pinned.get_mut(v as usize) {
-                    *p = true;
-                }
-            }
             if let Some((fp, _)) = fap_fp(src.key, source, target) {
                 if let Some(p) = pinned.get_mut(target.fp_vertices[&fp] as usize) {
                     *p = true;
@@ -433,7 +432,7 @@ mod tests {
         let mut out = src.clone();
         // Built once, as the pipeline does for its two passes.
         let topology = SmoothTopology::new(&s, &src, &s);
-        assert!(smooth_motions(&topology, &s, &src, &s, &[], &mut out).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, &mut out).is_empty());
         assert_eq!(out, src);
         // One vertex left still inside the bump (a hole in the correspondence) is a spike.
         let centre = 5 * 11 + 5;
@@ -448,7 +447,7 @@ mod tests {
                 .collect::<Vec<_>>(),
             &s.triangles,
         );
-        let done = smooth_motions(&topology, &s, &src, &s, &[], &mut holed);
+        let done = smooth_motions(&topology, &s, &src, &s, &mut holed);
         assert_eq!(done.len(), 1, "{done:?}");
         let d = crate::clone::quality::dense(&holed[0], 121);
         let posed: Vec<Vec3> = s.positions.iter().zip(&d).map(|(p, o)| *p + *o).collect();
@@ -470,7 +469,7 @@ mod tests {
         assert_eq!(d[0], Vec3::ZERO);
         // The pipeline runs the step again after the gain: a motion it settled is left as it is.
         let settled = holed.clone();
-        assert!(smooth_motions(&topology, &s, &src, &s, &[], &mut holed).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, &mut holed).is_empty());
         assert_eq!(holed, settled);
     }
 }
