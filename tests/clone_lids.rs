@@ -610,9 +610,14 @@ fn alma_onto_ict_lids() {
         eprintln!("note: bundled faces alma / ict not readable; skipped");
         return;
     };
-    let out =
-        fbakit::clone::face::clone_face(&alma, &fbakit::export::picture::strip_fat(&ict), &fit())
-            .unwrap();
+    // Both lid options on (their docs say why they are off by default).
+    let opts = CloneOptions {
+        smooth_shares: true,
+        lid_close: true,
+        ..fit()
+    };
+    let bare = fbakit::export::picture::strip_fat(&ict);
+    let out = fbakit::clone::face::clone_face(&alma, &bare, &opts).unwrap();
     let c = &out.face;
     let mut worst = Vec::new();
     for f in 19u8..=22 {

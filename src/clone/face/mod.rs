@@ -82,9 +82,9 @@
 //!    (the FAP's own feature point held) until none is rough, at most 40 rounds. Such defects
 //!    come from cloning across styles: target vertices reading unrelated parts of the source
 //!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
-//!    changed. The turns are checked at a quarter and a half of each motion too (the FAT
-//!    interpolates: a lid turning about its eyeball folds on the way, beyond a border check's
-//!    reach). Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more
+//!    changed. With [`CloneOptions::smooth_shares`] the turns are checked at a quarter and a
+//!    half of each motion too (the FAT interpolates: a lid turning about its eyeball folds on
+//!    the way, beyond a border check's reach). Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more
 //!    after `gain` and `lid_close`, whose changes can crease a motion again (bruno → ict's
 //!    lip corner).
 //!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
@@ -95,7 +95,8 @@
 //!    feature point off the source's peak (a stylised brow onto a real one) no longer leaves
 //!    the FAP half as strong. Not with FAPU scaling off
 //!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
-//!    **`lid_close`** (every method, `lid_close.rs`), after `gain`: where the source's blink
+//!    **`lid_close`** (every method, with [`CloneOptions::lid_close`]; `lid_close.rs`),
+//!    after `gain`: where the source's blink
 //!    closes its eye (its lid points meet under both lid FAPs at one value, in both tables'
 //!    first interval), the target's lid margins are moved vertically so that at that value
 //!    the slit's gap along the corner line is the source's (in IRISD0), the top FAP taking
@@ -593,6 +594,7 @@ fn clone_skin_motions(
         &ssurf.surface,
         &moving,
         &tsurf.surface,
+        opts.smooth_shares,
         &mut result.motions,
     );
     report.timings.push("smooth", clock.elapsed().as_secs_f64());
@@ -620,13 +622,15 @@ fn clone_skin_motions(
     }
     // The slits close band by band where the source's does (the margins `smooth` held).
     let clock = Instant::now();
-    lid_close::close_lids(
-        &ssurf.surface,
-        &moving,
-        &tsurf.surface,
-        [&margins[0], &margins[1]],
-        &mut result.motions,
-    );
+    if opts.lid_close {
+        lid_close::close_lids(
+            &ssurf.surface,
+            &moving,
+            &tsurf.surface,
+            [&margins[0], &margins[1]],
+            &mut result.motions,
+        );
+    }
     report
         .timings
         .push("lid_close", clock.elapsed().as_secs_f64());
@@ -640,6 +644,7 @@ fn clone_skin_motions(
         &ssurf.surface,
         &moving,
         &tsurf.surface,
+        opts.smooth_shares,
         &mut result.motions,
     ) {
         *report.smoothed.entry(k).or_default() += n;

@@ -7,8 +7,9 @@
 //!
 //! Per motion, with `θ_s` the source's largest normal turn
 //! ([`crate::clone::quality::max_normal_turn`]) and `τ = 1.25 · max(θ_s, 1°)`: every target
-//! triangle turning more than `τ` is *rough*. The same holds at a quarter and a half of the
-//! motion ([`SHARES`]), against the larger of the source's turn there and that share of
+//! triangle turning more than `τ` is *rough*. Optionally
+//! ([`CloneOptions::smooth_shares`](super::CloneOptions::smooth_shares)) the same holds at a
+//! quarter and a half of the motion ([`SHARES`]), against the larger of the source's turn there and that share of
 //! `θ_s`: a FAT interpolates between its borders, and a lid turning about its eyeball (alma's:
 //! 170° at ±1024, beyond any slack) is checked on the way — cloned onto ICT it folded at the
 //! eye corners at 256 and 512 (87.6° and 167.2° under `close_t_l_eyelid`, ICT's own FAT 63.5°
@@ -226,13 +227,14 @@ fn source_turn(
 }
 
 /// The smoothing of every cloned motion (module docs), on the `topology` of `source` and
-/// `target`. Returns, per smoothed motion (`name@value`), how many target vertices were
+/// `target`; `with_shares`: the turns at [`SHARES`] of each motion are checked too. Returns, per smoothed motion (`name@value`), how many target vertices were
 /// re-solved.
 pub(super) fn smooth_motions(
     topology: &SmoothTopology,
     source: &CloneSurface,
     motions: &[SurfaceMotion],
     target: &CloneSurface,
+    with_shares: bool,
     out: &mut [SurfaceMotion],
 ) -> BTreeMap<String, usize> {
     let n = target.positions.len();
@@ -270,6 +272,7 @@ pub(super) fn smooth_motions(
                     SHARES
                         .into_iter()
                         .zip(shares)
+                        .filter(|_| with_shares)
                         .map(|(s, th)| (s, th.max(s as f64 * theta))),
                 )
                 .map(|(s, th)| (s, SLACK * th.max(NORMAL_TURN_FLOOR)))
@@ -432,7 +435,7 @@ mod tests {
         let mut out = src.clone();
         // Built once, as the pipeline does for its two passes.
         let topology = SmoothTopology::new(&s, &src, &s);
-        assert!(smooth_motions(&topology, &s, &src, &s, &mut out).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, true, &mut out).is_empty());
         assert_eq!(out, src);
         // One vertex left still inside the bump (a hole in the correspondence) is a spike.
         let centre = 5 * 11 + 5;
@@ -447,7 +450,7 @@ mod tests {
                 .collect::<Vec<_>>(),
             &s.triangles,
         );
-        let done = smooth_motions(&topology, &s, &src, &s, &mut holed);
+        let done = smooth_motions(&topology, &s, &src, &s, true, &mut holed);
         assert_eq!(done.len(), 1, "{done:?}");
         let d = crate::clone::quality::dense(&holed[0], 121);
         let posed: Vec<Vec3> = s.positions.iter().zip(&d).map(|(p, o)| *p + *o).collect();
@@ -469,7 +472,7 @@ mod tests {
         assert_eq!(d[0], Vec3::ZERO);
         // The pipeline runs the step again after the gain: a motion it settled is left as it is.
         let settled = holed.clone();
-        assert!(smooth_motions(&topology, &s, &src, &s, &mut holed).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, true, &mut holed).is_empty());
         assert_eq!(holed, settled);
     }
 }
