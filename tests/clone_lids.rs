@@ -573,3 +573,103 @@ fn lips_check(case: &Case) -> Vec<(String, f32, f32)> {
         })
         .collect()
 }
+
+/// The largest normal turn (degrees) of any triangle of `face` posed with `acts`, against
+/// its neutral shape.
+fn max_turn(face: &FaceModel, acts: &[Activation]) -> f32 {
+    let n = face.pose(&[]).unwrap();
+    let p = face.pose(acts).unwrap();
+    let mut best = 0.0f32;
+    for (mi, fm) in face.meshes.iter().enumerate() {
+        for poly in fm.mesh.polygons.iter() {
+            for k in 1..poly.len().saturating_sub(1) {
+                let t = [poly[0], poly[k], poly[k + 1]].map(|v| v as usize);
+                let normal = |q: &[Vec3]| (q[t[1]] - q[t[0]]).cross(q[t[2]] - q[t[0]]);
+                let (a, b) = (normal(&n[mi]), normal(&p[mi]));
+                if a.length() < 1e-12 || b.length() < 1e-12 {
+                    continue;
+                }
+                let turn = a.normalize().dot(b.normalize()).clamp(-1.0, 1.0).acos();
+                best = best.max(turn.to_degrees());
+            }
+        }
+    }
+    best
+}
+
+/// Issue 21 §1 across styles: the cartoon alma's lids onto the real ICT head. Alma's closing
+/// lid turns about its eyeball (170° at ±1024, so a check at the tables' borders bounds
+/// nothing), and the clone's lids folded at the eye corners on the way (167° at `close_t_l`
+/// 512, ICT's own FAT 97°), and its slit stayed 0.10 IRISD0 open near the outer corner
+/// with the lids crossing by 0.18 further in. Under each lid FAP at 256 and 512 the clone
+/// turns at most 1.2× what ICT's own FAT turns, and at alma's closing value the slit is
+/// closed band by band.
+#[test]
+fn alma_onto_ict_lids() {
+    let (Ok(alma), Ok(ict)) = (fbakit::face::read("alma"), fbakit::face::read("ict")) else {
+        eprintln!("note: bundled faces alma / ict not readable; skipped");
+        return;
+    };
+    // Both lid options on (their docs say why they are off by default).
+    let opts = CloneOptions {
+        smooth_shares: true,
+        lid_close: true,
+        ..fit()
+    };
+    let bare = fbakit::export::picture::strip_fat(&ict);
+    let out = fbakit::clone::face::clone_face(&alma, &bare, &opts).unwrap();
+    let c = &out.face;
+    let mut worst = Vec::new();
+    for f in 19u8..=22 {
+        for v in [256.0, 512.0] {
+            let a = [Activation {
+                key: key(f),
+                value: v,
+            }];
+            let (clone, own) = (max_turn(c, &a), max_turn(&ict, &a));
+            eprintln!("FAP {f} @{v}: clone {clone:.1}°, ICT's own {own:.1}°");
+            if clone > 1.2 * own {
+                worst.push(format!("FAP {f} @{v}: {clone:.1}° against {own:.1}°"));
+            }
+        }
+    }
+    assert!(worst.is_empty(), "lids fold: {worst:?}");
+    for eye in &EYES {
+        let value = closing_value(&alma, eye).expect("alma's blink closes its eyes");
+        let own = closing_value(&ict, eye).expect("ICT's blink closes its eyes");
+        let part = if eye.faps.0 == 19 {
+            Part::LeftEye
+        } else {
+            Part::RightEye
+        };
+        // Band by band at alma's closing value, the slit is as closed as ICT's own at its
+        // own: every gap within the range of ICT's own gaps, widened by 0.05 IRISD0 (ICT's
+        // lids cross by up to 0.11 IRISD0; alma's, which the clone follows, just meet).
+        let pts = [eye.points[0], eye.points[1], eye.points[2], eye.points[3]];
+        let irisd = c.fapu().unwrap().distances.irisd0 as f32;
+        let reach = 0.9 * (fp(c, pts[0]).y - fp(c, pts[1]).y).abs();
+        let m = margins(c, pts, reach, 12);
+        let scaled = |g: Vec<f32>| g.iter().map(|x| x / irisd).collect::<Vec<f32>>();
+        let clone = scaled(gaps(&c.pose(&blink(c, eye, value)).unwrap(), &m));
+        let ict_own = scaled(gaps(&ict.pose(&blink(&ict, eye, own)).unwrap(), &m));
+        eprintln!("eye {:?} gaps at {value:.0}: {clone:.2?}", eye.faps);
+        eprintln!("    ICT's own at {own:.0}: {ict_own:.2?}");
+        let lo = ict_own.iter().copied().fold(f32::INFINITY, f32::min) - 0.05;
+        let hi = ict_own.iter().copied().fold(f32::NEG_INFINITY, f32::max) + 0.05;
+        assert!(
+            clone.iter().all(|g| (lo..=hi).contains(g)),
+            "eye {:?}: gaps {clone:.3?} outside [{lo:.3}, {hi:.3}]",
+            eye.faps
+        );
+        let ball = eyeball_vertices(&out, part);
+        let depth = eyeball_depth(c, &ball, &blink(c, eye, value));
+        let own_depth = eyeball_depth(&ict, &ball, &blink(&ict, eye, own));
+        // Not asserted (left, issue 21): the lid points move straight by their FAPU, as
+        // alma's turning lid does chord by chord, and pass 0.21–0.23 radii into the
+        // eyeball (ICT's own 0.11); a forward push of the lid skin folded the lower lid.
+        eprintln!(
+            "eye {:?}: depth {depth:.3} against ICT's own {own_depth:.3}",
+            eye.faps
+        );
+    }
+}

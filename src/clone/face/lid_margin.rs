@@ -120,6 +120,28 @@ fn fp(s: &str) -> FeaturePointId {
 }
 
 impl LidMargins {
+    /// One lid's margin (outer corner to inner): its neutral points and the surface vertex
+    /// each moves as, if found.
+    pub fn lid(&self, left: bool, upper: bool) -> Option<(&[Vec3], &[u32])> {
+        self.lids
+            .iter()
+            .find(|l| l.left == left && l.upper == upper)
+            .map(|l| (l.points.as_slice(), l.vertices.as_slice()))
+    }
+
+    /// One eye's outer and inner corner, if known.
+    pub fn corners(&self, left: bool) -> Option<(Vec3, Vec3)> {
+        self.eyes
+            .iter()
+            .find(|e| e.0 == left)
+            .map(|&(_, _, o, i)| (o, i))
+    }
+
+    /// Pupil distance (ES0 in the surface's frame).
+    pub fn es(&self) -> f32 {
+        self.es
+    }
+
     /// The surface vertices on every lid's margin.
     pub fn margin_vertices(&self) -> impl Iterator<Item = u32> + '_ {
         self.lids.iter().flat_map(|l| l.vertices.iter().copied())
@@ -252,7 +274,7 @@ impl LidMargins {
 
 /// The point of polyline `line` nearest `p`: segment start, parameter along the segment,
 /// distance. A single point is a segment of length zero.
-fn nearest_on(line: &[Vec3], p: Vec3) -> (usize, f32, f32) {
+pub(super) fn nearest_on(line: &[Vec3], p: Vec3) -> (usize, f32, f32) {
     let mut best = (0, 0.0, f32::INFINITY);
     let last = line.len().saturating_sub(1);
     for a in 0..line.len() {

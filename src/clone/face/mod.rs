@@ -83,8 +83,11 @@
 //!    (the FAP's own feature point held) until none is rough, at most 40 rounds. Such defects
 //!    come from cloning across styles: target vertices reading unrelated parts of the source
 //!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
-//!    changed. Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more
-//!    after `gain`, whose bump can crease a motion again (bruno → ict's lip corner).
+//!    changed. With [`CloneOptions::smooth_shares`] the turns are checked at a quarter and a
+//!    half of each motion too (the FAT interpolates: a lid turning about its eyeball folds on
+//!    the way, beyond a border check's reach). Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more
+//!    after `gain` and `lid_close`, whose changes can crease a motion again (bruno → ict's
+//!    lip corner).
 //!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
 //!    the FAPU-scaled source motion, turned by the alignment's rotation into the target's own
 //!    axes, by a smooth gain and turn field around it (Wendland C² bump over half an ES0,
@@ -93,6 +96,14 @@
 //!    feature point off the source's peak (a stylised brow onto a real one) no longer leaves
 //!    the FAP half as strong. Not with FAPU scaling off
 //!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
+//!    **`lid_close`** (every method, with [`CloneOptions::lid_close`]; `lid_close.rs`),
+//!    after `gain`: where the source's blink
+//!    closes its eye (its lid points meet under both lid FAPs at one value, in both tables'
+//!    first interval), the target's lid margins are moved vertically so that at that value
+//!    the slit's gap along the corner line is the source's (in IRISD0), the top FAP taking
+//!    the upper margin's share and the bottom FAP the lower's; each change fades into its lid
+//!    within 0.2 ES0. Across styles the surface method left the margin's drop a plateau
+//!    with a steep fall at the corners (alma → ict: 0.10 IRISD0 open, −0.18 crossed).
 //!    **`mouth`** (every method, `mouth_fill.rs`): the target's hidden mouth interior
 //!    (skin behind the lips' front and hidden from the front, reached from the inner lip
 //!    contour) takes a harmonic extension (edges weighed by inverse length) of the lips'
@@ -192,7 +203,7 @@
 //! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
 //! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
 //! the surface (steps 4 and 8), `rescale` step 6, the guard and the gain, `smooth` the smooth
-//! step, `turn_bound` the bound, `rigid`, `part_motion` and `jaw_follow`
+//! step, `lid_close` the slits' closure, `turn_bound` the bound, `rigid`, `part_motion` and `jaw_follow`
 //! step 7, `assemble`, `attached` and `lid_margin` step 8 and `fold` step 9. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
@@ -202,6 +213,7 @@ mod assemble;
 mod attached;
 mod fold;
 mod jaw_follow;
+mod lid_close;
 mod lid_margin;
 mod motions;
 mod mouth_fill;
@@ -583,6 +595,7 @@ fn clone_skin_motions(
         &ssurf.surface,
         &moving,
         &tsurf.surface,
+        opts.smooth_shares,
         &mut result.motions,
     );
     report.timings.push("smooth", clock.elapsed().as_secs_f64());
@@ -608,6 +621,20 @@ fn clone_skin_motions(
         );
         report.timings.push("gain", clock.elapsed().as_secs_f64());
     }
+    // The slits close band by band where the source's does (the margins `smooth` held).
+    let clock = Instant::now();
+    if opts.lid_close {
+        lid_close::close_lids(
+            &ssurf.surface,
+            &moving,
+            &tsurf.surface,
+            [&margins[0], &margins[1]],
+            &mut result.motions,
+        );
+    }
+    report
+        .timings
+        .push("lid_close", clock.elapsed().as_secs_f64());
     // The gain's bump changes the motion after `smooth` looked at it (bruno → ict's lip
     // corner under `viseme_1` turned 12× the source's): the same rule once more. A smooth
     // motion is not changed. Not after the mouth fill: smoothing the uniform-Laplacian way
@@ -618,6 +645,7 @@ fn clone_skin_motions(
         &ssurf.surface,
         &moving,
         &tsurf.surface,
+        opts.smooth_shares,
         &mut result.motions,
     ) {
         *report.smoothed.entry(k).or_default() += n;

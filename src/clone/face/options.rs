@@ -60,6 +60,15 @@ pub struct CloneOptions {
     /// Alignment rotations up to this many degrees are dropped (upright faces of other
     /// proportions; [`Similarity::fit_snapped`](super::Similarity::fit_snapped)). Default 3°.
     pub align_snap_degrees: f64,
+    /// `smooth` checks the turns at a quarter and a half of each motion too (module docs,
+    /// `smooth`): alma's lids onto ICT no longer fold at the eye corners. Default off: the
+    /// extra smoothing lowers the middle of a closing lid's margin against its lid point
+    /// (alma → ICT's lashes follow 75 % of it), which `lashes_follow_lids` rejects.
+    pub smooth_shares: bool,
+    /// Run `lid_close` (module docs): the slit closes band by band where the source's does.
+    /// Default off: at ±1024 the doubled change takes the lower lashes past their lid point
+    /// (alma → ICT 0.14 of the lid opening).
+    pub lid_close: bool,
 }
 
 impl Default for CloneOptions {
@@ -72,6 +81,8 @@ impl Default for CloneOptions {
             rbf_fapu_rescale: true,
             align: true,
             align_snap_degrees: 3.0,
+            smooth_shares: false,
+            lid_close: false,
         }
     }
 }

@@ -7,7 +7,13 @@
 //!
 //! Per motion, with `θ_s` the source's largest normal turn
 //! ([`crate::clone::quality::max_normal_turn`]) and `τ = 1.25 · max(θ_s, 1°)`: every target
-//! triangle turning more than `τ` is *rough*. Its corners and one ring of neighbours around
+//! triangle turning more than `τ` is *rough*. Optionally
+//! ([`CloneOptions::smooth_shares`](super::CloneOptions::smooth_shares)) the same holds at a
+//! quarter and a half of the motion ([`SHARES`]), against the larger of the source's turn there and that share of
+//! `θ_s`: a FAT interpolates between its borders, and a lid turning about its eyeball (alma's:
+//! 170° at ±1024, beyond any slack) is checked on the way — cloned onto ICT it folded at the
+//! eye corners at 256 and 512 (87.6° and 167.2° under `close_t_l_eyelid`, ICT's own FAT 63.5°
+//! and 97.3°; now 73.1° and 102.7°). Its corners and one ring of neighbours around
 //! them are smoothed by damped Laplacian steps (`d_v ← ½ d_v + ½ · mean of its mesh
 //! neighbours`, [`SWEEPS`] of them, everything else held), the rough triangles found again,
 //! and so on up to [`ROUNDS`] times. Small steps take out a spike or a crease (high
@@ -35,6 +41,10 @@ const SLACK: f64 = 1.25;
 const ROUNDS: usize = 40;
 /// Damped Laplacian sweeps per round.
 const SWEEPS: usize = 2;
+/// Shares of each motion, besides the whole, whose turns are checked too: a FAT
+/// interpolates between its borders, and a lid turning about its eyeball folds on the way
+/// (alma's closing lid turns 170° at ±1024, above any slack, but only 5–28° at 256–512).
+pub(super) const SHARES: [f32; 2] = [0.25, 0.5];
 
 /// Unit normal and doubled area of each triangle at `positions` (zero normal: degenerate or
 /// out of range).
@@ -63,10 +73,22 @@ pub(super) fn normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
 /// Whether triangle `t` (neutral unit normal `n0`) turns by more than the angle whose cosine
 /// is `cos_tau` under displacements `d`.
 pub(super) fn rough(positions: &[Vec3], d: &[Vec3], t: &[u32; 3], n0: Vec3, cos_tau: f32) -> bool {
+    rough_at(positions, d, 1.0, t, n0, cos_tau)
+}
+
+/// [`rough`] under `share` of the displacements `d`.
+fn rough_at(
+    positions: &[Vec3],
+    d: &[Vec3],
+    share: f32,
+    t: &[u32; 3],
+    n0: Vec3,
+    cos_tau: f32,
+) -> bool {
     if n0 == Vec3::ZERO {
         return false;
     }
-    let p = |k: usize| positions[t[k] as usize] + d[t[k] as usize];
+    let p = |k: usize| positions[t[k] as usize] + share * d[t[k] as usize];
     let n1 = (p(1) - p(0)).cross(p(2) - p(0));
     let l = n1.length();
     // A collapsed triangle is a fold ([`max_normal_turn`]).
@@ -150,6 +172,8 @@ pub(super) struct SmoothTopology {
     /// The largest normal turn of each source motion (`source_turn`), in the order of the
     /// motions both passes get.
     pub(super) source_turns: Vec<f64>,
+    /// The same at each of the [`SHARES`] of each source motion.
+    pub(super) share_turns: Vec<[f64; SHARES.len()]>,
 }
 
 impl SmoothTopology {
@@ -163,7 +187,11 @@ impl SmoothTopology {
         let source_incident = incident_triangles(source.positions.len(), &source.triangles);
         let source_turns = motions
             .par_iter()
-            .map(|m| source_turn(source, &source_incident, m))
+            .map(|m| source_turn(source, &source_incident, m, 1.0))
+            .collect();
+        let share_turns = motions
+            .par_iter()
+            .map(|m| SHARES.map(|s| source_turn(source, &source_incident, m, s)))
             .collect();
         SmoothTopology {
             adj: adjacency(n, &target.triangles),
@@ -171,16 +199,23 @@ impl SmoothTopology {
             source_incident,
             tn: normals(&target.positions, &target.triangles),
             source_turns,
+            share_turns,
         }
     }
 }
 
-/// The largest normal turn of source motion `src` ([`max_normal_turn`], radians).
-fn source_turn(source: &CloneSurface, source_incident: &[Vec<u32>], src: &SurfaceMotion) -> f64 {
+/// The largest normal turn of source motion `src` at `share` of it ([`max_normal_turn`],
+/// radians).
+fn source_turn(
+    source: &CloneSurface,
+    source_incident: &[Vec<u32>],
+    src: &SurfaceMotion,
+    share: f32,
+) -> f64 {
     let mut sd = source.positions.clone();
     for &(v, o) in &src.offsets {
         if let Some(p) = sd.get_mut(v as usize) {
-            *p += o;
+            *p += share * o;
         }
     }
     // Only a triangle with a moved corner turns.
@@ -192,13 +227,14 @@ fn source_turn(source: &CloneSurface, source_incident: &[Vec<u32>], src: &Surfac
 }
 
 /// The smoothing of every cloned motion (module docs), on the `topology` of `source` and
-/// `target`. Returns, per smoothed motion (`name@value`), how many target vertices were
+/// `target`; `with_shares`: the turns at [`SHARES`] of each motion are checked too. Returns, per smoothed motion (`name@value`), how many target vertices were
 /// re-solved.
 pub(super) fn smooth_motions(
     topology: &SmoothTopology,
     source: &CloneSurface,
     motions: &[SurfaceMotion],
     target: &CloneSurface,
+    with_shares: bool,
     out: &mut [SurfaceMotion],
 ) -> BTreeMap<String, usize> {
     let n = target.positions.len();
@@ -208,6 +244,7 @@ pub(super) fn smooth_motions(
         source_incident,
         tn,
         source_turns,
+        share_turns,
     } = topology;
     let results: Vec<Option<(String, usize)>> = motions
         .par_iter()
@@ -220,18 +257,41 @@ pub(super) fn smooth_motions(
             let theta = source_turns
                 .get(k)
                 .copied()
-                .unwrap_or_else(|| source_turn(source, source_incident, src));
-            let tau = SLACK * theta.max(NORMAL_TURN_FLOOR);
-            if tau >= std::f64::consts::PI {
+                .unwrap_or_else(|| source_turn(source, source_incident, src, 1.0));
+            let shares = share_turns
+                .get(k)
+                .copied()
+                .unwrap_or_else(|| SHARES.map(|s| source_turn(source, source_incident, src, s)));
+            // Each share of the motion against the source's turn at that share, or the
+            // share of its whole turn if more: a triangle displaced straight towards a
+            // rigid turn by θ turns at most share × θ up to half way (alma's lid: 5° at a
+            // quarter of its 170°), and a target's triangles may do what the source's
+            // largest turn does. A share whose slack reaches a half turn checks nothing.
+            let checks: Vec<(f32, f32)> = std::iter::once((1.0, theta))
+                .chain(
+                    SHARES
+                        .into_iter()
+                        .zip(shares)
+                        .filter(|_| with_shares)
+                        .map(|(s, th)| (s, th.max(s as f64 * theta))),
+                )
+                .map(|(s, th)| (s, SLACK * th.max(NORMAL_TURN_FLOOR)))
+                .filter(|&(_, tau)| tau < std::f64::consts::PI)
+                .map(|(s, tau)| (s, tau.cos() as f32))
+                .collect();
+            if checks.is_empty() {
                 return None;
             }
-            let cos_tau = tau.cos() as f32;
             let mut d = dense_field(n, &dst.offsets);
             let pos = &target.positions;
             let tris = &target.triangles;
+            let is_rough = |d: &[Vec3], i: u32| {
+                let (t, n0) = (&tris[i as usize], tn[i as usize]);
+                checks.iter().any(|&(s, c)| rough_at(pos, d, s, t, n0, c))
+            };
             let mut bad: Vec<u32> = touching(incident, &dst.offsets)
                 .into_iter()
-                .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+                .filter(|&i| is_rough(&d, i))
                 .collect();
             if bad.is_empty() {
                 return None;
@@ -298,7 +358,7 @@ pub(super) fn smooth_motions(
                 bad = listed
                     .iter()
                     .copied()
-                    .filter(|&i| rough(pos, &d, &tris[i as usize], tn[i as usize], cos_tau))
+                    .filter(|&i| is_rough(&d, i))
                     .collect();
                 if bad.is_empty() {
                     break;
@@ -375,7 +435,7 @@ mod tests {
         let mut out = src.clone();
         // Built once, as the pipeline does for its two passes.
         let topology = SmoothTopology::new(&s, &src, &s);
-        assert!(smooth_motions(&topology, &s, &src, &s, &mut out).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, true, &mut out).is_empty());
         assert_eq!(out, src);
         // One vertex left still inside the bump (a hole in the correspondence) is a spike.
         let centre = 5 * 11 + 5;
@@ -390,7 +450,7 @@ mod tests {
                 .collect::<Vec<_>>(),
             &s.triangles,
         );
-        let done = smooth_motions(&topology, &s, &src, &s, &mut holed);
+        let done = smooth_motions(&topology, &s, &src, &s, true, &mut holed);
         assert_eq!(done.len(), 1, "{done:?}");
         let d = crate::clone::quality::dense(&holed[0], 121);
         let posed: Vec<Vec3> = s.positions.iter().zip(&d).map(|(p, o)| *p + *o).collect();
@@ -412,7 +472,7 @@ mod tests {
         assert_eq!(d[0], Vec3::ZERO);
         // The pipeline runs the step again after the gain: a motion it settled is left as it is.
         let settled = holed.clone();
-        assert!(smooth_motions(&topology, &s, &src, &s, &mut holed).is_empty());
+        assert!(smooth_motions(&topology, &s, &src, &s, true, &mut holed).is_empty());
         assert_eq!(holed, settled);
     }
 }

@@ -1,0 +1,280 @@
+//! The `lid_close` step (module docs of [`super`]): at the value where the source's blink
+//! closes its eye, the target's slit closes band by band as the source's does.
+//!
+//! The surface method carries a lid's motion vertex by vertex; across styles the margin's
+//! drop comes out a plateau with a steep fall at the corners (alma's lid shell onto ICT's
+//! lid: 0.10 IRISD0 left open near the outer corner, the lids crossing by 0.18 further in).
+//! So, per eye with both lid FAPs (19 and 21, or 20 and 22):
+//!
+//! 1. The source's closing value `v` is where its lid points (3.1 / 3.3, 3.2 / 3.4) meet
+//!    under both FAPs at `v`, within both tables' first interval (else nothing is done), and
+//!    the source's gap between its margins at `v` is read along the corner line (in IRISD0).
+//! 2. The target's margins posed at `v` give its gap along the same line; the difference from
+//!    the source's (in the target's IRISD0) is taken up by the upper margin through the top
+//!    FAP and by the lower one through the bottom FAP, in the shares each FAP closes the
+//!    source's lid points by, as a vertical change of each margin vertex's motion (the FAPs'
+//!    own feature points and the corners keep theirs).
+//! 3. Each change spreads over its lid's side of the corner line, fading out by a Wendland
+//!    bump within [`REACH`] ES0 of the margin. `smooth`'s second pass follows (holding the
+//!    margins there instead creased ICT's lids cloned onto alma's and bruno's: turn ratios
+//!    1.37 → 1.56, 2.03 → 2.75).
+//!
+//! Measured, alma → ICT at alma's closing value 512 (left eye, per band outer → inner,
+//! IRISD0): before 0.01 0.10 −0.18 −0.14 −0.02 0.01 0.00 0.01 −0.08 −0.09 −0.10 0.03, after
+//! 0.05 −0.01 −0.05 −0.07 −0.01 0.07 0.00 0.02 −0.01 −0.00 −0.00 0.04 (ICT's own FAT at its
+//! closing value 493: −0.11 … 0.02, its lids crossing where alma's just meet).
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+
+use super::lid_margin::{nearest_on, LidMargins};
+use super::rescale::bump;
+use super::smooth::{dense_field, sparse_offsets};
+use crate::clone::{CloneSurface, SurfaceMotion};
+use crate::fat::TableKey;
+use crate::spec::{FapId, FeaturePointId};
+
+/// How far (ES0) a margin's change spreads into its lid.
+pub(super) const REACH: f32 = 0.2;
+
+/// One eye: left or not, top and bottom lid FAPs, upper and lower lid points.
+const EYES: [(bool, u8, u8, &str, &str); 2] =
+    [(true, 19, 21, "3.1", "3.3"), (false, 20, 22, "3.2", "3.4")];
+
+/// Index of the motion of FAP `fap` at its smallest positive border, with that border.
+fn first_motion(motions: &[SurfaceMotion], fap: u8) -> Option<(usize, f64)> {
+    let key = TableKey::LowLevel(FapId::new(fap)?);
+    motions
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m.key == key && m.value > 0.0)
+        .min_by(|a, b| a.1.value.total_cmp(&b.1.value))
+        .map(|(k, m)| (k, m.value))
+}
+
+/// A motion's offset at vertex `v` (zero if it has none).
+fn offset(m: &SurfaceMotion, v: u32) -> Vec3 {
+    m.offsets
+        .iter()
+        .find(|o| o.0 == v)
+        .map_or(Vec3::ZERO, |o| o.1)
+}
+
+/// A margin posed at the closing value: per vertex, its place along the corner line (0 at
+/// the outer corner, 1 at the inner) and its height.
+fn posed(
+    surf: &CloneSurface,
+    vertices: &[u32],
+    corners: (Vec3, Vec3),
+    fields: [(&[Vec3], f32); 2],
+) -> Vec<(f32, f32)> {
+    vertices
+        .iter()
+        .map(|&v| {
+            let p = surf.positions[v as usize];
+            let y = p.y + fields.iter().map(|(d, s)| s * d[v as usize].y).sum::<f32>();
+            (along(corners, p), y)
+        })
+        .collect()
+}
+
+/// Place of `p` along the corner line (0 outer, 1 inner), by x.
+fn along((o, i): (Vec3, Vec3), p: Vec3) -> f32 {
+    if (i.x - o.x).abs() > 0.0 {
+        (p.x - o.x) / (i.x - o.x)
+    } else {
+        0.5
+    }
+}
+
+/// Height of a posed margin at place `t` (linear between its vertices, the nearest end
+/// outside them).
+fn height(line: &[(f32, f32)], t: f32) -> Option<f32> {
+    for w in line.windows(2) {
+        let ((t0, y0), (t1, y1)) = (w[0], w[1]);
+        if (t0 <= t && t <= t1) || (t1 <= t && t <= t0) {
+            let s = if t1 != t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+            return Some(y0 + s * (y1 - y0));
+        }
+    }
+    line.iter()
+        .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+        .map(|p| p.1)
+}
+
+/// The source side of one eye: closing value, share of the closing done by the top FAP,
+/// and the gap between its margins along the corner line (IRISD0).
+struct SourceClose {
+    value: f64,
+    top_share: f32,
+    upper: Vec<(f32, f32)>,
+    lower: Vec<(f32, f32)>,
+    irisd: f32,
+}
+
+impl SourceClose {
+    fn gap(&self, t: f32) -> Option<f32> {
+        Some((height(&self.upper, t)? - height(&self.lower, t)?) / self.irisd)
+    }
+}
+
+/// Step 1 for one eye of the source.
+fn source_close(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    margins: &LidMargins,
+    eye: (bool, u8, u8, &str, &str),
+) -> Option<SourceClose> {
+    let (left, top, bottom, up, low) = eye;
+    let (kt, vt) = first_motion(motions, top)?;
+    let (kb, vb) = first_motion(motions, bottom)?;
+    let fp = |s: &str| {
+        s.parse::<FeaturePointId>()
+            .ok()
+            .and_then(|id| source.fp_vertices.get(&id).copied())
+    };
+    let (u, l) = (fp(up)?, fp(low)?);
+    let gap0 = source.positions[u as usize].y - source.positions[l as usize].y;
+    // Closing per unit of FAP value, by each FAP.
+    let rate_t = (offset(&motions[kt], u) - offset(&motions[kt], l)).y / vt as f32;
+    let rate_b = (offset(&motions[kb], u) - offset(&motions[kb], l)).y / vb as f32;
+    let rate = rate_t + rate_b;
+    if !(gap0 > 0.0 && rate < 0.0) {
+        return None;
+    }
+    let value = (-gap0 / rate) as f64;
+    if !(value.is_finite() && value <= vt.min(vb)) {
+        return None;
+    }
+    let corners = margins.corners(left)?;
+    let n = source.positions.len();
+    let (dt, db) = (
+        dense_field(n, &motions[kt].offsets),
+        dense_field(n, &motions[kb].offsets),
+    );
+    let fields = [
+        (dt.as_slice(), (value / vt) as f32),
+        (db.as_slice(), (value / vb) as f32),
+    ];
+    let upper = posed(source, margins.lid(left, true)?.1, corners, fields);
+    let lower = posed(source, margins.lid(left, false)?.1, corners, fields);
+    let irisd = source.fapu.distances.irisd0 as f32;
+    (irisd > 0.0).then_some(SourceClose {
+        value,
+        top_share: (rate_t / rate).clamp(0.0, 1.0),
+        upper,
+        lower,
+        irisd,
+    })
+}
+
+/// The step on every eye (module docs): `motions` are the source's, `out` the cloned ones
+/// (same order), `margins` the target's and the source's. Returns, per changed motion
+/// (`name@value`), how many target vertices changed.
+pub(super) fn close_lids(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    target: &CloneSurface,
+    margins: [&LidMargins; 2],
+    out: &mut [SurfaceMotion],
+) -> BTreeMap<String, usize> {
+    let mut done = BTreeMap::new();
+    let [tm, sm] = margins;
+    let n = target.positions.len();
+    let irisd = target.fapu.distances.irisd0 as f32;
+    for eye in EYES {
+        let (left, top, bottom, up, low) = eye;
+        let Some(sc) = source_close(source, motions, sm, eye) else {
+            continue;
+        };
+        let (Some((kt, vt)), Some((kb, vb))) = (first_motion(out, top), first_motion(out, bottom))
+        else {
+            continue;
+        };
+        let (Some(corners), Some(upper), Some(lower)) =
+            (tm.corners(left), tm.lid(left, true), tm.lid(left, false))
+        else {
+            continue;
+        };
+        let (st, sb) = ((sc.value / vt) as f32, (sc.value / vb) as f32);
+        let mut dt = dense_field(n, &out[kt].offsets);
+        let mut db = dense_field(n, &out[kb].offsets);
+        let fields = [(dt.as_slice(), st), (db.as_slice(), sb)];
+        let pu = posed(target, upper.1, corners, fields);
+        let pl = posed(target, lower.1, corners, fields);
+        // Kept: corners (on both margins) and the FAPs' own feature points.
+        let fixed: Vec<u32> = [up, low]
+            .iter()
+            .filter_map(|s| s.parse::<FeaturePointId>().ok())
+            .filter_map(|id| target.fp_vertices.get(&id).copied())
+            .chain(upper.1.iter().copied().filter(|v| lower.1.contains(v)))
+            .collect();
+        // Per margin vertex, the change of its height at the closing value.
+        let change = |own: &[(f32, f32)], other: &[(f32, f32)], is_upper: bool| -> Vec<f32> {
+            own.iter()
+                .map(|&(t, y)| {
+                    let (Some(o), Some(want)) = (height(other, t), sc.gap(t)) else {
+                        return 0.0;
+                    };
+                    let gap = if is_upper { y - o } else { o - y };
+                    let excess = gap - want * irisd;
+                    if is_upper {
+                        -sc.top_share * excess
+                    } else {
+                        (1.0 - sc.top_share) * excess
+                    }
+                })
+                .collect()
+        };
+        let cu = change(&pu, &pl, true);
+        let cl = change(&pl, &pu, false);
+        let reach = REACH * tm.es();
+        for ((line, verts), ch, share, field, is_upper) in [
+            (upper, cu, st, &mut dt, true),
+            (lower, cl, sb, &mut db, false),
+        ] {
+            let ch: Vec<f32> = verts
+                .iter()
+                .zip(ch)
+                .map(|(v, c)| if fixed.contains(v) { 0.0 } else { c / share })
+                .collect();
+            if !ch.iter().all(|c| c.is_finite()) || share <= 0.0 {
+                continue;
+            }
+            let (o, i) = corners;
+            let side = |p: Vec3| {
+                let t = along(corners, p).clamp(0.0, 1.0);
+                p.y - (o.y + t * (i.y - o.y))
+            };
+            let mut count = 0;
+            for (v, p) in target.positions.iter().enumerate() {
+                let on = verts.contains(&(v as u32));
+                let across = if is_upper { lower.1 } else { upper.1 };
+                if (!on && (side(*p) > 0.0) != is_upper)
+                    || fixed.contains(&(v as u32))
+                    || across.contains(&(v as u32))
+                {
+                    continue;
+                }
+                let (a, t, dist) = nearest_on(line, *p);
+                let w = if on { 1.0 } else { bump(dist / reach) };
+                if w <= 0.0 {
+                    continue;
+                }
+                let b = (a + 1).min(ch.len() - 1);
+                let c = (1.0 - t) * ch[a] + t * ch[b];
+                if c != 0.0 {
+                    field[v].y += w * c;
+                    count += 1;
+                }
+            }
+            let k = if is_upper { kt } else { kb };
+            if count > 0 {
+                out[k].offsets = sparse_offsets(field);
+                done.insert(format!("{}@{}", out[k].key.name(), out[k].value), count);
+            }
+        }
+    }
+    done
+}
