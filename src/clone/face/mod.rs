@@ -529,7 +529,12 @@ fn clone_skin_motions(
             rayon::join(
                 || {
                     (
-                        SmoothTopology::new(&ssurf.surface, &moving, &tsurf.surface),
+                        SmoothTopology::new(
+                            &ssurf.surface,
+                            &moving,
+                            &tsurf.surface,
+                            opts.smooth_shares,
+                        ),
                         [&tsurf.surface, &ssurf.surface].map(lid_margin::LidMargins::of),
                     )
                 },

@@ -172,16 +172,20 @@ pub(super) struct SmoothTopology {
     /// The largest normal turn of each source motion (`source_turn`), in the order of the
     /// motions both passes get.
     pub(super) source_turns: Vec<f64>,
-    /// The same at each of the [`SHARES`] of each source motion.
+    /// The same at each of the [`SHARES`] of each source motion (empty unless built
+    /// `with_shares`).
     pub(super) share_turns: Vec<[f64; SHARES.len()]>,
 }
 
 impl SmoothTopology {
-    /// The tables of `source` and `target`, and the turns of the source `motions`.
+    /// The tables of `source` and `target`, and the turns of the source `motions` (also at
+    /// [`SHARES`] of them if `with_shares`: two more passes over every motion, only for
+    /// [`CloneOptions::smooth_shares`](super::CloneOptions::smooth_shares)).
     pub(super) fn new(
         source: &CloneSurface,
         motions: &[SurfaceMotion],
         target: &CloneSurface,
+        with_shares: bool,
     ) -> Self {
         let n = target.positions.len();
         let source_incident = incident_triangles(source.positions.len(), &source.triangles);
@@ -189,10 +193,14 @@ impl SmoothTopology {
             .par_iter()
             .map(|m| source_turn(source, &source_incident, m, 1.0))
             .collect();
-        let share_turns = motions
-            .par_iter()
-            .map(|m| SHARES.map(|s| source_turn(source, &source_incident, m, s)))
-            .collect();
+        let share_turns = if with_shares {
+            motions
+                .par_iter()
+                .map(|m| SHARES.map(|s| source_turn(source, &source_incident, m, s)))
+                .collect()
+        } else {
+            Vec::new()
+        };
         SmoothTopology {
             adj: adjacency(n, &target.triangles),
             incident: incident_triangles(n, &target.triangles),
@@ -258,10 +266,14 @@ pub(super) fn smooth_motions(
                 .get(k)
                 .copied()
                 .unwrap_or_else(|| source_turn(source, source_incident, src, 1.0));
-            let shares = share_turns
-                .get(k)
-                .copied()
-                .unwrap_or_else(|| SHARES.map(|s| source_turn(source, source_incident, src, s)));
+            let shares = if with_shares {
+                share_turns
+                    .get(k)
+                    .copied()
+                    .unwrap_or_else(|| SHARES.map(|s| source_turn(source, source_incident, src, s)))
+            } else {
+                [0.0; SHARES.len()]
+            };
             // Each share of the motion against the source's turn at that share, or the
             // share of its whole turn if more: a triangle displaced straight towards a
             // rigid turn by θ turns at most share × θ up to half way (alma's lid: 5° at a
@@ -434,7 +446,7 @@ mod tests {
         // The same smooth motion on the target: nothing to do.
         let mut out = src.clone();
         // Built once, as the pipeline does for its two passes.
-        let topology = SmoothTopology::new(&s, &src, &s);
+        let topology = SmoothTopology::new(&s, &src, &s, true);
         assert!(smooth_motions(&topology, &s, &src, &s, true, &mut out).is_empty());
         assert_eq!(out, src);
         // One vertex left still inside the bump (a hole in the correspondence) is a spike.

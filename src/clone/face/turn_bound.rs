@@ -624,7 +624,7 @@ mod tests {
         let theta = turn(&s, &src[0]);
         assert!(before > BOUND * theta, "{before} {theta}");
         bound_turns(
-            &SmoothTopology::new(&s, &src, &t),
+            &SmoothTopology::new(&s, &src, &t, false),
             &s,
             &src,
             &t,
@@ -660,7 +660,7 @@ mod tests {
         let src = vec![motion(slope(&s))];
         let mut out = src.clone();
         assert!(bound_turns(
-            &SmoothTopology::new(&s, &src, &s),
+            &SmoothTopology::new(&s, &src, &s, false),
             &s,
             &src,
             &s,
@@ -715,7 +715,7 @@ mod tests {
             "{before} {theta}"
         );
         let done = bound_turns(
-            &SmoothTopology::new(&s, &src, &t),
+            &SmoothTopology::new(&s, &src, &t, false),
             &s,
             &src,
             &t,
@@ -802,7 +802,7 @@ mod tests {
             );
         }
         let src = vec![motion(slope(&s))];
-        let adj = SmoothTopology::new(&s, &src, &s).adj;
+        let adj = SmoothTopology::new(&s, &src, &s, false).adj;
         let d0: Vec<Vec3> = s
             .positions
             .iter()
