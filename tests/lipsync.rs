@@ -571,6 +571,33 @@ fn hostile_compressed_files_exit_2_naming_the_file_and_write_nothing() {
 // figures before it. With the closure edges set again after merging keys
 // (`speech::lipsync::coarticulation`): 0.513, 0.601, 0.008; the false-closure bound went
 // 0.025 → 0.012, which the 0.014 before fails.
+/// The no-transcript score of `texts` spoken by Festival in every condition, or `None`
+/// (with a note naming test `name`) when the recogniser or a Festival voice is missing.
+fn recognised_on_festival(
+    name: &str,
+    conditions: &[lipsync_eval::Condition],
+    texts: &[&str],
+) -> Option<LipsyncScore> {
+    if !recognition_available()
+        || !conditions
+            .iter()
+            .all(|c| lipsync_eval::festival_voice_available(c.voice))
+    {
+        eprintln!(
+            "skip {name}: needs pocketsphinx pocketsphinx-en-us festival festvox-kallpc16k \
+             festvox-kdlpc16k festvox-us-slt-hts"
+        );
+        return None;
+    }
+    let mut total = LipsyncScore::default();
+    for c in conditions {
+        for text in texts {
+            total.add(&lipsync_eval::run_recognised(text, c, 25.0).unwrap());
+        }
+    }
+    Some(total)
+}
+
 #[test]
 fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
     let name = "without_a_transcript_the_figures_hold_on_real_speakers_voices";
@@ -581,23 +608,10 @@ fn without_a_transcript_the_figures_hold_on_real_speakers_voices() {
         .into_iter()
         .filter(|c| c.synth == lipsync_eval::Synth::Festival && !c.mp3)
         .collect();
-    if !recognition_available()
-        || !conditions
-            .iter()
-            .all(|c| lipsync_eval::festival_voice_available(c.voice))
-    {
-        eprintln!(
-            "skip {name}: needs pocketsphinx pocketsphinx-en-us festival festvox-kallpc16k \
-             festvox-kdlpc16k festvox-us-slt-hts"
-        );
+    let Some(total) = recognised_on_festival(name, &conditions, &lipsync_eval::SENTENCES[..4])
+    else {
         return;
-    }
-    let mut total = LipsyncScore::default();
-    for c in &conditions {
-        for text in &lipsync_eval::SENTENCES[..4] {
-            total.add(&lipsync_eval::run_recognised(text, c, 25.0).unwrap());
-        }
-    }
+    };
     eprintln!(
         "recognised: closures {:.3} ({}/{}), agreement {:.3}, false closures {:.3}",
         total.closure_rate(),
@@ -639,23 +653,9 @@ fn without_a_transcript_clean_real_speakers_meet_the_targets() {
         return;
     }
     let conditions = lipsync_eval::clean_conditions();
-    if !recognition_available()
-        || !conditions
-            .iter()
-            .all(|c| lipsync_eval::festival_voice_available(c.voice))
-    {
-        eprintln!(
-            "skip {name}: needs pocketsphinx pocketsphinx-en-us festival festvox-kallpc16k \
-             festvox-kdlpc16k festvox-us-slt-hts"
-        );
+    let Some(total) = recognised_on_festival(name, &conditions, &lipsync_eval::SENTENCES) else {
         return;
-    }
-    let mut total = LipsyncScore::default();
-    for c in &conditions {
-        for text in lipsync_eval::SENTENCES {
-            total.add(&lipsync_eval::run_recognised(text, c, 25.0).unwrap());
-        }
-    }
+    };
     eprintln!(
         "recognised, clean: closures {:.3} ({}/{}), agreement {:.3}, false closures {:.3} ({}/{})",
         total.closure_rate(),
