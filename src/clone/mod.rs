@@ -24,6 +24,7 @@ pub mod eval;
 pub mod face;
 pub mod fit;
 pub mod fmc;
+mod mouth_interior;
 pub mod quality;
 pub mod rbf;
 mod tri_filter;

@@ -11,14 +11,9 @@
 //!
 //! # The region
 //!
-//! In the aligned frame, with `y_l` the lip line (mean y of 2.2 and 2.3), `z_l` the lips'
-//! front (the smaller z of the two), MNS0 and MW0 the target's units: a skin vertex is
-//! *inside* when it lies in the mouth box (|x − x_l| ≤ 0.9 MW0, y_l − 1.5 MNS0 ≤ y ≤
-//! y_l + 0.8 MNS0), at least [`BEHIND`] × MNS0 behind the lips' front, and hidden from the
-//! front: some skin triangle lies at least [`HIDDEN`] × MNS0 in front of it along +z (a
-//! depth buffer of the skin over the box). Cheeks beside the mouth corners are in front and
-//! stay out; a face without a mouth interior (CANDIDE-3) has no such vertex and is not
-//! changed. Feature points never are inside (they keep what the FAP defines).
+//! The target's hidden mouth interior (`clone/mouth_interior.rs`): in the mouth box,
+//! behind the lips' front, hidden from the front and reached from the inner lip contour. A
+//! face without one (CANDIDE-3) is not changed.
 //!
 //! # The fill
 //!
@@ -40,145 +35,20 @@ use faer::{Mat, Side};
 
 use super::jaw_follow::{chin_rigid, moves_jaw};
 use super::SkinSurface;
+use crate::clone::mouth_interior::{Extent, Mouth};
 use crate::clone::SurfaceMotion;
 use crate::mesh::geometry::adjacency;
-use crate::spec::FeaturePointId as F;
 
-/// How far behind the lips' front (MNS0) a vertex must lie to be inside.
-const BEHIND: f32 = 0.15;
-/// How far in front of it (MNS0) the skin must lie for a vertex to be hidden.
-const HIDDEN: f32 = 0.1;
 /// Deeper than this behind the lips' front (MNS0) the interior takes the prior exactly.
 const DEEP: f32 = 1.5;
-/// The inner lip contour and the lip corners, from which the interior is reached.
-const INNER_LIP: [F; 8] = [
-    F::FP_2_2,
-    F::FP_2_3,
-    F::FP_2_4,
-    F::FP_2_5,
-    F::FP_2_6,
-    F::FP_2_7,
-    F::FP_2_8,
-    F::FP_2_9,
-];
-/// Edge rings around the inner lip contour searched for the interior's first vertices.
-const SEED_RINGS: u8 = 4;
 /// Half the height (MNS0) of the band across the lip line where the jaw's share fades.
 const BAND: f32 = 0.5;
 
-/// The landmarks the region and the prior need (aligned frame).
-#[derive(Clone, Copy, Debug)]
-struct Mouth {
-    x: f32,
-    y: f32,
-    z: f32,
-    mns: f32,
-    mw: f32,
-}
-
-impl Mouth {
-    fn of(tsurf: &SkinSurface) -> Option<Mouth> {
-        let s = &tsurf.surface;
-        let (u, l) = (s.fp(F::FP_2_2)?, s.fp(F::FP_2_3)?);
-        let d = s.fapu.distances;
-        let (mns, mw) = (d.mns0 as f32, d.mw0 as f32);
-        (mns > 0.0 && mw > 0.0).then_some(Mouth {
-            x: 0.5 * (u.x + l.x),
-            y: 0.5 * (u.y + l.y),
-            z: u.z.min(l.z),
-            mns,
-            mw,
-        })
-    }
-
-    fn in_box(&self, p: Vec3) -> bool {
-        (p.x - self.x).abs() <= 0.9 * self.mw
-            && p.y >= self.y - 1.5 * self.mns
-            && p.y <= self.y + 0.8 * self.mns
-    }
-
-    /// The jaw's share at height `y` (module docs).
-    fn jaw_share(&self, y: f64) -> f64 {
-        let b = f64::from(BAND * self.mns);
-        let t = ((f64::from(self.y) + b - y) / (2.0 * b)).clamp(0.0, 1.0);
-        t * t * (3.0 - 2.0 * t)
-    }
-}
-
-/// The front-most skin depth over the mouth box, on a grid.
-struct DepthBuffer {
-    x0: f32,
-    y0: f32,
-    cell: f32,
-    nx: usize,
-    ny: usize,
-    z: Vec<f32>,
-}
-
-impl DepthBuffer {
-    fn new(tsurf: &SkinSurface, mouth: &Mouth) -> DepthBuffer {
-        let s = &tsurf.surface;
-        let cell = mouth.mns / 40.0;
-        let (x0, x1) = (mouth.x - mouth.mw, mouth.x + mouth.mw);
-        let (y0, y1) = (mouth.y - 1.6 * mouth.mns, mouth.y + 0.9 * mouth.mns);
-        let nx = ((x1 - x0) / cell).ceil() as usize + 1;
-        let ny = ((y1 - y0) / cell).ceil() as usize + 1;
-        let mut z = vec![f32::NEG_INFINITY; nx * ny];
-        for t in &s.triangles {
-            let [a, b, c] = t.map(|v| s.positions[v as usize]);
-            let lo = a.min(b).min(c);
-            let hi = a.max(b).max(c);
-            if hi.x < x0 || lo.x > x1 || hi.y < y0 || lo.y > y1 {
-                continue;
-            }
-            let i0 = ((lo.x - x0) / cell).floor().max(0.0) as usize;
-            let i1 = (((hi.x - x0) / cell).ceil().max(0.0) as usize).min(nx - 1);
-            let j0 = ((lo.y - y0) / cell).floor().max(0.0) as usize;
-            let j1 = (((hi.y - y0) / cell).ceil().max(0.0) as usize).min(ny - 1);
-            let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-            if det.abs() < 1e-12 * cell * cell {
-                continue;
-            }
-            for j in j0..=j1 {
-                for i in i0..=i1 {
-                    let (px, py) = (x0 + i as f32 * cell, y0 + j as f32 * cell);
-                    let wb = ((px - a.x) * (c.y - a.y) - (c.x - a.x) * (py - a.y)) / det;
-                    let wc = ((b.x - a.x) * (py - a.y) - (px - a.x) * (b.y - a.y)) / det;
-                    let wa = 1.0 - wb - wc;
-                    if wa >= -1e-4 && wb >= -1e-4 && wc >= -1e-4 {
-                        let depth = wa * a.z + wb * b.z + wc * c.z;
-                        let slot = &mut z[j * nx + i];
-                        *slot = slot.max(depth);
-                    }
-                }
-            }
-        }
-        DepthBuffer {
-            x0,
-            y0,
-            cell,
-            nx,
-            ny,
-            z,
-        }
-    }
-
-    /// The front-most skin depth over `p`'s cell and its neighbours.
-    fn front(&self, p: Vec3) -> f32 {
-        let i = ((p.x - self.x0) / self.cell).round();
-        let j = ((p.y - self.y0) / self.cell).round();
-        if i < 0.0 || j < 0.0 {
-            return f32::NEG_INFINITY;
-        }
-        let (i, j) = (i as usize, j as usize);
-        let mut best = f32::NEG_INFINITY;
-        for jj in j.saturating_sub(1)..=(j + 1).min(self.ny - 1) {
-            for ii in i.saturating_sub(1)..=(i + 1).min(self.nx - 1) {
-                best = best.max(self.z[jj * self.nx + ii]);
-            }
-        }
-        best
-    }
+/// The jaw's share at height `y` (module docs).
+fn jaw_share(mouth: &Mouth, y: f64) -> f64 {
+    let b = f64::from(BAND * mouth.mns);
+    let t = ((f64::from(mouth.y) + b - y) / (2.0 * b)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
 }
 
 /// A harmonic fill over a set of mesh vertices (uniform graph Laplacian, the vertices around
@@ -292,44 +162,11 @@ pub(super) struct MouthInterior {
 impl MouthInterior {
     /// The interior of `tsurf` (module docs), `None` when it has none.
     pub(super) fn new(tsurf: &SkinSurface) -> Option<MouthInterior> {
-        let mouth = Mouth::of(tsurf)?;
         let s = &tsurf.surface;
         let n = s.positions.len();
-        let depth = DepthBuffer::new(tsurf, &mouth);
-        let pinned: std::collections::BTreeSet<u32> = s.fp_vertices.values().copied().collect();
-        let mut candidate = vec![false; n];
-        for (v, p) in s.positions.iter().enumerate() {
-            candidate[v] = mouth.in_box(*p)
-                && !pinned.contains(&(v as u32))
-                && p.z <= mouth.z - BEHIND * mouth.mns
-                && depth.front(*p) >= p.z + HIDDEN * mouth.mns;
-        }
-        // Only what is reached from the inner lip contour: the interior behind the lips,
-        // not a hidden fold elsewhere in the box (under the jaw's angle).
+        let region = crate::clone::mouth_interior::MouthInterior::of(s, Extent::LIPS)?;
+        let (mouth, reached) = (region.mouth, region.inside);
         let adj = adjacency(n, &s.triangles);
-        let mut reached = vec![false; n];
-        let mut queue: std::collections::VecDeque<(u32, u8)> = INNER_LIP
-            .iter()
-            .filter_map(|id| s.fp_vertices.get(id))
-            .map(|&v| (v, 0))
-            .collect();
-        let mut seen = vec![false; n];
-        while let Some((v, rings)) = queue.pop_front() {
-            if std::mem::replace(&mut seen[v as usize], true) {
-                continue;
-            }
-            if candidate[v as usize] {
-                reached[v as usize] = true;
-            } else if rings >= SEED_RINGS {
-                continue;
-            }
-            for &w in &adj[v as usize] {
-                if !seen[w as usize] {
-                    let r = if candidate[v as usize] { 0 } else { rings + 1 };
-                    queue.push_back((w, r));
-                }
-            }
-        }
         let mut free = vec![false; n];
         let mut deep = vec![false; n];
         for (v, p) in s.positions.iter().enumerate() {
@@ -369,7 +206,7 @@ impl MouthInterior {
             match &rigid {
                 Some(r) => {
                     let q = s.positions[v as usize].as_dvec3();
-                    r.at(q) * self.mouth.jaw_share(q.y)
+                    r.at(q) * jaw_share(&self.mouth, q.y)
                 }
                 None => DVec3::ZERO,
             }

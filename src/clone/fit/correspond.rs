@@ -133,6 +133,9 @@ pub(crate) struct Labels<'a> {
     pub sides: &'a [Side],
     /// Whether each vertex lies on a face piece.
     pub face: &'a [bool],
+    /// Whether each vertex lies in the mouth interior, when both surfaces have one (empty
+    /// otherwise: every vertex is outside).
+    pub inside: &'a [bool],
 }
 
 /// Correspondences of every target vertex (`None`: no allowed source triangle, or beyond
@@ -146,7 +149,11 @@ pub(crate) fn correspond(
     scale: f32,
     opts: &FitOptions,
 ) -> Vec<Option<Correspondence>> {
-    let Labels { sides, face } = labels;
+    let Labels {
+        sides,
+        face,
+        inside,
+    } = labels;
     // The source's BVH is built while the target's normals and seams are found.
     let (source, (normals, creases, probes)) = rayon::join(source, || {
         let normals = vertex_normals(target, target_triangles);
@@ -167,6 +174,7 @@ pub(crate) fn correspond(
             let bit = query_bit(
                 sides.get(i).copied().unwrap_or(Side::Other),
                 face.get(i).copied().unwrap_or(true),
+                inside.get(i).copied().unwrap_or(false),
             );
             let nrm = normals.get(i).copied().unwrap_or(Vec3::ZERO);
             // A point on the surface is its own match, whatever the normals at a crease say.

@@ -14,6 +14,12 @@
 //!    on it takes none of the other side's corners. And a vertex of a *face piece* (a
 //!    connected piece holding a skin feature point) only matches face pieces: ICT's eye
 //!    occlusion shell lies against the lid margin and once took the upper lid's motion away.
+//!    Likewise a vertex of the hidden mouth interior (`clone/mouth_interior.rs`: a
+//!    rig head's mouth socket) only matches the other face's interior, and a vertex outside
+//!    it never does: registered onto a face without a socket, ICT's socket was dragged onto
+//!    the target's inner lips, which then read its motion (MediaPipe's canonical face: the
+//!    right lip corner moved 0.6 % of `stretch_r_cornerlip`'s FAPU). Without a source
+//!    interior the target's is matched like any skin (the `mouth` step moves it later).
 //! 2. **Registration** (`register.rs`, `system.rs`): the source's displacement field `u`
 //!    minimises, per step,
 //!    `Σ w_i‖p_i+u_i−c_i‖² + βΣ_l‖p_l+u_l−L_l‖² + α(‖Lu‖² + μ‖∇u‖²) + ε‖u‖²` —
@@ -79,6 +85,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::{CloneSurface, StepTimings, SurfaceCloneResult, SurfaceMotion};
+use crate::clone::mouth_interior::{Extent, MouthInterior};
 use crate::error::Result;
 use crate::mesh::spatial::find_coincident_vertices;
 pub(crate) use correspond::Correspondence;
@@ -324,13 +331,17 @@ fn register_and_correspond(
     let labels = |s: &CloneSurface| {
         let adj = adjacency(s.positions.len(), &s.triangles);
         let (sides, slits) = classify(s, &adj);
-        (adj, sides, slits, face_pieces(s))
+        let inside = MouthInterior::of(s, Extent::SOCKET).map_or_else(Vec::new, |m| m.inside);
+        ((adj, sides, slits, face_pieces(s)), inside)
     };
-    let ((adj, s_sides, s_slits, s_face), ((_, t_sides, t_slits, t_face), loose)) = rayon::join(
+    let (
+        ((adj, s_sides, s_slits, s_face), s_inside),
+        (((_, t_sides, t_slits, t_face), t_inside), loose),
+    ) = rayon::join(
         || labels(source),
         || {
             let t = labels(target);
-            let loose = loose_duplicates(target, &t.1);
+            let loose = loose_duplicates(target, &(t.0).1);
             (t, loose)
         },
     );
@@ -378,15 +389,31 @@ fn register_and_correspond(
         ));
     }
     stats.insert("fit_landmarks".into(), landmarks.len() as f64);
+    for (key, inside) in [
+        ("fit_source_mouth_interior", &s_inside),
+        ("fit_target_mouth_interior", &t_inside),
+    ] {
+        stats.insert(key.into(), inside.iter().filter(|&&i| i).count() as f64);
+    }
     timings.push("sides", clock.elapsed().as_secs_f64());
-    // 2. Registration of the source onto the target.
+    // 2. Registration of the source onto the target. The interiors are kept apart only when
+    // both faces have one: a socket left without matches on a face without one changes
+    // which matches the outlier cut keeps elsewhere (the ICT rig onto alma: a brow crease,
+    // normal-turn ratio 1.35 → 3.57), and the correspondence below keeps the target's lips
+    // off it anyway.
     let clock = Instant::now();
+    let both = !s_inside.is_empty() && !t_inside.is_empty();
+    let (s_reg_inside, t_reg_inside): (&[bool], &[bool]) = if both {
+        (&s_inside, &t_inside)
+    } else {
+        (&[], &[])
+    };
     let scale = face_scale(source);
     let fixed = || {
         QuerySurface::new(
             &target.positions,
             &target.triangles,
-            triangle_masks(&t_sides, &t_face, &target.triangles),
+            triangle_masks(&t_sides, &t_face, t_reg_inside, &target.triangles),
         )
     };
     let moving = Moving {
@@ -395,6 +422,7 @@ fn register_and_correspond(
         adjacency: &adj,
         sides: &s_sides,
         face: &s_face,
+        inside: s_reg_inside,
         landmarks: &landmarks,
         scale,
     };
@@ -418,7 +446,7 @@ fn register_and_correspond(
         QuerySurface::new(
             &reg.positions,
             &source.triangles,
-            triangle_masks(&s_sides, &s_face, &source.triangles),
+            triangle_masks(&s_sides, &s_face, &s_inside, &source.triangles),
         )
     };
     let corr = correspond::correspond(
@@ -427,6 +455,9 @@ fn register_and_correspond(
         correspond::Labels {
             sides: &t_sides,
             face: &t_face,
+            // Without a source interior, the target's own is matched like any skin (the
+            // `mouth` step moves it afterwards).
+            inside: if s_inside.is_empty() { &[] } else { &t_inside },
         },
         registered,
         (&source.triangles, &s_sides),

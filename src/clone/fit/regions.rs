@@ -40,6 +40,14 @@ pub(crate) const SEEN_BY_ALL: TriMask = 0b111;
 /// Triangle bit: on a face piece ([`face_pieces`]). Query bit: sees only such triangles.
 pub(crate) const FACE_PIECE: TriMask = 0b1000;
 
+/// Triangle bit: seen by queries from the mouth interior (a corner inside,
+/// [`crate::clone::mouth_interior`]). Query bit: a vertex inside the mouth.
+pub(crate) const INTERIOR: TriMask = 0b1_0000;
+
+/// Triangle bit: seen by queries from outside the mouth interior (a corner outside). Query
+/// bit: a vertex outside. A triangle across the interior's border has both.
+pub(crate) const EXTERIOR: TriMask = 0b10_0000;
+
 /// Per vertex, whether it lies on a face piece: a connected piece of the surface holding a
 /// skin feature point. The other pieces — ICT's eye occlusion and lacrimal shells, lashes,
 /// a one-mesh source's eyeballs and teeth — may touch the skin (the occlusion shell lies
@@ -211,10 +219,12 @@ pub(crate) fn classify(s: &CloneSurface, adj: &[Vec<u32>]) -> (Vec<Side>, usize)
     (sides, slits.len())
 }
 
-/// Triangle masks from vertex sides (module docs) and face pieces (`face`, per vertex).
+/// Triangle masks from vertex sides (module docs), face pieces (`face`, per vertex) and
+/// the mouth interior (`inside`, per vertex; empty when the face has none).
 pub(crate) fn triangle_masks(
     sides: &[Side],
     face: &[bool],
+    inside: &[bool],
     triangles: &[[u32; 3]],
 ) -> Vec<TriMask> {
     triangles
@@ -225,6 +235,10 @@ pub(crate) fn triangle_masks(
             } else {
                 0
             };
+            let is_in = |v: &u32| inside.get(*v as usize).copied().unwrap_or(false);
+            let mouth = if t.iter().any(is_in) { INTERIOR } else { 0 }
+                | if t.iter().all(is_in) { 0 } else { EXTERIOR };
+            let piece = piece | mouth;
             let has = |w: Side| t.iter().any(|&v| sides.get(v as usize) == Some(&w));
             piece
                 | match (has(Side::Upper), has(Side::Lower)) {
@@ -270,23 +284,24 @@ pub(crate) fn own_side_weights(
 }
 
 /// The mask bits a query from a vertex of side `s` needs (`face`: the vertex lies on a
-/// face piece, and sees only face-piece triangles).
-pub(crate) fn query_bit(s: Side, face: bool) -> TriMask {
+/// face piece, and sees only face-piece triangles; `inside`: the vertex lies in the mouth
+/// interior, and sees only triangles with a corner there — else only triangles with a
+/// corner outside).
+pub(crate) fn query_bit(s: Side, face: bool, inside: bool) -> TriMask {
     let side = match s {
         Side::Upper => 0b001,
         Side::Lower => 0b010,
         Side::Other => 0b100,
     };
-    if face {
-        side | FACE_PIECE
-    } else {
-        side
-    }
+    let piece = if face { FACE_PIECE } else { 0 };
+    side | piece | if inside { INTERIOR } else { EXTERIOR }
 }
 
 /// Whether a triangle of mask `mask` passes a query of bits `bit` ([`query_bit`]).
 pub(crate) fn mask_passes(mask: TriMask, bit: TriMask) -> bool {
-    mask & bit & SEEN_BY_ALL != 0 && (bit & FACE_PIECE == 0 || mask & FACE_PIECE != 0)
+    mask & bit & SEEN_BY_ALL != 0
+        && (bit & FACE_PIECE == 0 || mask & FACE_PIECE != 0)
+        && mask & bit & (INTERIOR | EXTERIOR) != 0
 }
 
 #[cfg(test)]
@@ -312,15 +327,37 @@ mod tests {
     fn bridging_triangles_are_seen_from_both_sides_and_pieces_stay_apart() {
         let sides = [Side::Upper, Side::Lower, Side::Other, Side::Upper];
         let face = [true, true, true, false];
-        let masks = triangle_masks(&sides, &face, &[[0, 1, 2], [3, 3, 3], [0, 2, 2]]);
+        let masks = triangle_masks(&sides, &face, &[], &[[0, 1, 2], [3, 3, 3], [0, 2, 2]]);
         // Bridging: every side, on the face.
-        assert!(mask_passes(masks[0], query_bit(Side::Upper, true)));
-        assert!(mask_passes(masks[0], query_bit(Side::Lower, true)));
+        assert!(mask_passes(masks[0], query_bit(Side::Upper, true, false)));
+        assert!(mask_passes(masks[0], query_bit(Side::Lower, true, false)));
         // Off the face: not for a face vertex, fine for another piece's vertex.
-        assert!(!mask_passes(masks[1], query_bit(Side::Upper, true)));
-        assert!(mask_passes(masks[1], query_bit(Side::Upper, false)));
+        assert!(!mask_passes(masks[1], query_bit(Side::Upper, true, false)));
+        assert!(mask_passes(masks[1], query_bit(Side::Upper, false, false)));
         // Upper only: not for a lower query.
-        assert!(!mask_passes(masks[2], query_bit(Side::Lower, true)));
-        assert!(mask_passes(masks[2], query_bit(Side::Other, false)));
+        assert!(!mask_passes(masks[2], query_bit(Side::Lower, true, false)));
+        assert!(mask_passes(masks[2], query_bit(Side::Other, false, false)));
+    }
+
+    #[test]
+    fn the_mouth_interior_and_the_outside_see_only_their_own_triangles() {
+        let sides = [Side::Other; 4];
+        let face = [true; 4];
+        // 0 and 1 inside the mouth, 2 and 3 outside.
+        let inside = [true, true, false, false];
+        let masks = triangle_masks(&sides, &face, &inside, &[[0, 1, 0], [0, 1, 2], [2, 3, 2]]);
+        let (q_in, q_out) = (
+            query_bit(Side::Other, true, true),
+            query_bit(Side::Other, true, false),
+        );
+        // Wholly inside: only for inside queries.
+        assert!(mask_passes(masks[0], q_in) && !mask_passes(masks[0], q_out));
+        // Across the border: for both.
+        assert!(mask_passes(masks[1], q_in) && mask_passes(masks[1], q_out));
+        // Wholly outside: only for outside queries.
+        assert!(!mask_passes(masks[2], q_in) && mask_passes(masks[2], q_out));
+        // A face without an interior: every triangle is outside.
+        let none = triangle_masks(&sides, &face, &[], &[[0, 1, 2]]);
+        assert!(!mask_passes(none[0], q_in) && mask_passes(none[0], q_out));
     }
 }

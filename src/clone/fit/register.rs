@@ -62,6 +62,10 @@ pub(crate) struct Moving<'a> {
     pub sides: &'a [Side],
     /// Whether each vertex lies on a face piece ([`super::regions::face_pieces`]).
     pub face: &'a [bool],
+    /// Whether each vertex lies in the mouth interior (`clone/mouth_interior.rs`;
+    /// empty when the surface has none): such a vertex matches only the fixed surface's
+    /// interior, and stays unmatched (held by its neighbours) when that has none.
+    pub inside: &'a [bool],
     /// `(vertex, landmark position on the fixed surface)`.
     pub landmarks: &'a [(u32, Vec3)],
     /// A length of the face (ES0), for the distance limits.
@@ -162,7 +166,11 @@ pub(crate) fn register(
                     fixed,
                     x[i],
                     normals[i],
-                    query_bit(m.sides[i], m.face.get(i).copied().unwrap_or(true)),
+                    query_bit(
+                        m.sides[i],
+                        m.face.get(i).copied().unwrap_or(true),
+                        m.inside.get(i).copied().unwrap_or(false),
+                    ),
                     b,
                     previous[i],
                 )
