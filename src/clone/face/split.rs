@@ -650,7 +650,9 @@ fn eye_layers(
             .min_by(|a, b| q.distance(a.1).total_cmp(&q.distance(b.1)))
             .map(|b| b.0)
     };
-    let lids = LidSurface::of(face, frames, eps, &on_ball);
+    // The lids' surface (a BVH over the skin) is built at the first rim it must measure:
+    // most faces have no eye layer to sort.
+    let mut lids: Option<Option<LidSurface>> = None;
     let mut out = Vec::new();
     for mi in candidates {
         let mesh = &face.meshes[mi].mesh;
@@ -674,18 +676,21 @@ fn eye_layers(
                 Some(_) => LayerPiece::BothEyes,
             });
         }
-        if let Some(lids) = &lids {
-            for v in rim_vertices(mesh, eps) {
-                let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
-                    continue;
-                };
-                let Some(LayerPiece::Eye(part)) = fate[k] else {
-                    continue;
-                };
-                let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
-                if lids.within(q, LID_CLEARANCE * radius) {
-                    fate[k] = Some(LayerPiece::OnLids);
-                }
+        for v in rim_vertices(mesh, eps) {
+            let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
+                continue;
+            };
+            let Some(LayerPiece::Eye(part)) = fate[k] else {
+                continue;
+            };
+            let Some(lids) =
+                lids.get_or_insert_with(|| LidSurface::of(face, frames, eps, &on_ball))
+            else {
+                break;
+            };
+            let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
+            if lids.within(q, LID_CLEARANCE * radius) {
+                fate[k] = Some(LayerPiece::OnLids);
             }
         }
         out.push(EyeLayer {
