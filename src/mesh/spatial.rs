@@ -1,8 +1,6 @@
 //! Nearest-vertex queries over a k-d tree, and detection of coincident (duplicated) vertices.
 
-use std::collections::HashMap;
-
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
@@ -147,7 +145,10 @@ fn squared_distance(a: Vec3, b: Vec3) -> f32 {
 }
 
 /// Every ordered pair `(i, j)`, `i ≠ j`, of finite points within `epsilon` (squared distance
-/// ≤ `epsilon²`), by a grid; `None` when the cells cannot be numbered.
+/// ≤ `epsilon²`), by a grid; `None` when the cells cannot be numbered. The points are sorted
+/// by a hash of their cell: a cell's points lie side by side (with those of any cell sharing
+/// its hash, which the distance test then turns away), and a point whose `epsilon` box
+/// crosses into other cells finds theirs by a binary search.
 fn grid_pairs(positions: &[Vec3], epsilon: f32) -> Option<Vec<(u32, u32)>> {
     if !(epsilon > 0.0 && epsilon.is_finite()) {
         return None;
@@ -157,60 +158,71 @@ fn grid_pairs(positions: &[Vec3], epsilon: f32) -> Option<Vec<(u32, u32)>> {
         let c = (x / cell).floor();
         (c.abs() < 1e15).then_some(c as i64)
     };
-    let key = |p: [f64; 3]| -> Option<[i64; 3]> {
-        Some([coordinate(p[0])?, coordinate(p[1])?, coordinate(p[2])?])
+    let key = |p: DVec3| -> Option<[i64; 3]> {
+        Some([coordinate(p.x)?, coordinate(p.y)?, coordinate(p.z)?])
     };
-    let mut keyed: Vec<([i64; 3], u32)> = Vec::with_capacity(positions.len());
+    let hash = |c: [i64; 3]| {
+        (c[0] as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (c[1] as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+            ^ (c[2] as u64).wrapping_mul(0x1656_67B1_9E37_79F9)
+    };
+    let mut keyed: Vec<(u64, u32)> = Vec::with_capacity(positions.len());
     for (i, p) in positions.iter().enumerate() {
         if p.is_finite() {
-            keyed.push((key(p.as_dvec3().to_array())?, i as u32));
+            keyed.push((hash(key(p.as_dvec3())?), i as u32));
         }
     }
-    keyed.sort_unstable();
-    let mut cells: HashMap<[i64; 3], (usize, usize)> = HashMap::with_capacity(keyed.len());
-    let mut a = 0;
-    while a < keyed.len() {
-        let mut b = a + 1;
-        while b < keyed.len() && keyed[b].0 == keyed[a].0 {
-            b += 1;
-        }
-        cells.insert(keyed[a].0, (a, b));
-        a = b;
-    }
+    keyed.par_sort_unstable();
+    let keyed = &keyed;
+    // The points of the cells with hash `h`.
+    let run = |h: u64| {
+        let a = keyed.partition_point(|e| e.0 < h);
+        let b = a + keyed[a..].partition_point(|e| e.0 == h);
+        &keyed[a..b]
+    };
     // The box searched: a little wider than `epsilon`, beyond any rounding of the squared
     // distance test.
     let reach = epsilon as f64 * (1.0 + 1e-3);
     let r2 = epsilon * epsilon;
-    let pairs = (0..positions.len())
+    let pairs = (0..keyed.len())
         .into_par_iter()
-        .flat_map_iter(|i| {
-            let p = positions[i];
-            let mut out = Vec::new();
+        .flat_map_iter(|k| {
+            let (h, i) = keyed[k];
+            let p = positions[i as usize];
             let q = p.as_dvec3();
-            let (Some(lo), Some(hi)) = (key((q - reach).to_array()), key((q + reach).to_array()))
-            else {
-                return out.into_iter();
+            let mut out = Vec::new();
+            let mut take = |near: &[(u64, u32)]| {
+                for &(_, j) in near {
+                    if j != i && squared_distance(p, positions[j as usize]) <= r2 {
+                        out.push((i, j));
+                    }
+                }
             };
-            if !p.is_finite() {
-                return out.into_iter();
-            }
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        let Some(&(a, b)) = cells.get(&[x, y, z]) else {
-                            continue;
-                        };
-                        for &(_, j) in &keyed[a..b] {
-                            if j as usize != i && squared_distance(p, positions[j as usize]) <= r2 {
-                                out.push((i as u32, j));
+            match (key(q - reach), key(q + reach)) {
+                (Some(lo), Some(hi)) if lo == hi => {
+                    // Within its own cell: the run around it.
+                    let a = keyed[..k].iter().rev().take_while(|e| e.0 == h).count();
+                    let b = keyed[k..].iter().take_while(|e| e.0 == h).count();
+                    take(&keyed[k - a..k + b]);
+                }
+                (Some(lo), Some(hi)) => {
+                    for x in lo[0]..=hi[0] {
+                        for y in lo[1]..=hi[1] {
+                            for z in lo[2]..=hi[2] {
+                                take(run(hash([x, y, z])));
                             }
                         }
                     }
                 }
+                _ => {}
             }
             out.into_iter()
         })
-        .collect();
+        .collect::<Vec<_>>();
+    let mut pairs = pairs;
+    // Two cells of one box sharing a hash list their points twice.
+    pairs.sort_unstable();
+    pairs.dedup();
     Some(pairs)
 }
 
