@@ -993,15 +993,26 @@ fn sub_mesh(mesh: &Mesh, polys: &[usize], keep: Option<&[u32]>) -> (Mesh, BTreeM
         .enumerate()
         .map(|(i, &v)| (v, i as u32))
         .collect();
+    // The map as a table (a tree lookup per polygon corner was most of a head's cut).
+    let mut table = vec![u32::MAX; vertices.last().map_or(0, |&v| v as usize + 1)];
+    for (i, &v) in vertices.iter().enumerate() {
+        table[v as usize] = i as u32;
+    }
     let pick = |src: &Polygons, remap: bool| {
         let mut out = Polygons::new();
+        let mut p: Vec<u32> = Vec::new();
         for &pi in polys {
             let poly = src.get(pi).unwrap_or(&[]);
-            let p: Vec<u32> = if remap {
-                poly.iter().filter_map(|v| map.get(v).copied()).collect()
+            p.clear();
+            if remap {
+                p.extend(
+                    poly.iter()
+                        .filter_map(|&v| table.get(v as usize).copied())
+                        .filter(|&i| i != u32::MAX),
+                );
             } else {
-                poly.to_vec()
-            };
+                p.extend_from_slice(poly);
+            }
             out.push(&p);
         }
         out
