@@ -87,7 +87,7 @@ pub struct CoincidentVertices {
 /// vertices `2·epsilon` apart may land in different clusters — fine for exact or near-exact
 /// duplicates, which is the use case. Non-finite positions are never merged.
 ///
-/// The pairs within `epsilon` come from a grid of cells [`CELL`] × `epsilon` wide (a point
+/// The pairs within `epsilon` come from a grid of cells `CELL` × `epsilon` wide (a point
 /// looks only into the cells its `epsilon` box touches: nearly always its own), in parallel;
 /// a k-d tree, several times slower on a head's tens of thousands of vertices (a clone
 /// calls this a dozen times), stands in when the cells cannot be numbered (`epsilon` 0,

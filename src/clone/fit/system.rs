@@ -383,7 +383,7 @@ mod tests {
                 .map(|i| if (i * 7 + step) % 3 == 0 { 1.0 } else { 1e-6 })
                 .collect();
             let rhs: Vec<[f64; 3]> = (0..n)
-                .map(|i| [i as f64 * 1e-3, (i % 11) as f64, -((i + step) % 5) as f64])
+                .map(|i| [i as f64 * 1e-3, (i % 11) as f64, -(((i + step) % 5) as f64)])
                 .collect();
             let a = ordered.solve(alpha, &diag, &rhs).unwrap();
             let b = plain.solve(alpha, &diag, &rhs).unwrap();
