@@ -14,6 +14,22 @@
 //! Most of that step's work on this pair is one motion (`open_jaw`: 2 900 vertices
 //! re-solved; under load its held rounds 109 ms and its spread rounds, never kept here, 75 ms,
 //! of ~250 ms for all twelve motions bounded). Not re-measured on a quiet machine.
+//!
+//! Helper `speed6` (lead's figure before it, quiet machine, load 0.8: 343.1 ms median; parts
+//! 33, fit:register 164, bound 47, fold 23 ms): coincident vertices found on a grid instead of
+//! a k-d tree (about a dozen calls per clone on the head's 24–27k vertices), the
+//! registration's eleven factorisations without faer reordering the matrix each time, the
+//! one-mesh head's cut remapping polygons through a table, the target check counting edges
+//! without a hash map, the lids' BVH built only when an eye layer needs it. Every output bit
+//! for bit the same (a hash of the whole cloned face's `Debug` text, 5 clones, old and new
+//! alike). Measured only on the shared machine (load 9–13, four sessions building):
+//! alternated 5-clone runs of a probe doing this clone, CPU time (user, 5 clones and the
+//! set-up) 2.80 / 2.84 s → 2.70 / 2.71 s; the serial `parts` step 95 / 232 / 289 →
+//! 61 / 104 / 126 ms (its share of the wall time under that load); wall medians (2.5–5 s
+//! at that load) within the noise. The 0.3 s target is not shown; quiet-machine gain
+//! expected ~15–25 ms (parts ~33 → ~15, the factorisations ~10 % each, the unnamed time
+//! before `align` where the target check runs). Peak memory 98–108 MB (unchanged within the
+//! noise of the allocator).
 
 use std::path::Path;
 use std::sync::OnceLock;
