@@ -25,11 +25,13 @@
 //! alike). Measured only on the shared machine (load 9–13, four sessions building):
 //! alternated 5-clone runs of a probe doing this clone, CPU time (user, 5 clones and the
 //! set-up) 2.80 / 2.84 s → 2.70 / 2.71 s; the serial `parts` step 95 / 232 / 289 →
-//! 61 / 104 / 126 ms (its share of the wall time under that load); wall medians (2.5–5 s
-//! at that load) within the noise. The 0.3 s target is not shown; quiet-machine gain
+//! 61 / 104 / 126 ms (its share of the wall time under that load). This bench (`-- fit`),
+//! old and new binaries alternated at load 10–12.7: medians 3.395 / 3.021 s → 2.757 /
+//! 2.811 s, fastest 2.837 / 2.637 → 2.560 / 2.648 s (the register and bound steps swing by
+//! ±20 % between runs at that load). The 0.3 s target is not shown; quiet-machine gain
 //! expected ~15–25 ms (parts ~33 → ~15, the factorisations ~10 % each, the unnamed time
-//! before `align` where the target check runs). Peak memory 98–108 MB (unchanged within the
-//! noise of the allocator).
+//! before `align` where the target check runs). Peak memory: bench 98–99 → 100 MB, probe
+//! 98–99 → 102–108 MB (the grid's sort buffers; within 200 MB).
 
 use std::path::Path;
 use std::sync::OnceLock;
