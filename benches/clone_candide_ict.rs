@@ -31,7 +31,7 @@
 //! ±20 % between runs at that load). The 0.3 s target is not shown; quiet-machine gain
 //! expected ~15–25 ms (parts ~33 → ~15, the factorisations ~10 % each, the unnamed time
 //! before `align` where the target check runs). Peak memory: bench 98–99 → 100 MB, probe
-//! 98–99 → 102–108 MB (the grid's sort buffers; within 200 MB).
+//! 98–99 → 102–108 MB (not traced; the grid holds 16 bytes a vertex while it runs; within 200 MB).
 
 use std::path::Path;
 use std::sync::OnceLock;
