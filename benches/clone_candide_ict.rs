@@ -14,6 +14,24 @@
 //! Most of that step's work on this pair is one motion (`open_jaw`: 2 900 vertices
 //! re-solved; under load its held rounds 109 ms and its spread rounds, never kept here, 75 ms,
 //! of ~250 ms for all twelve motions bounded). Not re-measured on a quiet machine.
+//!
+//! Helper `speed6` (lead's figure before it, quiet machine, load 0.8: 343.1 ms median; parts
+//! 33, fit:register 164, bound 47, fold 23 ms): coincident vertices found on a grid instead of
+//! a k-d tree (about a dozen calls per clone on the head's 24–27k vertices), the
+//! registration's eleven factorisations without faer reordering the matrix each time, the
+//! one-mesh head's cut remapping polygons through a table, the target check counting edges
+//! without a hash map, the lids' BVH built only when an eye layer needs it. Every output bit
+//! for bit the same (a hash of the whole cloned face's `Debug` text, 5 clones, old and new
+//! alike). Measured only on the shared machine (load 9–13, four sessions building):
+//! alternated 5-clone runs of a probe doing this clone, CPU time (user, 5 clones and the
+//! set-up) 2.80 / 2.84 s → 2.70 / 2.71 s; the serial `parts` step 95 / 232 / 289 →
+//! 61 / 104 / 126 ms (its share of the wall time under that load). This bench (`-- fit`),
+//! old and new binaries alternated at load 10–12.7: medians 3.395 / 3.021 s → 2.757 /
+//! 2.811 s, fastest 2.837 / 2.637 → 2.560 / 2.648 s (the register and bound steps swing by
+//! ±20 % between runs at that load). The 0.3 s target is not shown; quiet-machine gain
+//! expected ~15–25 ms (parts ~33 → ~15, the factorisations ~10 % each, the unnamed time
+//! before `align` where the target check runs). Peak memory: bench 98–99 → 100 MB, probe
+//! 98–99 → 102–108 MB (not traced; the grid holds 16 bytes a vertex while it runs; within 200 MB).
 
 use std::path::Path;
 use std::sync::OnceLock;

@@ -650,7 +650,9 @@ fn eye_layers(
             .min_by(|a, b| q.distance(a.1).total_cmp(&q.distance(b.1)))
             .map(|b| b.0)
     };
-    let lids = LidSurface::of(face, frames, eps, &on_ball);
+    // The lids' surface (a BVH over the skin) is built at the first rim it must measure:
+    // most faces have no eye layer to sort.
+    let mut lids: Option<Option<LidSurface>> = None;
     let mut out = Vec::new();
     for mi in candidates {
         let mesh = &face.meshes[mi].mesh;
@@ -674,18 +676,21 @@ fn eye_layers(
                 Some(_) => LayerPiece::BothEyes,
             });
         }
-        if let Some(lids) = &lids {
-            for v in rim_vertices(mesh, eps) {
-                let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
-                    continue;
-                };
-                let Some(LayerPiece::Eye(part)) = fate[k] else {
-                    continue;
-                };
-                let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
-                if lids.within(q, LID_CLEARANCE * radius) {
-                    fate[k] = Some(LayerPiece::OnLids);
-                }
+        for v in rim_vertices(mesh, eps) {
+            let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
+                continue;
+            };
+            let Some(LayerPiece::Eye(part)) = fate[k] else {
+                continue;
+            };
+            let Some(lids) =
+                lids.get_or_insert_with(|| LidSurface::of(face, frames, eps, &on_ball))
+            else {
+                break;
+            };
+            let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
+            if lids.within(q, LID_CLEARANCE * radius) {
+                fate[k] = Some(LayerPiece::OnLids);
             }
         }
         out.push(EyeLayer {
@@ -988,15 +993,26 @@ fn sub_mesh(mesh: &Mesh, polys: &[usize], keep: Option<&[u32]>) -> (Mesh, BTreeM
         .enumerate()
         .map(|(i, &v)| (v, i as u32))
         .collect();
+    // The map as a table (a tree lookup per polygon corner was most of a head's cut).
+    let mut table = vec![u32::MAX; vertices.last().map_or(0, |&v| v as usize + 1)];
+    for (i, &v) in vertices.iter().enumerate() {
+        table[v as usize] = i as u32;
+    }
     let pick = |src: &Polygons, remap: bool| {
         let mut out = Polygons::new();
+        let mut p: Vec<u32> = Vec::new();
         for &pi in polys {
             let poly = src.get(pi).unwrap_or(&[]);
-            let p: Vec<u32> = if remap {
-                poly.iter().filter_map(|v| map.get(v).copied()).collect()
+            p.clear();
+            if remap {
+                p.extend(
+                    poly.iter()
+                        .filter_map(|&v| table.get(v as usize).copied())
+                        .filter(|&i| i != u32::MAX),
+                );
             } else {
-                poly.to_vec()
-            };
+                p.extend_from_slice(poly);
+            }
             out.push(&p);
         }
         out

@@ -80,28 +80,9 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<Diagnostic>) {
         )));
     }
 
-    // Edges: how often each is used, and in which direction.
-    let mut edges: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
-    for poly in mesh.polygons.iter() {
-        if poly.len() < 3 || poly.iter().any(|&v| v as usize >= np) {
-            continue;
-        }
-        for k in 0..poly.len() {
-            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-            if a == b {
-                continue;
-            }
-            let e = edges.entry((a.min(b), a.max(b))).or_default();
-            if a < b {
-                e.0 += 1;
-            } else {
-                e.1 += 1;
-            }
-        }
-    }
-    // Edge → (uses a→b, uses b→a), in a fixed order so the places named are stable.
-    let mut sorted: Vec<_> = edges.into_iter().collect();
-    sorted.sort_unstable();
+    // Edges: how often each is used, and in which direction. Edge → (uses a→b, uses b→a),
+    // in a fixed order so the places named are stable.
+    let sorted = edge_uses(&mesh.polygons, np);
     let place = |(a, b): (u32, u32)| format!("edge {a}-{b}");
     let non_manifold: Vec<String> = sorted
         .iter()
@@ -172,6 +153,47 @@ fn check_mesh(target: &FaceModel, m: usize, warnings: &mut Vec<Diagnostic>) {
     }
 }
 
+/// Every edge `(a, b)`, `a < b`, of the polygons (those with an index out of range left out)
+/// with how often it runs a→b and b→a, sorted by edge. Gathered per lower end, as an
+/// adjacency list is (a hash map of a head's edges cost several times more).
+fn edge_uses(polygons: &crate::mesh::Polygons, np: usize) -> Vec<((u32, u32), (u32, u32))> {
+    let valid = |poly: &[u32]| poly.len() >= 3 && poly.iter().all(|&v| (v as usize) < np);
+    fn sides(poly: &[u32]) -> impl Iterator<Item = (u32, u32)> + '_ {
+        (0..poly.len())
+            .map(|k| (poly[k], poly[(k + 1) % poly.len()]))
+            .filter(|(a, b)| a != b)
+    }
+    let mut start = vec![0usize; np + 1];
+    for poly in polygons.iter().filter(|p| valid(p)) {
+        for (a, b) in sides(poly) {
+            start[a.min(b) as usize + 1] += 1;
+        }
+    }
+    for v in 0..np {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    // (upper end, runs a→b)
+    let mut ends = vec![(0u32, false); start[np]];
+    for poly in polygons.iter().filter(|p| valid(p)) {
+        for (a, b) in sides(poly) {
+            let lo = a.min(b) as usize;
+            ends[fill[lo]] = (a.max(b), a < b);
+            fill[lo] += 1;
+        }
+    }
+    let mut out = Vec::new();
+    for a in 0..np {
+        let run = &mut ends[start[a]..start[a + 1]];
+        run.sort_unstable_by_key(|e| e.0);
+        for e in run.chunk_by(|x, y| x.0 == y.0) {
+            let forward = e.iter().filter(|x| x.1).count() as u32;
+            out.push(((a as u32, e[0].0), (forward, e.len() as u32 - forward)));
+        }
+    }
+    out
+}
+
 /// Feature points far from every vertex, and feature points at the same place.
 fn check_feature_points(target: &FaceModel, warnings: &mut Vec<Diagnostic>) {
     let frames = target.frames();
@@ -232,5 +254,54 @@ fn check_feature_points(target: &FaceModel, warnings: &mut Vec<Diagnostic>) {
             "target feature points coincide: {}; distances measured between them are zero",
             same.join(", ")
         )));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Polygons;
+
+    #[test]
+    fn edge_uses_count_each_direction_per_edge_in_order() {
+        let mut polygons = Polygons::new();
+        // Two triangles sharing 1-2 the right way and a third on it (non-manifold), two
+        // wound the same way along 3-4 (flipped), a quad, a degenerate corner and an index
+        // out of range.
+        for p in [
+            &[0u32, 1, 2][..],
+            &[2, 1, 3],
+            &[2, 3, 4],
+            &[3, 4, 6],
+            &[1, 2, 5],
+            &[5, 6, 7, 4],
+            &[6, 6, 7],
+            &[0, 1, 99],
+        ] {
+            polygons.push(p);
+        }
+        let np = 8;
+        let mut want: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+        for poly in polygons.iter() {
+            if poly.len() < 3 || poly.iter().any(|&v| v as usize >= np) {
+                continue;
+            }
+            for k in 0..poly.len() {
+                let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                if a != b {
+                    let e = want.entry((a.min(b), a.max(b))).or_default();
+                    if a < b {
+                        e.0 += 1;
+                    } else {
+                        e.1 += 1;
+                    }
+                }
+            }
+        }
+        let mut want: Vec<_> = want.into_iter().collect();
+        want.sort_unstable();
+        let got = edge_uses(&polygons, np);
+        assert_eq!(got, want);
+        assert!(got.contains(&((1, 2), (2, 1))) && got.contains(&((3, 4), (2, 0))));
     }
 }
