@@ -17,6 +17,9 @@ use fbakit::clone::eval::{compliance, normal_turns, ComplianceReport, NormalTurn
 use fbakit::clone::face::{clone_face, CloneOptions, CloneOutcome};
 use fbakit::export::picture::strip_fat;
 use fbakit::face::FaceModel;
+use fbakit::fat::eval::Activation;
+use fbakit::fat::morph::fat_to_morph_targets;
+use glam::Vec3;
 
 fn bundled(name: &str) -> FaceModel {
     fbakit::face::read(name).unwrap()
@@ -102,6 +105,156 @@ fn pairs() -> &'static Vec<Pair> {
             })
             .collect()
     })
+}
+
+/// Every triangle of `face` (polygons triangulated) as (mesh, mesh-local corners) and as
+/// corners in the meshes' concatenated vertices.
+fn triangles(face: &FaceModel) -> Vec<(usize, [u32; 3], [u32; 3])> {
+    let mut out = Vec::new();
+    let mut start = 0u32;
+    for (mi, m) in face.meshes.iter().enumerate() {
+        let (tris, _) = fbakit::mesh::geometry::triangulate(&m.mesh.positions, &m.mesh.polygons);
+        out.extend(tris.iter().map(|&t| (mi, t, t.map(|v| v + start))));
+        start += m.mesh.positions.len() as u32;
+    }
+    out
+}
+
+/// The turn (degrees) of every triangle of `face` posed at `key`@`value` (a key `face`'s FAT
+/// lacks poses neutral: every turn 0).
+fn triangle_turns(
+    face: &FaceModel,
+    tris: &[(usize, [u32; 3], [u32; 3])],
+    a: &[Activation],
+) -> Vec<f64> {
+    let mut e = face.evaluator().unwrap();
+    let mut o = e.output();
+    let flat = |p: Vec<Vec<Vec3>>| p.into_iter().flatten().collect::<Vec<Vec3>>();
+    let n = flat(face.pose_with(&mut e, &mut o, &[]));
+    let q = flat(face.pose_with(&mut e, &mut o, a));
+    tris.iter()
+        .map(|(_, _, t)| {
+            let c = |p: &[Vec3]| {
+                let [a, b, c] = t.map(|v| p[v as usize].as_dvec3());
+                (b - a).cross(c - a)
+            };
+            let (n0, n1) = (c(&n), c(&q));
+            if n0.length() <= 0.0 {
+                0.0
+            } else if n1.length() <= 1e-6 * n0.length() {
+                180.0
+            } else {
+                n0.cross(n1).length().atan2(n0.dot(n1)).to_degrees()
+            }
+        })
+        .collect()
+}
+
+/// The honest account of one pair (issue 21 §2, brief `turns6`): every key over the issue's
+/// 1.5×, with the target's own FAT's largest turn under the same key at the same value; for
+/// the worst key, where its worst triangle is (mesh, vertices, position, nearest feature
+/// point in MNS0) and how much the target's own FAT turns that very triangle.
+fn account(p: &Pair) {
+    let (Some(src), Some(dst)) = (face(p.source), face(p.target)) else {
+        return;
+    };
+    let clone = &p.outcome.face;
+    let same = clone.mesh_sizes() == dst.mesh_sizes();
+    let tris = triangles(clone);
+    let mns0 = dst.fapu().map(|f| f.distances.mns0).unwrap_or(1.0);
+    let mut over: Vec<_> = p.turns.keys.iter().filter(|k| k.ratio > 1.5).collect();
+    over.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
+    eprintln!(
+        "  account {}→{}: {} keys over 1.5× (target's own FAT: {} tables)",
+        p.source,
+        p.target,
+        over.len(),
+        dst.fat.tables.len()
+    );
+    let key_of = |name: &str| {
+        fat_to_morph_targets(&src.fat)
+            .into_iter()
+            .find(|t| t.key.name() == name)
+            .map(|t| t.key)
+    };
+    for (rank, k) in over.iter().enumerate() {
+        let Some(key) = key_of(&k.key) else { continue };
+        let a = [Activation {
+            key,
+            value: k.value,
+        }];
+        let turns = triangle_turns(clone, &tris, &a);
+        let own = if same {
+            triangle_turns(dst, &tris, &a)
+        } else {
+            vec![]
+        };
+        let (worst, deg) = turns
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, &d)| (i, d))
+            .unwrap_or((0, 0.0));
+        let own_max = own.iter().copied().fold(0.0, f64::max);
+        eprintln!(
+            "    {:<24} @{:6.0}: source {:6.1}° clone {:6.1}° ratio {:5.2}; own FAT largest {:6.1}°, on this triangle {}",
+            k.key,
+            k.value,
+            k.source_degrees,
+            deg,
+            k.ratio,
+            own_max,
+            own.get(worst).map_or("-".into(), |d| format!("{d:.1}°"))
+        );
+        if rank < 3 {
+            let (mi, local, _) = tris[worst];
+            let m = &clone.meshes[mi];
+            let world = clone.neutral_world_positions();
+            let at = local.map(|v| world[mi][v as usize]).iter().sum::<Vec3>() / 3.0;
+            let near = dst
+                .feature_points
+                .iter()
+                .filter_map(|f| Some((f.id, f.position?.distance(at))))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            eprintln!(
+                "      worst triangle: mesh {} ({}), vertices {:?} (1-based {:?}), at {:.2?}, nearest fp {:?} at {:.2} MNS0",
+                mi,
+                m.name,
+                local,
+                local.map(|v| v + 1),
+                at.to_array(),
+                near.map(|n| n.0.to_string()),
+                near.map_or(0.0, |n| f64::from(n.1) / mns0)
+            );
+            // Each corner's neutral position and its motion on the clone and on the target's
+            // own FAT, in MNS0.
+            let moved = |f: &FaceModel| f.pose(&a).ok().map(|q| local.map(|v| q[mi][v as usize]));
+            let (qc, qo) = (moved(clone), if same { moved(dst) } else { None });
+            // The nearest feature point's motion on the source (source MNS0).
+            if let Some((id, _)) = near {
+                let smns0 = src.fapu().map(|f| f.distances.mns0).unwrap_or(1.0) as f32;
+                let sp = src.fp_vertex(id).and_then(|(m, v)| {
+                    let q = src.pose(&a).ok()?;
+                    let n = src.neutral_world_positions();
+                    Some(((q[m][v as usize] - n[m][v as usize]) / smns0).to_array())
+                });
+                let tp = clone.fp_vertex(id).map(|(m, v)| (m, v));
+                eprintln!(
+                    "        fp {id}: source moves {sp:.3?} (source MNS0); target vertex {tp:?}"
+                );
+            }
+            for (k, &v) in local.iter().enumerate() {
+                let p0 = world[mi][v as usize];
+                let d = |q: &Option<[Vec3; 3]>| q.map(|q| ((q[k] - p0) / mns0 as f32).to_array());
+                eprintln!(
+                    "        corner {v}: at {:.4?}, clone moves {:.3?}, own FAT {:.3?} (MNS0)",
+                    (p0 / mns0 as f32).to_array(),
+                    d(&qc),
+                    d(&qo)
+                );
+            }
+        }
+    }
 }
 
 fn print(p: &Pair) {
@@ -242,6 +395,9 @@ const BOUNDS: [(&str, &str, f64, f64); 10] = [
 fn across_styles_compliant_and_smooth() {
     for p in pairs() {
         print(p);
+        if std::env::var_os("FBAKIT_STYLES_ACCOUNT").is_some() {
+            account(p);
+        }
     }
     for p in pairs() {
         let &(_, _, c, r) = BOUNDS
