@@ -62,6 +62,59 @@ struct Pair {
     /// The source's own compliance, to read the clone's beside.
     source_compliance: ComplianceReport,
     turns: NormalTurnReport,
+    /// The like-with-like ratio ([`own_referenced`]) and its worst key.
+    own_referenced: Option<OwnReferenced>,
+}
+
+/// The largest, over the source's keys and the clone's triangles, of a triangle's turn over
+/// the larger of the source's largest turn (at least 1°) and the target's own FAT's turn of
+/// that very triangle under the same key at the same value.
+struct OwnReferenced {
+    ratio: f64,
+    key: String,
+    value: f64,
+    clone_degrees: f64,
+    own_degrees: f64,
+}
+
+/// [`OwnReferenced`] of a clone of `src` onto `dst` (`None` without a FAT of the target's
+/// own in the clone's layout). Why beside the issue's measure: a real head's own animation
+/// turns triangles no stylised source has — ICT's lips roll inward over a millimetre-thin
+/// edge, its mouth corners fold (its own FAT turns triangles there 150–180° under the lip
+/// FAPs and visemes, where alma and bruno turn 15–60°). The issue's measure counts such a
+/// turn as a crease wherever it is; this one only counts what the clone turns beyond what
+/// the head's own rig does to the same triangle, and never allows less than the issue does.
+fn own_referenced(src: &FaceModel, dst: &FaceModel, clone: &FaceModel) -> Option<OwnReferenced> {
+    if dst.fat.tables.is_empty() || clone.mesh_sizes() != dst.mesh_sizes() {
+        return None;
+    }
+    let tris = triangles(clone);
+    let s_tris = triangles(src);
+    let mut best: Option<OwnReferenced> = None;
+    for t in fat_to_morph_targets(&src.fat) {
+        let a = [Activation {
+            key: t.key,
+            value: t.value,
+        }];
+        let source = triangle_turns(src, &s_tris, &a)
+            .into_iter()
+            .fold(1.0, f64::max);
+        let c = triangle_turns(clone, &tris, &a);
+        let own = triangle_turns(dst, &tris, &a);
+        for (&cd, &od) in c.iter().zip(&own) {
+            let r = cd / source.max(od);
+            if best.as_ref().is_none_or(|b| r > b.ratio) {
+                best = Some(OwnReferenced {
+                    ratio: r,
+                    key: t.key.name(),
+                    value: t.value,
+                    clone_degrees: cd,
+                    own_degrees: od,
+                });
+            }
+        }
+    }
+    best
 }
 
 /// The pairs: every stylised face onto both real heads and back.
@@ -93,6 +146,7 @@ fn pairs() -> &'static Vec<Pair> {
                 let source_compliance = compliance(src).unwrap();
                 let compliance = compliance(&outcome.face).unwrap();
                 let turns = normal_turns(src, &outcome.face).unwrap();
+                let own_referenced = own_referenced(src, dst, &outcome.face);
                 Some(Pair {
                     source: s,
                     target: t,
@@ -101,6 +155,7 @@ fn pairs() -> &'static Vec<Pair> {
                     compliance,
                     source_compliance,
                     turns,
+                    own_referenced,
                 })
             })
             .collect()
@@ -277,6 +332,12 @@ fn print(p: &Pair) {
             .map(|f| (&f.fap, f.value, f.repaired))
             .collect::<Vec<_>>()
     );
+    if let Some(o) = &p.own_referenced {
+        eprintln!(
+            "    like with like (beside the issue's {:.2}): {:.2} under {}@{} (clone {:.1}°, the target's own FAT {:.1}° on that triangle)",
+            p.turns.worst_ratio, o.ratio, o.key, o.value, o.clone_degrees, o.own_degrees
+        );
+    }
     let steps: Vec<String> = p
         .outcome
         .report
