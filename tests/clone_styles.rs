@@ -88,19 +88,15 @@ fn own_referenced(src: &FaceModel, dst: &FaceModel, clone: &FaceModel) -> Option
     if dst.fat.tables.is_empty() || clone.mesh_sizes() != dst.mesh_sizes() {
         return None;
     }
-    let tris = triangles(clone);
-    let s_tris = triangles(src);
+    let (mut ps, mut pc, mut po) = (Poser::new(src), Poser::new(clone), Poser::new(dst));
     let mut best: Option<OwnReferenced> = None;
     for t in fat_to_morph_targets(&src.fat) {
         let a = [Activation {
             key: t.key,
             value: t.value,
         }];
-        let source = triangle_turns(src, &s_tris, &a)
-            .into_iter()
-            .fold(1.0, f64::max);
-        let c = triangle_turns(clone, &tris, &a);
-        let own = triangle_turns(dst, &tris, &a);
+        let source = ps.turns(&a).into_iter().fold(1.0, f64::max);
+        let (c, own) = (pc.turns(&a), po.turns(&a));
         for (&cd, &od) in c.iter().zip(&own) {
             let r = cd / source.max(od);
             if best.as_ref().is_none_or(|b| r > b.ratio) {
@@ -175,34 +171,56 @@ fn triangles(face: &FaceModel) -> Vec<(usize, [u32; 3], [u32; 3])> {
     out
 }
 
-/// The turn (degrees) of every triangle of `face` posed at `key`@`value` (a key `face`'s FAT
-/// lacks poses neutral: every turn 0).
-fn triangle_turns(
-    face: &FaceModel,
-    tris: &[(usize, [u32; 3], [u32; 3])],
-    a: &[Activation],
-) -> Vec<f64> {
-    let mut e = face.evaluator().unwrap();
-    let mut o = e.output();
-    let flat = |p: Vec<Vec<Vec3>>| p.into_iter().flatten().collect::<Vec<Vec3>>();
-    let n = flat(face.pose_with(&mut e, &mut o, &[]));
-    let q = flat(face.pose_with(&mut e, &mut o, a));
-    tris.iter()
-        .map(|(_, _, t)| {
-            let c = |p: &[Vec3]| {
-                let [a, b, c] = t.map(|v| p[v as usize].as_dvec3());
-                (b - a).cross(c - a)
-            };
-            let (n0, n1) = (c(&n), c(&q));
-            if n0.length() <= 0.0 {
-                0.0
-            } else if n1.length() <= 1e-6 * n0.length() {
-                180.0
-            } else {
-                n0.cross(n1).length().atan2(n0.dot(n1)).to_degrees()
-            }
-        })
-        .collect()
+/// Poses one face many times: its evaluator, its neutral (meshes concatenated) and its
+/// triangles.
+struct Poser<'a> {
+    face: &'a FaceModel,
+    evaluator: fbakit::fat::eval::FatEvaluator,
+    output: fbakit::fat::eval::FatOutput,
+    neutral: Vec<Vec3>,
+    triangles: Vec<(usize, [u32; 3], [u32; 3])>,
+}
+
+impl<'a> Poser<'a> {
+    fn new(face: &'a FaceModel) -> Poser<'a> {
+        let mut evaluator = face.evaluator().unwrap();
+        let mut output = evaluator.output();
+        let neutral = face.pose_with(&mut evaluator, &mut output, &[]).concat();
+        Poser {
+            face,
+            evaluator,
+            output,
+            neutral,
+            triangles: triangles(face),
+        }
+    }
+
+    /// The turn (degrees) of every triangle posed at `a` (a key the face's FAT lacks poses
+    /// neutral: every turn 0).
+    fn turns(&mut self, a: &[Activation]) -> Vec<f64> {
+        let q = self
+            .face
+            .pose_with(&mut self.evaluator, &mut self.output, a)
+            .concat();
+        let n = &self.neutral;
+        self.triangles
+            .iter()
+            .map(|(_, _, t)| {
+                let c = |p: &[Vec3]| {
+                    let [a, b, c] = t.map(|v| p[v as usize].as_dvec3());
+                    (b - a).cross(c - a)
+                };
+                let (n0, n1) = (c(n), c(&q));
+                if n0.length() <= 0.0 {
+                    0.0
+                } else if n1.length() <= 1e-6 * n0.length() {
+                    180.0
+                } else {
+                    n0.cross(n1).length().atan2(n0.dot(n1)).to_degrees()
+                }
+            })
+            .collect()
+    }
 }
 
 /// The honest account of one pair (issue 21 §2, brief `turns6`): every key over the issue's
@@ -216,6 +234,7 @@ fn account(p: &Pair) {
     let clone = &p.outcome.face;
     let same = clone.mesh_sizes() == dst.mesh_sizes();
     let tris = triangles(clone);
+    let (mut pc, mut po) = (Poser::new(clone), same.then(|| Poser::new(dst)));
     let mns0 = dst.fapu().map(|f| f.distances.mns0).unwrap_or(1.0);
     let mut over: Vec<_> = p.turns.keys.iter().filter(|k| k.ratio > 1.5).collect();
     over.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
@@ -238,12 +257,8 @@ fn account(p: &Pair) {
             key,
             value: k.value,
         }];
-        let turns = triangle_turns(clone, &tris, &a);
-        let own = if same {
-            triangle_turns(dst, &tris, &a)
-        } else {
-            vec![]
-        };
+        let turns = pc.turns(&a);
+        let own = po.as_mut().map_or(vec![], |po| po.turns(&a));
         let (worst, deg) = turns
             .iter()
             .enumerate()
@@ -439,29 +454,43 @@ fn print(p: &Pair) {
 /// a primitive of their own: 13.8 % of `open_jaw`'s peak apart before, 0.000 % now): alma →
 /// ict and → ict-rig 3.17 → 3.41 (`viseme_12`, the same triangle at the back of the gums
 /// and tongue piece, OBJ vertex 16572, 49.3° → 53.0°), the rest unchanged.
-const BOUNDS: [(&str, &str, f64, f64); 10] = [
-    ("alma", "ict", 0.015, 3.45),
-    ("bruno", "ict", 0.015, 4.5),
-    ("candide", "ict", 0.015, 9.7),
-    ("ict", "alma", 0.015, 1.45),
-    ("ict", "bruno", 0.01, 2.05),
-    ("ict", "candide", 0.01, 1.45),
-    ("alma", "ict-rig", 0.015, 3.45),
-    ("candide", "ict-rig", 0.015, 9.7),
-    ("ict-rig", "alma", 0.015, 1.45),
-    ("ict-rig", "candide", 0.01, 1.45),
+/// Accounted for (2026-11-27, `turns6`; the test prints every key over 1.5× with the target's
+/// own FAT beside it): the ICT heads' own FAT (from their ARKit shapes) turns triangles
+/// 150–180° under most lip FAPs and visemes — but not the triangles the clones turn most:
+/// alma → ict `viseme_12` 53.0° at the back of the gums piece (OBJ vertices 16756, 17028,
+/// 17029; ICT's own 3.4° there), candide → ict `open_jaw` 65.9° on the lower lip's inner face
+/// just behind 2.3 (ICT's own 5.1°), ict → bruno `stretch_r_cornerlip_o` 172.4° at the lip
+/// corner 8.4 (bruno's own 4.6°). Only bruno → ict's worst, `viseme_9` 150.5° at ICT's inner
+/// lip corner 2.4, is a triangle ICT's own FAT turns too (97.4°). The like-with-like ratio
+/// (last column; see [`own_referenced`]) is therefore the issue's on every pair but that one
+/// (4.43 → 3.89, `viseme_6` at 2.5). candide → ict's 9.50 is made by the `bound` step itself:
+/// before it that triangle does not turn (its three corners still, as CANDIDE's `open_jaw`
+/// leaves its lower lip and 2.3 still while the chin drops), the worst is ICT's chin at 87°;
+/// the bound's re-solved region around the chin reaches the lip's inner face behind 2.3 and
+/// moves two corners 0.12 MNS0 while 2.3, outside the region, stays — a 66° turn, which the
+/// step keeps as the best of its rounds (larger regions pull the still lip down and turn
+/// more).
+const BOUNDS: [(&str, &str, f64, f64, f64); 10] = [
+    ("alma", "ict", 0.015, 3.45, 3.45),
+    ("bruno", "ict", 0.015, 4.5, 3.95),
+    ("candide", "ict", 0.015, 9.7, 9.7),
+    ("ict", "alma", 0.015, 1.45, 1.45),
+    ("ict", "bruno", 0.01, 2.05, 2.05),
+    ("ict", "candide", 0.01, 1.45, 1.45),
+    ("alma", "ict-rig", 0.015, 3.45, 3.45),
+    ("candide", "ict-rig", 0.015, 9.7, 9.7),
+    ("ict-rig", "alma", 0.015, 1.45, 1.45),
+    ("ict-rig", "candide", 0.01, 1.45, 1.45),
 ];
 
 #[test]
 fn across_styles_compliant_and_smooth() {
     for p in pairs() {
         print(p);
-        if std::env::var_os("FBAKIT_STYLES_ACCOUNT").is_some() {
-            account(p);
-        }
+        account(p);
     }
     for p in pairs() {
-        let &(_, _, c, r) = BOUNDS
+        let &(_, _, c, r, like) = BOUNDS
             .iter()
             .find(|b| b.0 == p.source && b.1 == p.target)
             .unwrap();
@@ -479,6 +508,15 @@ fn across_styles_compliant_and_smooth() {
             p.target,
             p.turns.worst_ratio
         );
+        if let Some(o) = &p.own_referenced {
+            assert!(
+                o.ratio <= like,
+                "{}→{}: like-with-like ratio {}",
+                p.source,
+                p.target,
+                o.ratio
+            );
+        }
         // Every FAP the source moves is measured on the clone.
         assert!(!p.turns.keys.is_empty());
     }
