@@ -308,7 +308,7 @@ fn account(p: &Pair) {
                     let n = src.neutral_world_positions();
                     Some(((q[m][v as usize] - n[m][v as usize]) / smns0).to_array())
                 });
-                let tp = clone.fp_vertex(id).map(|(m, v)| (m, v));
+                let tp = clone.fp_vertex(id);
                 eprintln!(
                     "        fp {id}: source moves {sp:.3?} (source MNS0); target vertex {tp:?}"
                 );

@@ -702,6 +702,25 @@ mod tests {
     }
 
     #[test]
+    fn a_fill_fades_over_its_outer_rings() {
+        // A path 0–1–…–9 with the region 1..=8: vertices 0 and 9 lie outside.
+        let adj: Vec<Vec<u32>> = (0..10u32)
+            .map(|v| {
+                [v.checked_sub(1), (v < 9).then_some(v + 1)]
+                    .into_iter()
+                    .flatten()
+                    .collect()
+            })
+            .collect();
+        let region: Vec<u32> = (1..=8).collect();
+        let in_region: Vec<bool> = (0..10).map(|v| (1..=8).contains(&v)).collect();
+        let w = rim_shares(&adj, &region, &in_region);
+        // One, two and three hops from the outside on each end take ¼, ½, ¾; the middle,
+        // four hops in, takes the whole fill.
+        assert_eq!(w, vec![0.25, 0.5, 0.75, 1.0, 1.0, 0.75, 0.5, 0.25]);
+    }
+
+    #[test]
     fn a_motion_under_the_bound_is_untouched() {
         let s = grid(9);
         let src = vec![motion(slope(&s))];
