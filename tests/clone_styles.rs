@@ -17,6 +17,9 @@ use fbakit::clone::eval::{compliance, normal_turns, ComplianceReport, NormalTurn
 use fbakit::clone::face::{clone_face, CloneOptions, CloneOutcome};
 use fbakit::export::picture::strip_fat;
 use fbakit::face::FaceModel;
+use fbakit::fat::eval::Activation;
+use fbakit::fat::morph::fat_to_morph_targets;
+use glam::Vec3;
 
 fn bundled(name: &str) -> FaceModel {
     fbakit::face::read(name).unwrap()
@@ -59,6 +62,55 @@ struct Pair {
     /// The source's own compliance, to read the clone's beside.
     source_compliance: ComplianceReport,
     turns: NormalTurnReport,
+    /// The like-with-like ratio ([`own_referenced`]) and its worst key.
+    own_referenced: Option<OwnReferenced>,
+}
+
+/// The largest, over the source's keys and the clone's triangles, of a triangle's turn over
+/// the larger of the source's largest turn (at least 1°) and the target's own FAT's turn of
+/// that very triangle under the same key at the same value.
+struct OwnReferenced {
+    ratio: f64,
+    key: String,
+    value: f64,
+    clone_degrees: f64,
+    own_degrees: f64,
+}
+
+/// [`OwnReferenced`] of a clone of `src` onto `dst` (`None` without a FAT of the target's
+/// own in the clone's layout). Why beside the issue's measure: a real head's own animation
+/// turns triangles no stylised source has — ICT's lips roll inward over a millimetre-thin
+/// edge, its mouth corners fold (its own FAT turns triangles there 150–180° under the lip
+/// FAPs and visemes, where alma and bruno turn 15–60°). The issue's measure counts such a
+/// turn as a crease wherever it is; this one only counts what the clone turns beyond what
+/// the head's own rig does to the same triangle, and never allows less than the issue does.
+fn own_referenced(src: &FaceModel, dst: &FaceModel, clone: &FaceModel) -> Option<OwnReferenced> {
+    if dst.fat.tables.is_empty() || clone.mesh_sizes() != dst.mesh_sizes() {
+        return None;
+    }
+    let (mut ps, mut pc, mut po) = (Poser::new(src), Poser::new(clone), Poser::new(dst));
+    let mut best: Option<OwnReferenced> = None;
+    for t in fat_to_morph_targets(&src.fat) {
+        let a = [Activation {
+            key: t.key,
+            value: t.value,
+        }];
+        let source = ps.turns(&a).into_iter().fold(1.0, f64::max);
+        let (c, own) = (pc.turns(&a), po.turns(&a));
+        for (&cd, &od) in c.iter().zip(&own) {
+            let r = cd / source.max(od);
+            if best.as_ref().is_none_or(|b| r > b.ratio) {
+                best = Some(OwnReferenced {
+                    ratio: r,
+                    key: t.key.name(),
+                    value: t.value,
+                    clone_degrees: cd,
+                    own_degrees: od,
+                });
+            }
+        }
+    }
+    best
 }
 
 /// The pairs: every stylised face onto both real heads and back.
@@ -90,6 +142,7 @@ fn pairs() -> &'static Vec<Pair> {
                 let source_compliance = compliance(src).unwrap();
                 let compliance = compliance(&outcome.face).unwrap();
                 let turns = normal_turns(src, &outcome.face).unwrap();
+                let own_referenced = own_referenced(src, dst, &outcome.face);
                 Some(Pair {
                     source: s,
                     target: t,
@@ -98,10 +151,180 @@ fn pairs() -> &'static Vec<Pair> {
                     compliance,
                     source_compliance,
                     turns,
+                    own_referenced,
                 })
             })
             .collect()
     })
+}
+
+/// Every triangle of `face` (polygons triangulated) as (mesh, mesh-local corners) and as
+/// corners in the meshes' concatenated vertices.
+fn triangles(face: &FaceModel) -> Vec<(usize, [u32; 3], [u32; 3])> {
+    let mut out = Vec::new();
+    let mut start = 0u32;
+    for (mi, m) in face.meshes.iter().enumerate() {
+        let (tris, _) = fbakit::mesh::geometry::triangulate(&m.mesh.positions, &m.mesh.polygons);
+        out.extend(tris.iter().map(|&t| (mi, t, t.map(|v| v + start))));
+        start += m.mesh.positions.len() as u32;
+    }
+    out
+}
+
+/// Poses one face many times: its evaluator, its neutral (meshes concatenated) and its
+/// triangles.
+struct Poser<'a> {
+    face: &'a FaceModel,
+    evaluator: fbakit::fat::eval::FatEvaluator,
+    output: fbakit::fat::eval::FatOutput,
+    neutral: Vec<Vec3>,
+    triangles: Vec<(usize, [u32; 3], [u32; 3])>,
+}
+
+impl<'a> Poser<'a> {
+    fn new(face: &'a FaceModel) -> Poser<'a> {
+        let mut evaluator = face.evaluator().unwrap();
+        let mut output = evaluator.output();
+        let neutral = face.pose_with(&mut evaluator, &mut output, &[]).concat();
+        Poser {
+            face,
+            evaluator,
+            output,
+            neutral,
+            triangles: triangles(face),
+        }
+    }
+
+    /// The turn (degrees) of every triangle posed at `a` (a key the face's FAT lacks poses
+    /// neutral: every turn 0).
+    fn turns(&mut self, a: &[Activation]) -> Vec<f64> {
+        let q = self
+            .face
+            .pose_with(&mut self.evaluator, &mut self.output, a)
+            .concat();
+        let n = &self.neutral;
+        self.triangles
+            .iter()
+            .map(|(_, _, t)| {
+                let c = |p: &[Vec3]| {
+                    let [a, b, c] = t.map(|v| p[v as usize].as_dvec3());
+                    (b - a).cross(c - a)
+                };
+                let (n0, n1) = (c(n), c(&q));
+                if n0.length() <= 0.0 {
+                    0.0
+                } else if n1.length() <= 1e-6 * n0.length() {
+                    180.0
+                } else {
+                    n0.cross(n1).length().atan2(n0.dot(n1)).to_degrees()
+                }
+            })
+            .collect()
+    }
+}
+
+/// The honest account of one pair (issue 21 §2, brief `turns6`): every key over the issue's
+/// 1.5×, with the target's own FAT's largest turn under the same key at the same value; for
+/// the worst key, where its worst triangle is (mesh, vertices, position, nearest feature
+/// point in MNS0) and how much the target's own FAT turns that very triangle.
+fn account(p: &Pair) {
+    let (Some(src), Some(dst)) = (face(p.source), face(p.target)) else {
+        return;
+    };
+    let clone = &p.outcome.face;
+    let same = clone.mesh_sizes() == dst.mesh_sizes();
+    let tris = triangles(clone);
+    let (mut pc, mut po) = (Poser::new(clone), same.then(|| Poser::new(dst)));
+    let mns0 = dst.fapu().map(|f| f.distances.mns0).unwrap_or(1.0);
+    let mut over: Vec<_> = p.turns.keys.iter().filter(|k| k.ratio > 1.5).collect();
+    over.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
+    eprintln!(
+        "  account {}→{}: {} keys over 1.5× (target's own FAT: {} tables)",
+        p.source,
+        p.target,
+        over.len(),
+        dst.fat.tables.len()
+    );
+    let key_of = |name: &str| {
+        fat_to_morph_targets(&src.fat)
+            .into_iter()
+            .find(|t| t.key.name() == name)
+            .map(|t| t.key)
+    };
+    for (rank, k) in over.iter().enumerate() {
+        let Some(key) = key_of(&k.key) else { continue };
+        let a = [Activation {
+            key,
+            value: k.value,
+        }];
+        let turns = pc.turns(&a);
+        let own = po.as_mut().map_or(vec![], |po| po.turns(&a));
+        let (worst, deg) = turns
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, &d)| (i, d))
+            .unwrap_or((0, 0.0));
+        let own_max = own.iter().copied().fold(0.0, f64::max);
+        eprintln!(
+            "    {:<24} @{:6.0}: source {:6.1}° clone {:6.1}° ratio {:5.2}; own FAT largest {:6.1}°, on this triangle {}",
+            k.key,
+            k.value,
+            k.source_degrees,
+            deg,
+            k.ratio,
+            own_max,
+            own.get(worst).map_or("-".into(), |d| format!("{d:.1}°"))
+        );
+        if rank < 3 {
+            let (mi, local, _) = tris[worst];
+            let m = &clone.meshes[mi];
+            let world = clone.neutral_world_positions();
+            let at = local.map(|v| world[mi][v as usize]).iter().sum::<Vec3>() / 3.0;
+            let near = dst
+                .feature_points
+                .iter()
+                .filter_map(|f| Some((f.id, f.position?.distance(at))))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            eprintln!(
+                "      worst triangle: mesh {} ({}), vertices {:?} (1-based {:?}), at {:.2?}, nearest fp {:?} at {:.2} MNS0",
+                mi,
+                m.name,
+                local,
+                local.map(|v| v + 1),
+                at.to_array(),
+                near.map(|n| n.0.to_string()),
+                near.map_or(0.0, |n| f64::from(n.1) / mns0)
+            );
+            // Each corner's neutral position and its motion on the clone and on the target's
+            // own FAT, in MNS0.
+            let moved = |f: &FaceModel| f.pose(&a).ok().map(|q| local.map(|v| q[mi][v as usize]));
+            let (qc, qo) = (moved(clone), if same { moved(dst) } else { None });
+            // The nearest feature point's motion on the source (source MNS0).
+            if let Some((id, _)) = near {
+                let smns0 = src.fapu().map(|f| f.distances.mns0).unwrap_or(1.0) as f32;
+                let sp = src.fp_vertex(id).and_then(|(m, v)| {
+                    let q = src.pose(&a).ok()?;
+                    let n = src.neutral_world_positions();
+                    Some(((q[m][v as usize] - n[m][v as usize]) / smns0).to_array())
+                });
+                let tp = clone.fp_vertex(id);
+                eprintln!(
+                    "        fp {id}: source moves {sp:.3?} (source MNS0); target vertex {tp:?}"
+                );
+            }
+            for (k, &v) in local.iter().enumerate() {
+                let p0 = world[mi][v as usize];
+                let d = |q: &Option<[Vec3; 3]>| q.map(|q| ((q[k] - p0) / mns0 as f32).to_array());
+                eprintln!(
+                    "        corner {v}: at {:.4?}, clone moves {:.3?}, own FAT {:.3?} (MNS0)",
+                    (p0 / mns0 as f32).to_array(),
+                    d(&qc),
+                    d(&qo)
+                );
+            }
+        }
+    }
 }
 
 fn print(p: &Pair) {
@@ -124,6 +347,12 @@ fn print(p: &Pair) {
             .map(|f| (&f.fap, f.value, f.repaired))
             .collect::<Vec<_>>()
     );
+    if let Some(o) = &p.own_referenced {
+        eprintln!(
+            "    like with like (beside the issue's {:.2}): {:.2} under {}@{} (clone {:.1}°, the target's own FAT {:.1}° on that triangle)",
+            p.turns.worst_ratio, o.ratio, o.key, o.value, o.clone_degrees, o.own_degrees
+        );
+    }
     let steps: Vec<String> = p
         .outcome
         .report
@@ -225,26 +454,47 @@ fn print(p: &Pair) {
 /// a primitive of their own: 13.8 % of `open_jaw`'s peak apart before, 0.000 % now): alma →
 /// ict and → ict-rig 3.17 → 3.41 (`viseme_12`, the same triangle at the back of the gums
 /// and tongue piece, OBJ vertex 16572, 49.3° → 53.0°), the rest unchanged.
-const BOUNDS: [(&str, &str, f64, f64); 10] = [
-    ("alma", "ict", 0.015, 3.45),
-    ("bruno", "ict", 0.015, 4.5),
-    ("candide", "ict", 0.015, 9.7),
-    ("ict", "alma", 0.015, 1.45),
-    ("ict", "bruno", 0.01, 2.05),
-    ("ict", "candide", 0.01, 1.45),
-    ("alma", "ict-rig", 0.015, 3.45),
-    ("candide", "ict-rig", 0.015, 9.7),
-    ("ict-rig", "alma", 0.015, 1.45),
-    ("ict-rig", "candide", 0.01, 1.45),
+/// Accounted for (2026-11-27, `turns6`; the test prints every key over 1.5× with the target's
+/// own FAT beside it): the ICT heads' own FAT (from their ARKit shapes) turns triangles
+/// 150–180° under most lip FAPs and visemes — but not the triangles the clones turn most:
+/// alma → ict `viseme_12` 53.0° at the back of the gums piece (OBJ vertices 16756, 17028,
+/// 17029; ICT's own 3.4° there), candide → ict `open_jaw` 65.9° on the lower lip's inner face
+/// just behind 2.3 (ICT's own 5.1°), ict → bruno `stretch_r_cornerlip_o` 172.4° at the lip
+/// corner 8.4 (bruno's own 4.6°). Only bruno → ict's worst, `viseme_9` 150.5° at ICT's inner
+/// lip corner 2.4, is a triangle ICT's own FAT turns too (97.4°). The like-with-like ratio
+/// (last column; see [`own_referenced`]) is therefore the issue's on every pair but that one
+/// (4.43 → 3.89, `viseme_6` at 2.5). candide → ict's 9.50 is made by the `bound` step itself:
+/// before it that triangle does not turn (its three corners still, as CANDIDE's `open_jaw`
+/// leaves its lower lip and 2.3 still while the chin drops), the worst is ICT's chin at 87°;
+/// the bound's re-solved region around the chin reaches the lip's inner face behind 2.3 and
+/// moves two corners 0.12 MNS0 while 2.3, outside the region, stays — a 66° turn, which the
+/// step kept as the best of its rounds (larger regions pull the still lip down and turn
+/// more). Since each round is also tried faded into the clone's own motion over the region's
+/// outer three rings: candide → ict and → ict-rig 9.50 → 9.16 (the lip's inner face no
+/// longer turns; the worst is now ICT's dense chin 0.38 MNS0 under 2.1, 63.6°, where ICT's own
+/// FAT turns 3.6°: its whole jaw turns rigidly, while CANDIDE's drops the chin point alone),
+/// the rest unchanged.
+const BOUNDS: [(&str, &str, f64, f64, f64); 10] = [
+    ("alma", "ict", 0.015, 3.45, 3.45),
+    ("bruno", "ict", 0.015, 4.5, 3.95),
+    ("candide", "ict", 0.015, 9.2, 9.2),
+    ("ict", "alma", 0.015, 1.45, 1.45),
+    ("ict", "bruno", 0.01, 2.05, 2.05),
+    ("ict", "candide", 0.01, 1.45, 1.45),
+    ("alma", "ict-rig", 0.015, 3.45, 3.45),
+    ("candide", "ict-rig", 0.015, 9.2, 9.2),
+    ("ict-rig", "alma", 0.015, 1.45, 1.45),
+    ("ict-rig", "candide", 0.01, 1.45, 1.45),
 ];
 
 #[test]
 fn across_styles_compliant_and_smooth() {
     for p in pairs() {
         print(p);
+        account(p);
     }
     for p in pairs() {
-        let &(_, _, c, r) = BOUNDS
+        let &(_, _, c, r, like) = BOUNDS
             .iter()
             .find(|b| b.0 == p.source && b.1 == p.target)
             .unwrap();
@@ -262,6 +512,15 @@ fn across_styles_compliant_and_smooth() {
             p.target,
             p.turns.worst_ratio
         );
+        if let Some(o) = &p.own_referenced {
+            assert!(
+                o.ratio <= like,
+                "{}→{}: like-with-like ratio {}",
+                p.source,
+                p.target,
+                o.ratio
+            );
+        }
         // Every FAP the source moves is measured on the clone.
         assert!(!p.turns.keys.is_empty());
     }

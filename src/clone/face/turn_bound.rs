@@ -22,9 +22,9 @@
 //! points (compliance is measured there), the lips' slit (the surface's borders near the
 //! mouth and two rings around them) and the lid margins: the slits' gaps and the lashes
 //! riding on the lids must stay as cloned. Rigid parts are not on the skin surface and are not
-//! touched. Each round's motion is measured over every triangle and the one turning least is
-//! kept, if it turns less than the clone's own; a motion already under the bound is not
-//! changed at all.
+//! touched. Each round's motion is measured over every triangle, also faded into the clone's
+//! own motion over the region's outer rings, and the one turning least is kept, if it turns
+//! less than the clone's own; a motion already under the bound is not changed at all.
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -139,6 +139,37 @@ fn fill(positions: &[Vec3], adj: &[Vec<u32>], region: &[u32], follows: &Follows,
     {
         d[v as usize] = v4[v as usize].into();
     }
+}
+
+/// Rings over which a round's fill is faded into the clone's own motion at its rim.
+const RIM: u8 = 3;
+
+/// Per `region` vertex, its share of the fill when faded at the rim: (its hops from a vertex
+/// outside the region) / (`RIM` + 1), 1 deeper in.
+fn rim_shares(adj: &[Vec<u32>], region: &[u32], in_region: &[bool]) -> Vec<f32> {
+    let mut hops: HashMap<u32, u8> = HashMap::new();
+    let mut front: Vec<u32> = region
+        .iter()
+        .copied()
+        .filter(|&v| adj[v as usize].iter().any(|&w| !in_region[w as usize]))
+        .collect();
+    for h in 1..=RIM {
+        for &v in &front {
+            hops.entry(v).or_insert(h);
+        }
+        front = front
+            .iter()
+            .flat_map(|&v| adj[v as usize].iter().copied())
+            .filter(|&w| in_region[w as usize] && !hops.contains_key(&w))
+            .collect();
+    }
+    region
+        .iter()
+        .map(|v| {
+            hops.get(v)
+                .map_or(1.0, |&h| f32::from(h) / f32::from(RIM + 1))
+        })
+        .collect()
 }
 
 /// The largest turn (cosine: smallest) over `tris` under `d`; 1 without triangles.
@@ -396,6 +427,22 @@ impl Bounds<'_> {
             if worst > best.0 {
                 best = (worst, Some(region.iter().map(|&v| d[v as usize]).collect()));
             }
+            // The same round faded into the clone's own motion towards the region's rim
+            // (`RIM` rings): a fill meets the motion it holds at a hard rim, and where the
+            // rim crosses small triangles the step there turns them (CANDIDE-3's `open_jaw`
+            // on the ICT head: the chin's region reached the lower lip's inner face, whose
+            // feature point 2.3 stayed outside and still: 66°).
+            let faded = rim_shares(adj, &region, &in_region);
+            let mut t = d.clone();
+            for (&v, &w) in region.iter().zip(&faded) {
+                if Some(v) != own_target {
+                    t[v as usize] = d0[v as usize] + w * (d[v as usize] - d0[v as usize]);
+                }
+            }
+            let worst = worst_cos(pos, &t, tris, tn, &measure);
+            if worst > best.0 {
+                best = (worst, Some(region.iter().map(|&v| t[v as usize]).collect()));
+            }
             let mut seen = std::collections::HashSet::new();
             bad = region
                 .iter()
@@ -652,6 +699,25 @@ mod tests {
         assert_eq!(sliver_apex(&p, &[0, 1, 2]), Some((2, (0, 1, 0.25))));
         // Well shaped (apex as high as half the longest edge): it stays in the fill.
         assert_eq!(sliver_apex(&p, &[0, 1, 3]), None);
+    }
+
+    #[test]
+    fn a_fill_fades_over_its_outer_rings() {
+        // A path 0–1–…–9 with the region 1..=8: vertices 0 and 9 lie outside.
+        let adj: Vec<Vec<u32>> = (0..10u32)
+            .map(|v| {
+                [v.checked_sub(1), (v < 9).then_some(v + 1)]
+                    .into_iter()
+                    .flatten()
+                    .collect()
+            })
+            .collect();
+        let region: Vec<u32> = (1..=8).collect();
+        let in_region: Vec<bool> = (0..10).map(|v| (1..=8).contains(&v)).collect();
+        let w = rim_shares(&adj, &region, &in_region);
+        // One, two and three hops from the outside on each end take ¼, ½, ¾; the middle,
+        // four hops in, takes the whole fill.
+        assert_eq!(w, vec![0.25, 0.5, 0.75, 1.0, 1.0, 0.75, 0.5, 0.25]);
     }
 
     #[test]
