@@ -211,6 +211,7 @@
 mod align;
 mod assemble;
 mod attached;
+mod eyeball;
 mod fold;
 mod jaw_follow;
 mod lid_close;
