@@ -471,3 +471,179 @@ fn iris_eye_white_and_highlight_turn_as_one_eye_in_every_layout() {
         }
     }
 }
+
+/// The JSON chunk of a glb.
+fn glb_json(p: &std::path::Path) -> serde_json::Value {
+    let bytes = std::fs::read(p).unwrap();
+    let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+    serde_json::from_slice(chunks.json).unwrap()
+}
+
+/// VRoid's eyes (eye whites in `Body`'s `eyes` primitive, irises and highlights in two more
+/// primitives, all on the eye joints `LeftEye` / `RightEye`) with the pupils given on the
+/// irises' poles, as `fp from-landmarks` or an artist marks them: each joint turns its eye
+/// over all three primitives (`nodeParts`: eye white, iris and highlight, pivot at the eye
+/// white's centre), no mesh keeps a target for the turns, the glb reads back with the
+/// library clone's FAT, `play` turns the joints, and the files add no validator issue. On
+/// the old code the eye white was no layer of the iris: the joints were refused ("it moves
+/// mesh `Body.2` beyond the eyeball") and the turns stayed morph targets of the iris alone.
+#[test]
+fn eye_joints_turn_iris_and_eye_white_when_the_pupil_is_on_the_iris() {
+    use support::avatar::{self, Options, VroidEyes, LEFT_EYE_JOINT, RIGHT_EYE_JOINT};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = fbakit::face::read("alma").unwrap();
+    let opts = Options {
+        vroid_eyes: Some(VroidEyes {
+            highlight_node: false,
+            iris_share: 1.0,
+        }),
+        ..Options::default()
+    };
+    let built = avatar::build_with(&opts);
+    let glb = d.join("avatar.glb");
+    std::fs::write(&glb, built.to_glb()).unwrap();
+    // The iris caps' poles (armature cm → file metres), the pupils there.
+    let iris = built.prims.iter().find(|p| p.name == "iris").unwrap();
+    let pole = |left: bool| {
+        let p = iris.positions.iter().filter(|p| (p.x > 0.0) == left).fold(
+            Vec3::splat(f32::NEG_INFINITY),
+            |a, &p| if p.z > a.z { p } else { a },
+        );
+        p * 0.01
+    };
+    let csv = avatar::fp_csv(&source, d, "");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let text: String = text
+        .lines()
+        .map(|l| {
+            let at = |q: Vec3, id: &str| format!("{id},{},{},{}", q.x, q.y, q.z);
+            match l.split(',').next() {
+                Some("3.5") => at(pole(true), "3.5"),
+                Some("3.6") => at(pole(false), "3.6"),
+                _ => l.to_string(),
+            }
+        })
+        .map(|l| l + "\n")
+        .collect();
+    std::fs::write(&csv, text).unwrap();
+    let out = d.join("out.glb");
+    let o = support::cli::command()
+        .args(["clone".as_ref(), "alma".as_ref(), glb.as_os_str()])
+        .args(["--fp-target".as_ref(), csv.as_os_str(), "-o".as_ref()])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = support::cli::text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(!stderr.contains("eye node"), "{stderr}");
+    let patched = glb_json(&out);
+    let names: String = patched["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["extras"]["targetNames"].to_string())
+        .collect();
+    for t in [
+        "yaw_l_eyeball",
+        "yaw_r_eyeball",
+        "pitch_l_eyeball",
+        "pitch_r_eyeball",
+    ] {
+        assert!(!names.contains(t), "{t}: {names}");
+    }
+    let parts = patched["scenes"][0]["extras"]["fbakit"]["nodeParts"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no nodeParts: {stderr}"))
+        .clone();
+    assert_eq!(parts.len(), 2, "{parts:?}");
+    for (node, left) in [(LEFT_EYE_JOINT, true), (RIGHT_EYE_JOINT, false)] {
+        let p = parts.iter().find(|p| p["node"] == node).unwrap();
+        let meshes: Vec<&str> = p["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["mesh"].as_str().unwrap())
+            .collect();
+        assert_eq!(meshes, ["Body.2", "Body.4", "Body.5"], "joint {node}");
+        // The pivot: the eye white's centre (file metres), within 1 % of the eye (2.4 cm).
+        let c: Vec<f32> = p["center"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap() as f32)
+            .collect();
+        let off = Vec3::from_slice(&c).distance(avatar::eye_centre(left) * 0.01);
+        eprintln!("joint {node}: pivot {off} m off the eye white's centre");
+        assert!(off <= 0.01 * 0.024, "joint {node}: pivot {off} m off");
+    }
+    // Read back: the library clone's FAT.
+    let target = fbakit::face::read_with(
+        &glb,
+        &fbakit::face::FaceReadOptions::with_feature_points(Some(&csv)),
+    )
+    .unwrap()
+    .0;
+    let cloned = clone_face(&source, &target, &CloneOptions::default())
+        .unwrap()
+        .face;
+    let back = fbakit::face::read(&out).unwrap();
+    let report = fbakit::snapshot::diff(&cloned, &back, &fbakit::snapshot::DiffOptions::default());
+    assert!(report.equal, "{report}");
+    // Play a gaze: the eye joints turn.
+    let gaze = d.join("gaze.fap");
+    let mask: Vec<&str> = (1..=68)
+        .map(|f| if (23..=26).contains(&f) { "1" } else { "0" })
+        .collect();
+    let mut text = "2.1 gaze 25 3\n".to_string();
+    for (i, v) in [[0, 0, 0, 0], [20000, 20000, 0, 0], [0, 0, 12000, -9000]]
+        .iter()
+        .enumerate()
+    {
+        text.push_str(&format!(
+            "{}\n{i} {} {} {} {}\n",
+            mask.join(" "),
+            v[0],
+            v[1],
+            v[2],
+            v[3]
+        ));
+    }
+    std::fs::write(&gaze, text).unwrap();
+    let played = d.join("played.glb");
+    let o = support::cli::command()
+        .args([
+            "play".as_ref(),
+            out.as_os_str(),
+            gaze.as_os_str(),
+            "-o".as_ref(),
+        ])
+        .arg(&played)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", support::cli::text(&o.stderr));
+    let pj = glb_json(&played);
+    let play = pj["animations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "play")
+        .unwrap()
+        .clone();
+    for node in [LEFT_EYE_JOINT, RIGHT_EYE_JOINT] {
+        assert!(
+            play["channels"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|c| c["target"]["node"] == node && c["target"]["path"] == "rotation"),
+            "joint {node} not turned"
+        );
+    }
+    let files = [glb, out, played];
+    if let Some(reports) = support::validator::validate(&files) {
+        let issues = |r: &serde_json::Value| (r["errors"].clone(), r["warnings"].clone());
+        assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
+        assert_eq!(issues(&reports[0]), issues(&reports[2]), "{}", reports[2]);
+    }
+}

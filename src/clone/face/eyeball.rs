@@ -145,6 +145,34 @@ pub(super) fn eyeballs(face: &FaceModel, frames: &FaceFrames, diag: f32, es: f32
     out
 }
 
+/// The points of an eye's part meshes (`meshes`, face frame) its turn's centre is fitted to:
+/// the connected piece with the largest bounding box — the eye white, not the iris,
+/// cornea or highlight caps in front of it, which sit on spheres of their own and would
+/// pull a fit over all of them forward.
+pub(super) fn eye_white_points(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    meshes: &[usize],
+) -> Vec<Vec3> {
+    let diag = super::parts::face_diagonal(face, frames);
+    let mut best: (f32, Vec<Vec3>) = (-1.0, Vec::new());
+    for &mi in meshes {
+        let world = face.mesh_world(frames, mi);
+        let (piece, count) = mesh_pieces(&face.meshes[mi].mesh, diag * 1e-6);
+        let mut members: Vec<Vec<Vec3>> = vec![Vec::new(); count];
+        for (&k, &q) in piece.iter().zip(&world) {
+            members[k].push(q);
+        }
+        for pts in members {
+            let r = bounds(pts.iter().copied()).map_or(-1.0, |b| b.1);
+            if r > best.0 {
+                best = (r, pts);
+            }
+        }
+    }
+    best.1
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
