@@ -3,7 +3,9 @@
 //! ([`super::split`]); this folds the view's FAT back into the user's mesh. Entries on the
 //! view's skin and part meshes go back to the original vertex numbers through the split's
 //! index maps, and the motion of transforms created only for cut parts is baked into
-//! per-vertex displacements of those vertices ([`crate::fat::bake`]), within 1 % of the part's
+//! per-vertex displacements of those vertices ([`crate::fat::bake`]) — so is that of a part
+//! transform kept for a whole mesh (an iris) when it also turns pieces cut out of a mesh that
+//! goes back elsewhere (a highlight cut from a primitive whose occlusion shell is skin) —, within 1 % of the part's
 //! size at every FAP value the table covers. The face returned has exactly the target's
 //! meshes, vertices and polygons; its transforms are the target's plus those that still hold
 //! a mesh (a created root `head`).

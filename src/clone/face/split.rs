@@ -6,10 +6,16 @@
 //! above the lip line (2.2/2.3) are the upper row, those below the lower, and a piece free
 //! in the mouth reaching across the line (gums joined to a tongue) is cut along it
 //! ([`teeth_row_plans`]: the rule); and meshes without feature points lying wholly on the
-//! eyeballs, one piece per eye (VRoid's iris and highlight layers: [`eye_layer_plans`]) go
-//! to the eye each piece lies on — unless its rim rests on the lids (an eye occlusion shell,
-//! a lacrimal film, an eye blend): such a mesh is skin ([`lid_layers`]). The split is an internal view: its index maps
-//! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
+//! eyeballs, one piece per eye (VRoid's iris and highlight layers, an eye white behind an
+//! iris cap holding the pupil: [`eye_layer_plans`]) go to the eye each piece lies on —
+//! unless its rim rests on the lids (an eye occlusion shell, a lacrimal film, an eye blend):
+//! a mesh all of such pieces is skin ([`lid_layers`]), and one holding both kinds is cut,
+//! its lid-resting pieces staying in it as skin. A one-mesh head's pieces are sorted the same
+//! way ([`eye_layer_pieces`]). The split is an internal view: its index maps
+//! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9;
+//! a part cut out of a mesh whose rest is skin, under an eye transform kept for a mesh of
+//! its own, is baked into per-vertex rows of that mesh, since the transform no longer holds
+//! its vertices).
 
 use std::collections::{BTreeMap, BTreeSet};
 
