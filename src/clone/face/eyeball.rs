@@ -31,6 +31,9 @@ const BALL_SPREAD: f32 = 0.2;
 /// the ball's surface, a cornea bulges out of it).
 const PUPIL_DEPTH: f32 = 0.75;
 
+/// A mesh's world positions, the connected piece of each vertex and the piece count.
+type MeshPieces = (Vec<Vec3>, Vec<usize>, usize);
+
 /// One eye's eyeball (face frame).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Eyeball {
@@ -82,7 +85,7 @@ fn as_ball(points: &[Vec3]) -> Option<(Vec3, f32)> {
 pub(super) fn eyeballs(face: &FaceModel, frames: &FaceFrames, diag: f32, es: f32) -> Vec<Eyeball> {
     let eps = diag * 1e-6;
     // Per mesh: world positions and connected pieces, found once.
-    let mut meshes: Vec<Option<(Vec<Vec3>, Vec<usize>, usize)>> = vec![None; face.meshes.len()];
+    let mut meshes: Vec<Option<MeshPieces>> = vec![None; face.meshes.len()];
     let mut of_mesh = |mi: usize| {
         meshes[mi]
             .get_or_insert_with(|| {
