@@ -315,7 +315,7 @@ fn setup() -> Option<&'static Setup> {
         }
         // Every layout from alma; the one-mesh OBJ and the primitives from CANDIDE-3 too (a
         // source of another style, with no eyeballs or teeth of its own).
-        let runs: Vec<(&'static str, &(&str, FaceModel, Vec<Vec<u32>>))> = SOURCES
+        let runs: Vec<(&'static str, &_)> = SOURCES
             .iter()
             .flat_map(|&source| {
                 layouts
