@@ -1,5 +1,7 @@
 //! A real head's parts, whatever its layout (issue 19 §1): ICT-FaceKit's neutral head (from
-//! `../shared/data`) cloned from alma in three layouts — its own one-mesh OBJ, one glTF mesh
+//! `../shared/data`) cloned from alma in three layouts (and from CANDIDE-3, from the shared
+//! data, in the first two: a source of another style without eyeballs or teeth; its lower
+//! teeth follow the jaw rigidly within 0.9 % of the row under FAP 15) — its own one-mesh OBJ, one glTF mesh
 //! with one primitive per material, and one glTF node and mesh per material (the split
 //! Blender's exporter makes; the skin's two materials share their seam vertices, so those
 //! come twice) — and each layout's cloned FAT checked part by part against the issue's rules
@@ -15,6 +17,8 @@
 //! jaw with the lower gums (decided so; a tongue with 6.x points is a part of its own, see
 //! `parts_in_one_primitive.rs`).
 
+#[path = "support/candide.rs"]
+mod candide_data;
 #[path = "support/ict_truth.rs"]
 mod ict_truth;
 
@@ -256,7 +260,10 @@ fn fp_csv(prims: &[Prim], spec: impl Fn(usize) -> String) -> String {
 /// One layout of the head, read and cloned: per face mesh of the target, the OBJ vertex of
 /// each of its vertices.
 struct Layout {
-    name: &'static str,
+    /// The layout and its source, as `NAME (SOURCE)`.
+    name: String,
+    /// The source face's name.
+    source: &'static str,
     target: FaceModel,
     out: CloneOutcome,
     obj_vertex: Vec<Vec<u32>>,
@@ -268,6 +275,9 @@ struct Setup {
     _dir: tempfile::TempDir,
 }
 
+/// The sources cloned from.
+const SOURCES: [&str; 2] = ["alma", "candide"];
+
 fn setup() -> Option<&'static Setup> {
     static S: OnceLock<Option<Setup>> = OnceLock::new();
     S.get_or_init(|| {
@@ -277,7 +287,6 @@ fn setup() -> Option<&'static Setup> {
         let obj = read_obj(&obj_path);
         assert_eq!(obj.positions.len(), VERTICES);
         let prims = prims_by_material(&obj);
-        let alma = fbakit::face::read("alma").unwrap();
         let read = |path: &Path, fp: &Path| {
             fbakit::face::read_with(path, &FaceReadOptions::with_feature_points(Some(fp)))
                 .unwrap()
@@ -304,17 +313,40 @@ fn setup() -> Option<&'static Setup> {
             let map = prims.iter().map(|p| p.vertices.clone()).collect();
             layouts.push((name, face, map));
         }
-        let layouts = layouts
+        // Every layout from alma; the one-mesh OBJ and the primitives from CANDIDE-3 too (a
+        // source of another style, with no eyeballs or teeth of its own).
+        let runs: Vec<(&'static str, &_)> = SOURCES
+            .iter()
+            .flat_map(|&source| {
+                layouts
+                    .iter()
+                    .filter(move |l| source == "alma" || l.0 != "nodes")
+                    .map(move |l| (source, l))
+            })
+            .collect();
+        // CANDIDE-3 from the shared data (the bundled samples are procedural), with its FAT.
+        let mut sources: BTreeMap<&str, FaceModel> = BTreeMap::new();
+        sources.insert("alma", fbakit::face::read("alma").unwrap());
+        if let Some(c) = candide_data::candide(&[]) {
+            sources.insert("candide", c);
+        }
+        let runs: Vec<_> = runs
             .into_iter()
-            .map(|(name, target, obj_vertex)| {
+            .filter(|r| sources.contains_key(r.0))
+            .collect();
+        let layouts = runs
+            .into_iter()
+            .map(|(source, (name, target, obj_vertex))| {
                 let t = std::time::Instant::now();
-                let out = clone_face(&alma, &target, &CloneOptions::default()).unwrap();
+                let out = clone_face(&sources[source], target, &CloneOptions::default()).unwrap();
+                let name = format!("{name} ({source})");
                 eprintln!("{name}: cloned in {:.2} s", t.elapsed().as_secs_f64());
                 Layout {
                     name,
-                    target,
+                    source,
+                    target: target.clone(),
                     out,
-                    obj_vertex,
+                    obj_vertex: obj_vertex.clone(),
                 }
             })
             .collect();
@@ -479,23 +511,24 @@ fn every_layout_comes_back_vertex_for_vertex() {
     }
 }
 
-/// Low-level FAPs with a table in every layout's clone.
-fn faps(s: &Setup) -> Vec<u8> {
+/// The layouts cloned from `source`.
+fn of_source<'a>(s: &'a Setup, source: &'a str) -> impl Iterator<Item = &'a Layout> + 'a {
+    s.layouts.iter().filter(move |l| l.source == source)
+}
+
+/// Low-level FAPs with a table in every clone from `source`.
+fn faps(s: &Setup, source: &str) -> Vec<u8> {
     (1..=68u8)
         .filter(|&f| {
-            s.layouts
-                .iter()
-                .all(|l| l.out.face.fat.tables.iter().any(|t| t.key == key(f)))
+            of_source(s, source).all(|l| l.out.face.fat.tables.iter().any(|t| t.key == key(f)))
         })
         .collect()
 }
 
-/// [`sample_values`] of every layout together: a part a layout turns by a transform (linear
-/// in the value, no borders) is sampled where another layout baked it.
-fn all_values(s: &Setup, fap: u8) -> Vec<f64> {
-    let mut out: Vec<f64> = s
-        .layouts
-        .iter()
+/// [`sample_values`] of every clone from `source` together: a part a layout turns by a
+/// transform (linear in the value, no borders) is sampled where another layout baked it.
+fn all_values(s: &Setup, source: &str, fap: u8) -> Vec<f64> {
+    let mut out: Vec<f64> = of_source(s, source)
         .flat_map(|l| sample_values(&l.out.face, fap))
         .collect();
     out.sort_by(f64::total_cmp);
@@ -512,8 +545,8 @@ fn eyeballs_turn_rigidly_for_their_own_faps_only() {
         let mut worst_rigid: f32 = 0.0;
         let mut worst_still: (f32, u8) = (0.0, 0);
         let mut turned: f32 = 0.0;
-        for fap in faps(s) {
-            for value in all_values(s, fap) {
+        for fap in faps(s, l.source) {
+            for value in all_values(s, l.source, fap) {
                 let (d, _) = displacements(l, fap, value);
                 for (side, range) in &eyes {
                     let rest: Vec<Vec3> = range.clone().map(|v| p[v]).collect();
@@ -553,12 +586,17 @@ fn eyeballs_turn_rigidly_for_their_own_faps_only() {
                 }
             }
         }
-        assert!(
-            faps(s).iter().filter(|f| matches!(f, 23..=26)).count() == 4,
-            "{}: no eyeball turn tables",
-            l.name
-        );
-        assert!(turned > 0.02, "{}: the eyeballs turn {turned}", l.name);
+        // CANDIDE-3 has no eyeballs: nothing to turn them with.
+        let turns = faps(s, l.source)
+            .iter()
+            .filter(|f| matches!(f, 23..=26))
+            .count();
+        if l.source == "alma" {
+            assert!(turns == 4, "{}: no eyeball turn tables", l.name);
+        }
+        if turns > 0 {
+            assert!(turned > 0.02, "{}: the eyeballs turn {turned}", l.name);
+        }
         eprintln!(
             "{}: eyeballs turn up to {:.1} % of their size, off rigid ≤ {:.4} %; other FAPs move them ≤ {:.5} % (FAP {})",
             l.name,
@@ -577,7 +615,7 @@ fn see_through_eye_layers_never_turn_with_the_eyeball() {
     let eye_size = size(&LEFT_EYEBALL.map(|v| p[v]).collect::<Vec<_>>());
     for l in &s.layouts {
         for fap in [23u8, 24, 25, 26] {
-            for value in all_values(s, fap) {
+            for value in all_values(s, l.source, fap) {
                 let (d, _) = displacements(l, fap, value);
                 for (name, range) in [
                     ("eye occlusion", OCCLUSION),
@@ -724,13 +762,18 @@ const GROUPS: [(&str, std::ops::Range<usize>); 8] = [
 #[test]
 fn the_layouts_move_alike_and_seam_twins_together() {
     let Some(s) = setup() else { return };
-    let obj = &s.layouts[0];
     // Per group: worst per-vertex gap to the OBJ's motion, as a share of the FAP's peak.
     let mut worst: Vec<(f32, u8, &str)> = vec![(0.0, 0, ""); GROUPS.len()];
     // Per group: where the worst gap is (OBJ vertex, the OBJ's motion and the layout's).
     let mut at: Vec<(usize, Vec3, Vec3)> = vec![(0, Vec3::ZERO, Vec3::ZERO); GROUPS.len()];
-    for fap in faps(s) {
-        let values = all_values(s, fap);
+    for (source, fap) in SOURCES
+        .iter()
+        .flat_map(|&source| faps(s, source).into_iter().map(move |f| (source, f)))
+    {
+        let mut same = of_source(s, source);
+        let obj = same.next().unwrap();
+        let others: Vec<&Layout> = same.collect();
+        let values = all_values(s, source, fap);
         let (lo, hi) = values
             .iter()
             .fold((0.0f64, 0.0f64), |a, &v| (a.0.min(v), a.1.max(v)));
@@ -740,7 +783,7 @@ fn the_layouts_move_alike_and_seam_twins_together() {
             if peak == 0.0 {
                 continue;
             }
-            for l in &s.layouts[1..] {
+            for &l in &others {
                 let (d, twins) = displacements(l, fap, value);
                 if twins > 1e-4 * peak {
                     twin_report(l, fap, value);
@@ -756,7 +799,7 @@ fn the_layouts_move_alike_and_seam_twins_together() {
                         .map(|v| (v, d[v].distance(base[v]) / peak))
                         .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
                     if gap > worst[g].0 {
-                        worst[g] = (gap, fap, l.name);
+                        worst[g] = (gap, fap, l.name.as_str());
                         at[g] = (v, base[v], d[v]);
                     }
                 }

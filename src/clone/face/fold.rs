@@ -3,7 +3,9 @@
 //! ([`super::split`]); this folds the view's FAT back into the user's mesh. Entries on the
 //! view's skin and part meshes go back to the original vertex numbers through the split's
 //! index maps, and the motion of transforms created only for cut parts is baked into
-//! per-vertex displacements of those vertices ([`crate::fat::bake`]), within 1 % of the part's
+//! per-vertex displacements of those vertices ([`crate::fat::bake`]) — so is that of a part
+//! transform kept for a whole mesh (an iris) when it also turns pieces cut out of a mesh that
+//! goes back elsewhere (a highlight cut from a primitive whose occlusion shell is skin) —, within 1 % of the part's
 //! size at every FAP value the table covers. The face returned has exactly the target's
 //! meshes, vertices and polygons; its transforms are the target's plus those that still hold
 //! a mesh (a created root `head`).
@@ -116,21 +118,40 @@ pub(super) fn fold_into_target(
         });
     }
     let ranges = covered_ranges(targets);
-    // The transform whose motion a view mesh's vertices are baked with, if any.
-    let baked_by = |m: &ViewMesh| -> Option<usize> {
+    // The transform whose motion a view mesh's vertices are baked with, if any: one baked
+    // away, or, for a part cut out of a mesh that goes back elsewhere (an iris highlight cut
+    // from a primitive whose occlusion shell is skin, its eye's transform kept for an iris
+    // mesh of its own), the part's transform, which no longer holds those vertices.
+    let baked_by = |cut: &CutMeshes, m: &ViewMesh| -> Option<usize> {
         m.part?;
         let t = cloned.meshes[m.index].transform?;
-        hierarchy_ancestors(cloned, Some(t))
+        let gone = hierarchy_ancestors(cloned, Some(t))
             .iter()
-            .any(|&a| baked.contains(&cloned.transforms[a].name))
-            .then_some(t)
+            .any(|&a| baked.contains(&cloned.transforms[a].name));
+        let away = cut.meshes.first().is_some_and(|r| r.index != m.index) && cut.home != Some(t);
+        (gone || away).then_some(t)
     };
+    // Transforms whose motion such a part takes apart from its cut mesh's home: a table
+    // moving one of them (or a baked one) is baked.
+    let mut carried: BTreeSet<&str> = baked.iter().map(String::as_str).collect();
+    for cut in &cuts {
+        let home_chain = hierarchy_ancestors(cloned, cut.home);
+        for m in &cut.meshes {
+            if let Some(t) = baked_by(cut, m) {
+                for a in hierarchy_ancestors(cloned, Some(t)) {
+                    if !home_chain.contains(&a) {
+                        carried.insert(&cloned.transforms[a].name);
+                    }
+                }
+            }
+        }
+    }
     // Transforms baked into several cut meshes (VRoid's eye white, iris and highlight layers,
     // each a primitive holding both eyes): their rows in every mesh share one set of borders,
     // so the part reads back as one motion (each mesh's bisection alone ends elsewhere).
     let mut cut_count: HashMap<usize, usize> = HashMap::new();
     for cut in &cuts {
-        let ts: BTreeSet<usize> = cut.meshes.iter().filter_map(&baked_by).collect();
+        let ts: BTreeSet<usize> = cut.meshes.iter().filter_map(|m| baked_by(cut, m)).collect();
         for t in ts {
             *cut_count.entry(t).or_default() += 1;
         }
@@ -153,7 +174,7 @@ pub(super) fn fold_into_target(
             let moves_baked = table
                 .transforms
                 .iter()
-                .any(|t| baked.contains(&t.transform));
+                .any(|t| carried.contains(t.transform.as_str()));
             let range = ranges.get(&table.key).copied().unwrap_or((0.0, 0.0));
             // Per spread transform, the borders its meshes need together.
             let mut shared: HashMap<usize, Vec<f64>> = HashMap::new();
@@ -161,7 +182,7 @@ pub(super) fn fold_into_target(
                 for cut in &cuts {
                     let own = cut_borders(cloned, table, cut);
                     for m in &cut.meshes {
-                        let Some(t) = baked_by(m).filter(|t| spread.contains(t)) else {
+                        let Some(t) = baked_by(cut, m).filter(|t| spread.contains(t)) else {
                             continue;
                         };
                         let motion = match &mut motion {
@@ -208,7 +229,7 @@ pub(super) fn fold_into_target(
                         .flat_map(|e| e.interval_borders.iter().copied())
                         .collect();
                     for m in &cut.meshes {
-                        let Some(t) = baked_by(m) else {
+                        let Some(t) = baked_by(cut, m) else {
                             continue;
                         };
                         let motion = match &mut motion {

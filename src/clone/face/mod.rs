@@ -20,13 +20,20 @@
 //!    glTF primitive) holding the feature points of several parts — both pupils in one eyes
 //!    mesh, the upper and lower teeth points in one teeth mesh — is cut into one part each:
 //!    by connected pieces, a piece going to the part whose points it holds or lie nearest,
-//!    polygon by polygon when one piece holds several parts' points. A mesh holding no
-//!    feature point whose every piece lies on an eyeball (within 1.3 radii of the centre of
-//!    the piece holding a pupil: VRoid's iris and highlight layers) is cut the same way, each
+//!    polygon by polygon when one piece holds several parts' points. An eye's eyeball is the
+//!    piece holding its pupil, or — when the pupil is on an iris or cornea cap — the largest
+//!    ball-shaped piece behind it that the pupil lies on (an eye white of its own, holding
+//!    no feature point: `eyeball.rs`). A mesh holding no
+//!    feature point whose every piece lies on an eyeball (within 1.3 radii of its centre:
+//!    the eye white, VRoid's iris and highlight layers) is cut the same way, each
 //!    piece to the eye it lies on, so the layers turn with their eyeballs — unless a piece's
-//!    rim rests on the lids (an eye occlusion shell, a lacrimal film, an eye blend): such a
-//!    mesh is skin even when it shares no vertex with the skin, as it is in a one-mesh head,
-//!    so it moves with the lids. A mesh without feature points behind the lips whose rows lie on either side of
+//!    rim rests on the lids (an eye occlusion shell, a lacrimal film, an eye blend): a mesh
+//!    all of such pieces is skin even when it shares no vertex with the skin, as it is in a
+//!    one-mesh head, so it moves with the lids, and a mesh holding both kinds is cut: its
+//!    pieces on an eye go to that eye, those on the lids stay in the mesh as skin. In a
+//!    one-mesh head the same holds for its pieces: one lying wholly on an eyeball goes to
+//!    the eye when its rim is clear of the lids and is skin when it rests on them. Each eye
+//!    turns about its eye white's centre (step 7). A mesh without feature points behind the lips whose rows lie on either side of
 //!    the lip line is cut by rows, and gums joined to a tongue in a mesh of their own (open,
 //!    running back along the jaws) along the line, as in a one-mesh head. Each eye then turns
 //!    about its own centre and the lower row follows the jaw; step 9 folds them back.
@@ -126,7 +133,8 @@
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
 //!    teeth is fine for the teeth, not for the tongue) gets a new transform, child of that one;
 //!    a face without transforms gets a root `head`. Centres: eyes at their eyeball centre
-//!    (least-squares sphere fit, bounding-box centre if the mesh is no sphere), head at 7.1;
+//!    (least-squares sphere fit of the eye's largest piece, the eye white, not the caps in
+//!    front of it; bounding-box centre if that piece is no sphere), head at 7.1;
 //!    a transform the source rotates that has no centre (zero) gets the source's centre mapped
 //!    through the alignment. Centres change with `translation` compensated, so the neutral
 //!    pose does not move. Source `FaceDefTransform`s then map by role: rotations copy their
@@ -211,6 +219,7 @@
 mod align;
 mod assemble;
 mod attached;
+mod eyeball;
 mod fold;
 mod jaw_follow;
 mod lid_close;

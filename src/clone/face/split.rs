@@ -6,10 +6,16 @@
 //! above the lip line (2.2/2.3) are the upper row, those below the lower, and a piece free
 //! in the mouth reaching across the line (gums joined to a tongue) is cut along it
 //! ([`teeth_row_plans`]: the rule); and meshes without feature points lying wholly on the
-//! eyeballs, one piece per eye (VRoid's iris and highlight layers: [`eye_layer_plans`]) go
-//! to the eye each piece lies on — unless its rim rests on the lids (an eye occlusion shell,
-//! a lacrimal film, an eye blend): such a mesh is skin ([`lid_layers`]). The split is an internal view: its index maps
-//! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9).
+//! eyeballs, one piece per eye (VRoid's iris and highlight layers, an eye white behind an
+//! iris cap holding the pupil: [`eye_layer_plans`]) go to the eye each piece lies on —
+//! unless its rim rests on the lids (an eye occlusion shell, a lacrimal film, an eye blend):
+//! a mesh all of such pieces is skin ([`lid_layers`]), and one holding both kinds is cut,
+//! its lid-resting pieces staying in it as skin. A one-mesh head's pieces are sorted the same
+//! way ([`eye_layer_pieces`]). The split is an internal view: its index maps
+//! ([`SplitPart::source_vertices`]) fold the clone back into the target's own mesh (step 9;
+//! a part cut out of a mesh whose rest is skin, under an eye transform kept for a mesh of
+//! its own, is baked into per-vertex rows of that mesh, since the transform no longer holds
+//! its vertices).
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -18,6 +24,7 @@ use parry3d::math::Vector as PVec;
 use parry3d::shape::{CompositeShapeRef, TriMesh};
 use serde::Serialize;
 
+use super::eyeball::{eyeballs, EYE_LAYER_REACH};
 use super::parts::{face_diagonal, fp_mesh_vertex};
 use super::Part;
 use crate::face::{FaceFrames, FaceMesh, FaceModel};
@@ -271,7 +278,7 @@ fn chin_plan(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Option<CutPlan
         members[k].push(v);
     }
     let core = (0..count).max_by_key(|&k| members[k].len()).unwrap_or(0);
-    let fates: Vec<Fate> = (0..count)
+    let mut fates: Vec<Fate> = (0..count)
         .map(|k| {
             if k == core {
                 Fate::Skin
@@ -281,6 +288,9 @@ fn chin_plan(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Option<CutPlan
             }
         })
         .collect();
+    eye_layer_pieces(
+        face, frames, &lm, mesh, &world, &piece, core, &mut fates, diag,
+    );
     let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
     let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
     for (pi, poly) in mesh.polygons.iter().enumerate() {
@@ -558,13 +568,6 @@ fn teeth_row_plans(
     plans
 }
 
-/// Farthest a vertex of an eye layer may lie from its eyeball's centre, in eyeball radii.
-const EYE_LAYER_REACH: f32 = 1.3;
-
-/// Largest eyeball radius an eye layer is looked for around, in ES0 (an eyeball is about
-/// 0.2 ES0: a pupil on a bigger piece is on the skin, as on CANDIDE-3).
-const EYEBALL_MAX_RADIUS: f32 = 0.5;
-
 /// Where a connected piece of a mesh lying on the eyeballs goes ([`eye_layers`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum LayerPiece {
@@ -588,8 +591,9 @@ struct EyeLayer {
 }
 
 /// Meshes (or glTF primitives) holding no feature point whose connected pieces all lie on an
-/// eyeball — every vertex within [`EYE_LAYER_REACH`] radii of the centre of the piece holding
-/// a pupil (bounding-box centre and half extent) —, each piece sorted: a piece whose rim
+/// eyeball — every vertex within [`EYE_LAYER_REACH`] radii of its centre ([`eyeballs`]: the
+/// piece holding the pupil, or the eye white behind an iris cap holding it, which is such a
+/// layer itself) —, each piece sorted: a piece whose rim
 /// comes within [`LID_CLEARANCE`] eyeball radii of the skin rests on the lids (ICT's eye
 /// occlusion, lacrimal film and corner blends), any other goes to the eye it lies on (VRoid's
 /// iris and highlight layers). Meshes in `planned` (cut already) are left out.
@@ -617,39 +621,14 @@ fn eye_layers(
         return Vec::new();
     }
     // Each eyeball: (eye, centre, radius).
-    let mut balls: Vec<(Part, Vec3, f32)> = Vec::new();
-    for (part, id) in [
-        (Part::LeftEye, FeaturePointId::FP_3_5),
-        (Part::RightEye, FeaturePointId::FP_3_6),
-    ] {
-        let Some((mi, v)) = fp_mesh_vertex(face, frames, id, diag * 1e-4) else {
-            continue;
-        };
-        let world = face.mesh_world(frames, mi);
-        let (piece, _) = mesh_pieces(&face.meshes[mi].mesh, eps);
-        let Some(&k) = piece.get(v as usize) else {
-            continue;
-        };
-        let (lo, hi) = piece.iter().zip(&world).filter(|(p, _)| **p == k).fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), (_, &q)| (lo.min(q), hi.max(q)),
-        );
-        let radius = ((hi - lo) / 2.0).max_element();
-        if radius > 0.0 && radius < EYEBALL_MAX_RADIUS * lm.es {
-            balls.push((part, (lo + hi) / 2.0, radius));
-        }
-    }
+    let balls: Vec<(Part, Vec3, f32)> = eyeballs(face, frames, diag, lm.es)
+        .into_iter()
+        .map(|b| (b.part, b.centre, b.radius))
+        .collect();
     if balls.is_empty() {
         return Vec::new();
     }
-    // The eye whose eyeball a point lies on.
-    let on_ball = |q: Vec3| {
-        balls
-            .iter()
-            .filter(|b| q.distance(b.1) <= EYE_LAYER_REACH * b.2)
-            .min_by(|a, b| q.distance(a.1).total_cmp(&q.distance(b.1)))
-            .map(|b| b.0)
-    };
+    let on_ball = |q: Vec3| ball_under(&balls, q);
     // The lids' surface (a BVH over the skin) is built at the first rim it must measure:
     // most faces have no eye layer to sort.
     let mut lids: Option<Option<LidSurface>> = None;
@@ -702,9 +681,92 @@ fn eye_layers(
     out
 }
 
-/// [`eye_layers`] whose every piece goes to an eye, cut one piece per eye so each turns with
-/// its eyeball; the first eye stays in the mesh. A mesh with a piece resting on the lids is
-/// left whole (all of it on the lids: [`lid_layers`]).
+/// The eye whose eyeball (`balls`: eye, centre, radius) `q` lies on: within
+/// [`EYE_LAYER_REACH`] radii of its centre, the nearest such.
+fn ball_under(balls: &[(Part, Vec3, f32)], q: Vec3) -> Option<Part> {
+    balls
+        .iter()
+        .filter(|b| q.distance(b.1) <= EYE_LAYER_REACH * b.2)
+        .min_by(|a, b| q.distance(a.1).total_cmp(&q.distance(b.1)))
+        .map(|b| b.0)
+}
+
+/// Pieces of a one-mesh head's skin mesh (`fates` from their shape and place) that are eye
+/// layers, sorted as such layers are as meshes of their own ([`eye_layers`]): a piece left to
+/// the skin or taken for an eyeball that lies wholly on one eyeball ([`eyeballs`]) goes to
+/// that eye when its rim is clear of the lids (an iris cap holding the pupil in front of its
+/// eye white, a highlight; a closed eyeball has no rim) and is skin when its rim rests on
+/// them (an occlusion shell, round enough to pass for an eyeball, a tear film, corner
+/// blends).
+#[allow(clippy::too_many_arguments)]
+fn eye_layer_pieces(
+    face: &FaceModel,
+    frames: &FaceFrames,
+    lm: &Landmarks,
+    mesh: &Mesh,
+    world: &[Vec3],
+    piece: &[usize],
+    core: usize,
+    fates: &mut [Fate],
+    diag: f32,
+) {
+    let eps = diag * 1e-6;
+    let balls: Vec<(Part, Vec3, f32)> = eyeballs(face, frames, diag, lm.es)
+        .into_iter()
+        .map(|b| (b.part, b.centre, b.radius))
+        .collect();
+    if balls.is_empty() {
+        return;
+    }
+    // Per piece left to the skin: the one eye all its vertices lie on, `None` for none.
+    let mut on: Vec<Option<Option<Part>>> = fates
+        .iter()
+        .enumerate()
+        .map(|(k, f)| {
+            let eye = matches!(f, Fate::Part(Part::LeftEye | Part::RightEye));
+            (k != core && (*f == Fate::Skin || eye)).then_some(None)
+        })
+        .collect();
+    let mut seen = vec![false; fates.len()];
+    for (&k, &q) in piece.iter().zip(world) {
+        let Some(slot) = on.get_mut(k) else { continue };
+        let Some(eye) = slot else { continue };
+        let here = ball_under(&balls, q);
+        *eye = if seen[k] && *eye != here { None } else { here };
+        if eye.is_none() {
+            *slot = None;
+        }
+        seen[k] = true;
+    }
+    if !on.iter().any(|o| matches!(o, Some(Some(_)))) {
+        return;
+    }
+    let on_ball = |q: Vec3| ball_under(&balls, q);
+    if let Some(lids) = LidSurface::of(face, frames, eps, &on_ball) {
+        for v in rim_vertices(mesh, eps) {
+            let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
+                continue;
+            };
+            let Some(Some(part)) = on[k] else { continue };
+            let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
+            if lids.within(q, LID_CLEARANCE * radius) {
+                fates[k] = Fate::Skin;
+                on[k] = None;
+            }
+        }
+    }
+    for (k, o) in on.into_iter().enumerate() {
+        if let Some(Some(part)) = o {
+            fates[k] = Fate::Part(part);
+        }
+    }
+}
+
+/// [`eye_layers`] with a piece going to an eye and none over both eyes, cut one piece per
+/// eye so each turns with its eyeball. Pieces resting on the lids (an occlusion shell in one
+/// primitive with an iris highlight) are skin and stay in the mesh under its name, moved by
+/// the surface method; without them the first eye stays there. A mesh all on the lids is
+/// left whole ([`lid_layers`]).
 fn eye_layer_plans(
     face: &FaceModel,
     frames: &FaceFrames,
@@ -716,19 +778,21 @@ fn eye_layer_plans(
         let mesh = &face.meshes[layer.mesh].mesh;
         let mut dest: BTreeMap<Option<Part>, Vec<usize>> = BTreeMap::new();
         let mut pieces: BTreeMap<Part, BTreeSet<usize>> = BTreeMap::new();
-        let mut all_on = true;
+        let mut both = false;
         for (pi, poly) in mesh.polygons.iter().enumerate() {
             let Some(&k) = poly.first().and_then(|&v| layer.piece.get(v as usize)) else {
                 continue;
             };
-            let Some(LayerPiece::Eye(part)) = layer.fate[k] else {
-                all_on = false;
-                break;
-            };
-            pieces.entry(part).or_default().insert(k);
-            dest.entry(Some(part)).or_default().push(pi);
+            match layer.fate[k] {
+                Some(LayerPiece::Eye(part)) => {
+                    pieces.entry(part).or_default().insert(k);
+                    dest.entry(Some(part)).or_default().push(pi);
+                }
+                Some(LayerPiece::OnLids) => dest.entry(None).or_default().push(pi),
+                Some(LayerPiece::BothEyes) | None => both = true,
+            }
         }
-        if !all_on || dest.is_empty() {
+        if both || pieces.is_empty() {
             continue;
         }
         let rest = dest.keys().next().copied().flatten();

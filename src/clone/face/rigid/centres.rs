@@ -85,7 +85,8 @@ fn install_recorded(
     installed.push((face.transforms[t].name.clone(), world.to_array()));
 }
 
-/// Centres each eye's transform at its eyeball centre.
+/// Centres each eye's transform at its eyeball centre: the eye white's (the largest piece of
+/// the eye's meshes), whatever caps lie in front of it.
 pub(super) fn install_eye_centres(
     face: &mut FaceModel,
     tparts: &FaceParts,
@@ -96,17 +97,7 @@ pub(super) fn install_eye_centres(
     let frames = face.frames();
     for eye in [Part::LeftEye, Part::RightEye] {
         if let (Some(&t), Some(meshes)) = (part_tf.get(&eye), tparts.parts.get(&eye)) {
-            let pts: Vec<Vec3> = meshes
-                .iter()
-                .flat_map(|&m| {
-                    let w = frames.meshes[m];
-                    face.meshes[m]
-                        .mesh
-                        .positions
-                        .iter()
-                        .map(move |&p| w.transform_point3(p))
-                })
-                .collect();
+            let pts = super::super::eyeball::eye_white_points(face, &frames, meshes);
             if let Some(c) = eyeball_centre(&pts) {
                 install_recorded(face, t, c, installed);
             }
