@@ -610,12 +610,8 @@ fn alma_onto_ict_lids() {
         eprintln!("note: bundled faces alma / ict not readable; skipped");
         return;
     };
-    // Both lid options on (their docs say why they are off by default).
-    let opts = CloneOptions {
-        smooth_shares: true,
-        lid_close: true,
-        ..fit()
-    };
+    // The default options: `smooth_shares` and `lid_close` on.
+    let opts = fit();
     let bare = fbakit::export::picture::strip_fat(&ict);
     let out = fbakit::clone::face::clone_face(&alma, &bare, &opts).unwrap();
     let c = &out.face;
@@ -664,12 +660,59 @@ fn alma_onto_ict_lids() {
         let ball = eyeball_vertices(&out, part);
         let depth = eyeball_depth(c, &ball, &blink(c, eye, value));
         let own_depth = eyeball_depth(&ict, &ball, &blink(&ict, eye, own));
-        // Not asserted (left, issue 21): the lid points move straight by their FAPU, as
-        // alma's turning lid does chord by chord, and pass 0.21–0.23 radii into the
-        // eyeball (ICT's own 0.11); a forward push of the lid skin folded the lower lid.
         eprintln!(
-            "eye {:?}: depth {depth:.3} against ICT's own {own_depth:.3}",
+            "eye {:?}: blink depth {depth:.3} against ICT's own {own_depth:.3}",
             eye.faps
         );
+        // No lid deeper into the eyeball than ICT's own FAT takes it (the old clone: 0.21–
+        // 0.23 radii under the blink, ICT's own 0.11): under the blink, and under each lid
+        // FAP alone at each border of its table and half way between (a FAT moves a vertex
+        // on a straight chord between borders, and a lid turning about its eyeball in the
+        // source cut through it on the way).
+        assert!(
+            depth <= own_depth + 0.03,
+            "eye {:?}: the blink takes a lid {depth:.3} radii into the eyeball (ICT's own {own_depth:.3})",
+            eye.faps
+        );
+        for f in [eye.faps.0, eye.faps.1] {
+            for v in border_values(c, f) {
+                let a = [Activation {
+                    key: key(f),
+                    value: v,
+                }];
+                let (d, o) = (eyeball_depth(c, &ball, &a), eyeball_depth(&ict, &ball, &a));
+                eprintln!("FAP {f} @{v}: depth {d:.3} against ICT's own {o:.3}");
+                assert!(
+                    d <= o + 0.03,
+                    "FAP {f} @{v}: a lid goes {d:.3} radii into the eyeball (ICT's own {o:.3})"
+                );
+            }
+        }
     }
+}
+
+/// The borders of FAP `f`'s table in `face` and the values half way between them (and 0).
+fn border_values(face: &FaceModel, f: u8) -> Vec<f64> {
+    let mut b: Vec<f64> = face
+        .fat
+        .tables
+        .iter()
+        .filter(|t| t.key == key(f))
+        .flat_map(|t| {
+            t.meshes
+                .iter()
+                .flat_map(|m| m.interval_borders.iter().copied())
+        })
+        .chain([0.0])
+        .collect();
+    b.sort_by(f64::total_cmp);
+    b.dedup();
+    let mut out: Vec<f64> = b
+        .windows(2)
+        .flat_map(|w| [0.5 * (w[0] + w[1]), w[0], w[1]])
+        .filter(|v| *v != 0.0)
+        .collect();
+    out.sort_by(f64::total_cmp);
+    out.dedup();
+    out
 }

@@ -214,6 +214,7 @@ mod attached;
 mod fold;
 mod jaw_follow;
 mod lid_close;
+mod lid_eyeball;
 mod lid_margin;
 mod motions;
 mod mouth_fill;
@@ -358,13 +359,20 @@ pub fn clone_face(
         .timings
         .push("motions", clock.elapsed().as_secs_f64());
     // 5, 6. Surface method and FAPU rescale.
-    let (mut cloned_motions, [tmargins, smargins]) =
-        clone_skin_motions(&ssurf, &tsurf, &motions, &alignment, opts, &mut report)?;
+    let (mut cloned_motions, [tmargins, smargins]) = clone_skin_motions(
+        &ssurf,
+        &tsurf,
+        &motions,
+        (target, &tparts),
+        &alignment,
+        opts,
+        &mut report,
+    )?;
     // Lashes ride on their own lid's margin: rows that are pieces of the skin take its
     // motion here, rows of their own mesh in step 8. A source with rows of lashes in its own
     // skin has them mapped onto the target's by the surface method, like for like (and a
     // target one mesh with the source keeps the source's lash motion vertex to vertex).
-    let margins = tmargins.with_eyeballs(target, &tparts, &alignment);
+    let margins = tmargins;
     let source_rows = lid_margin::SkinRows::of(source, &ssurf, &smargins);
     if !whole && source_rows.is_empty() {
         lid_margin::SkinRows::of(target, &tsurf, &margins).carry(&mut cloned_motions);
@@ -510,6 +518,7 @@ fn clone_skin_motions(
     ssurf: &SkinSurface,
     tsurf: &SkinSurface,
     motions: &[SurfaceMotion],
+    (target, tparts): (&FaceModel, &FaceParts),
     alignment: &Similarity,
     opts: &CloneOptions,
     report: &mut CloneReport,
@@ -550,6 +559,11 @@ fn clone_skin_motions(
         },
     );
     let mut result = result?;
+    let topology = topology.with_lid_middles(&margins[0]);
+    // The target's margins know its eyeballs (lashes and lids stay out of them).
+    let [tm, sm] = margins;
+    let margins = [tm.with_eyeballs(target, tparts, alignment), sm];
+
     for (name, s) in &result.timings.steps {
         report
             .timings
@@ -640,6 +654,15 @@ fn clone_skin_motions(
     report
         .timings
         .push("lid_close", clock.elapsed().as_secs_f64());
+    // No lid through an eyeball on its way to any border; before `smooth2` and `bound`,
+    // which settle what the push turns.
+    let clock = Instant::now();
+    if opts.lid_close {
+        lid_eyeball::keep_lids_out(&tsurf.surface, &margins[0], &mut result.motions);
+    }
+    report
+        .timings
+        .push("eyeball", clock.elapsed().as_secs_f64());
     // The gain's bump changes the motion after `smooth` looked at it (bruno → ict's lip
     // corner under `viseme_1` turned 12× the source's): the same rule once more. A smooth
     // motion is not changed. Not after the mouth fill: smoothing the uniform-Laplacian way
@@ -658,6 +681,7 @@ fn clone_skin_motions(
     report
         .timings
         .push("smooth2", clock.elapsed().as_secs_f64());
+
     // The hidden mouth interior: a smooth extension of the lips into the jaw's motion.
     let clock = Instant::now();
     if let Some(interior) = interior {

@@ -30,10 +30,13 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::lid_margin::LidMargins;
 use super::rescale::fap_fp;
 use crate::clone::quality::{max_normal_turn, NORMAL_TURN_FLOOR};
 use crate::clone::{CloneSurface, SurfaceMotion};
+use crate::fat::TableKey;
 use crate::mesh::geometry::adjacency;
+use crate::spec::FapId;
 
 /// Slack over the source's largest turn before a target triangle counts as rough.
 const SLACK: f64 = 1.25;
@@ -175,6 +178,10 @@ pub(super) struct SmoothTopology {
     /// The same at each of the [`SHARES`] of each source motion (empty unless built
     /// `with_shares`).
     pub(super) share_turns: Vec<[f64; SHARES.len()]>,
+    /// Per lid FAP, the middle of its lid's margin on the target
+    /// ([`LidMargins::middle`]), held with the FAP's own feature point when the shares are
+    /// checked (empty until [`Self::with_lid_middles`]).
+    pub(super) lid_middles: Vec<(TableKey, Vec<u32>)>,
 }
 
 impl SmoothTopology {
@@ -208,7 +215,29 @@ impl SmoothTopology {
             tn: normals(&target.positions, &target.triangles),
             source_turns,
             share_turns,
+            lid_middles: Vec::new(),
         }
+    }
+
+    /// The same holding the middles of the target's lid margins (`margins`) under their lid
+    /// FAPs (19–22) when the shares are checked: smoothing a fold at an eye corner at a
+    /// quarter of the motion otherwise drew the margin's middle up against its held lid
+    /// point (alma → ICT's lashes, riding the margin, followed 75 % of the lid point).
+    pub(super) fn with_lid_middles(mut self, margins: &LidMargins) -> Self {
+        self.lid_middles = [
+            (19, true, true),
+            (20, false, true),
+            (21, true, false),
+            (22, false, false),
+        ]
+        .into_iter()
+        .filter_map(|(fap, left, upper)| {
+            let key = TableKey::LowLevel(FapId::new(fap)?);
+            let middle = margins.middle(left, upper);
+            (!middle.is_empty()).then_some((key, middle))
+        })
+        .collect();
+        self
     }
 }
 
@@ -253,6 +282,7 @@ pub(super) fn smooth_motions(
         tn,
         source_turns,
         share_turns,
+        lid_middles,
     } = topology;
     let results: Vec<Option<(String, usize)>> = motions
         .par_iter()
@@ -313,6 +343,17 @@ pub(super) fn smooth_motions(
             if let Some((fp, _)) = fap_fp(src.key, source, target) {
                 if let Some(p) = pinned.get_mut(target.fp_vertices[&fp] as usize) {
                     *p = true;
+                }
+            }
+            // So does the middle of a lid FAP's margin when the shares are checked
+            // ([`SmoothTopology::with_lid_middles`]).
+            if with_shares {
+                for (_, middle) in lid_middles.iter().filter(|m| m.0 == src.key) {
+                    for &v in middle {
+                        if let Some(p) = pinned.get_mut(v as usize) {
+                            *p = true;
+                        }
+                    }
                 }
             }
             let mut touched = vec![false; n];
@@ -386,9 +427,7 @@ pub(super) fn smooth_motions(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fat::TableKey;
     use crate::fdp::{Fapu, FapuDistances};
-    use crate::spec::FapId;
 
     /// A flat grid of `k × k` vertices (spacing 1) in the xy plane.
     fn grid(k: u32) -> CloneSurface {
