@@ -14,7 +14,16 @@
 //!    FAP and by the lower one through the bottom FAP, in the shares each FAP closes the
 //!    source's lid points by, as a vertical change of each margin vertex's motion (the FAPs'
 //!    own feature points and the corners keep theirs).
-//! 3. Each change spreads over its lid's side of the corner line, fading out by a Wendland
+//! 3. The change fades out over the margin's middle ([`LidMargins::middle_weights`]: none at
+//!    the lid point, all of it from half way to each corner on). The lid point moves as its
+//!    FAP defines, and the lashes over the lid's middle ride the margin beside it: a change
+//!    there left alone took them off their lid (alma → ICT's lower lashes 0.14 of the lid
+//!    opening past the lid point at 1024).
+//! 4. The change grows with the FAP value over the table's first interval, so it is capped
+//!    where that would close (or open) the slit at the interval's end further than the
+//!    source's own slit is closed there (the source over-closes past `v`; the target by no
+//!    more): a change of `v`'s full size doubled at 1024 for alma's `v` = 512.
+//! 5. Each change spreads over its lid's side of the corner line, fading out by a Wendland
 //!    bump within [`REACH`] ES0 of the margin. `smooth`'s second pass follows (holding the
 //!    margins there instead creased ICT's lids cloned onto alma's and bruno's: turn ratios
 //!    1.37 → 1.56, 2.03 → 2.75).
@@ -345,5 +354,22 @@ fn capped(excess: f32, at_far: f32) -> f32 {
         0.0
     } else {
         excess.signum() * excess.abs().min(at_far.abs())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_change_is_capped_by_what_the_end_of_the_interval_allows() {
+        // Closing by 0.2 at the closing value, but only 0.1 (scaled back) keeps the end of
+        // the interval no more closed than the source's there.
+        assert_eq!(capped(0.2, 0.1), 0.1);
+        assert_eq!(capped(0.05, 0.1), 0.05);
+        assert_eq!(capped(-0.2, -0.05), -0.05);
+        // The end is already past the source's: no change at all.
+        assert_eq!(capped(0.2, -0.1), 0.0);
+        assert_eq!(capped(-0.2, 0.1), 0.0);
     }
 }

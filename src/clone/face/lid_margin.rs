@@ -695,6 +695,24 @@ mod tests {
     }
 
     #[test]
+    fn the_margin_middle_fades_in_from_the_lid_point_to_half_way() {
+        let surf = strip();
+        let margins = LidMargins::of(&surf);
+        // Vertices 0..=8 along x, the lid point 3.1 at 4: half way to each corner is two
+        // vertices out.
+        let w = margins.middle_weights(true, true);
+        assert_eq!(w.len(), 9);
+        assert_eq!(w[4], 0.0);
+        assert!(
+            (w[3] - 0.5).abs() < 1e-6 && (w[5] - 0.5).abs() < 1e-6,
+            "{w:?}"
+        );
+        assert!(w[..=2].iter().chain(&w[6..]).all(|&x| x == 1.0), "{w:?}");
+        assert_eq!(margins.middle(true, true), [3, 4, 5]);
+        assert!(margins.middle(false, true).is_empty());
+    }
+
+    #[test]
     fn a_coarse_skin_uses_the_feature_points_alone() {
         let mut surf = strip();
         // The lid point on the corner's vertex, as on the coarse test avatar.
