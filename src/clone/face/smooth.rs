@@ -101,6 +101,30 @@ fn rough_at(
     n0.dot(n1) / l < cos_tau
 }
 
+/// The turn of triangle `t` (neutral unit normal `n0`) under `share` of the displacements
+/// `d`, over the angle whose cosine is `cos_tau` (a collapsed triangle: a half turn).
+fn turn_ratio(
+    positions: &[Vec3],
+    d: &[Vec3],
+    share: f32,
+    t: &[u32; 3],
+    n0: Vec3,
+    cos_tau: f32,
+) -> f32 {
+    if n0 == Vec3::ZERO {
+        return 0.0;
+    }
+    let p = |k: usize| positions[t[k] as usize] + share * d[t[k] as usize];
+    let n1 = (p(1) - p(0)).cross(p(2) - p(0));
+    let l = n1.length();
+    let angle = if l.is_finite() && l > 0.0 {
+        (n0.dot(n1) / l).clamp(-1.0, 1.0).acos()
+    } else {
+        std::f32::consts::PI
+    };
+    angle / cos_tau.clamp(-1.0, 1.0).acos().max(1e-6)
+}
+
 /// The triangles using each of `n` vertices.
 pub(super) fn incident_triangles(n: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
     let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
@@ -347,8 +371,10 @@ pub(super) fn smooth_motions(
             }
             // So does the middle of a lid FAP's margin when the shares are checked
             // ([`SmoothTopology::with_lid_middles`]).
+            let mut held_middle = false;
             if with_shares {
                 for (_, middle) in lid_middles.iter().filter(|m| m.0 == src.key) {
+                    held_middle = true;
                     for &v in middle {
                         if let Some(p) = pinned.get_mut(v as usize) {
                             *p = true;
@@ -356,6 +382,24 @@ pub(super) fn smooth_motions(
                     }
                 }
             }
+            // The worst turn over the checks, against each check's limit.
+            let worst = |d: &[Vec3], offsets: &[(u32, Vec3)]| -> f32 {
+                touching(incident, offsets)
+                    .into_iter()
+                    .map(|i| {
+                        let (t, n0) = (&tris[i as usize], tn[i as usize]);
+                        checks
+                            .iter()
+                            .map(|&(s, c)| turn_ratio(pos, d, s, t, n0, c))
+                            .fold(0.0, f32::max)
+                    })
+                    .fold(0.0, f32::max)
+            };
+            let before = if held_middle {
+                worst(&d, &dst.offsets)
+            } else {
+                0.0
+            };
             let mut touched = vec![false; n];
             let mut count = 0usize;
             let mut next = d.clone();
@@ -417,7 +461,13 @@ pub(super) fn smooth_motions(
                     break;
                 }
             }
-            dst.offsets = sparse_offsets(&d);
+            let smoothed = sparse_offsets(&d);
+            // With a lid's middle held the smoothing can fold the lid next to it (ICT's
+            // `close_t_l_eyelid` onto alma: 31° → 178°): then it is undone.
+            if held_middle && worst(&d, &smoothed) > before {
+                return None;
+            }
+            dst.offsets = smoothed;
             Some((format!("{}@{}", src.key.name(), src.value), count))
         })
         .collect();
