@@ -202,11 +202,7 @@ fn every_mode_on_identity_heads() {
                         Mode::Fmc => (4.6, 6.0),
                         Mode::Rbf => (3.2, 4.3),
                         _ if c.name.contains("dense") => (2.95, 4.0),
-                        // Vertex to vertex, then the pipeline's later steps: 0.0 % until
-                        // stop 33; with `smooth_shares` / `lid_close` on by default and
-                        // `bound`'s faded rounds, 0.1–0.3 % on the lip corners
-                        // (stretch_*_cornerlip; not yet traced to one of them).
-                        _ => (0.1, 0.5),
+                        _ => (0.1, 0.1),
                     };
                     assert!(
                         r.median <= med && r.worst.1 <= worst,
