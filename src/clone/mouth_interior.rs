@@ -25,7 +25,6 @@ use std::collections::{BTreeSet, VecDeque};
 use glam::Vec3;
 
 use super::CloneSurface;
-use crate::mesh::geometry::adjacency;
 use crate::spec::FeaturePointId as F;
 
 /// How far behind the lips' front (MNS0) a vertex must lie to be inside.
@@ -124,9 +123,9 @@ pub(crate) struct MouthInterior {
 }
 
 impl MouthInterior {
-    /// The interior of `s` (module docs) within `extent` of the lips; `None` when it has
-    /// none.
-    pub(crate) fn of(s: &CloneSurface, extent: Extent) -> Option<MouthInterior> {
+    /// The interior of `s` (module docs) within `extent` of the lips, `adj` its vertex
+    /// adjacency (the callers have it already); `None` when it has none.
+    pub(crate) fn of(s: &CloneSurface, adj: &[Vec<u32>], extent: Extent) -> Option<MouthInterior> {
         let mouth = Mouth::of(s)?;
         let n = s.positions.len();
         let depth = DepthBuffer::new(s, &mouth, extent);
@@ -145,7 +144,6 @@ impl MouthInterior {
         if !candidate.iter().any(|&c| c) {
             return None;
         }
-        let adj = adjacency(n, &s.triangles);
         let mut inside = vec![false; n];
         let mut queue: VecDeque<(u32, u8)> = INNER_LIP
             .iter()
@@ -165,8 +163,8 @@ impl MouthInterior {
             } else if rings >= SEED_RINGS {
                 continue;
             }
-            for &w in &adj[v as usize] {
-                if !seen[w as usize] {
+            for &w in adj.get(v as usize).map_or(&[][..], Vec::as_slice) {
+                if !seen.get(w as usize).copied().unwrap_or(true) {
                     let r = if candidate[v as usize] { 0 } else { rings + 1 };
                     queue.push_back((w, r));
                 }

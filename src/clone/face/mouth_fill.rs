@@ -164,9 +164,9 @@ impl MouthInterior {
     pub(super) fn new(tsurf: &SkinSurface) -> Option<MouthInterior> {
         let s = &tsurf.surface;
         let n = s.positions.len();
-        let region = crate::clone::mouth_interior::MouthInterior::of(s, Extent::LIPS)?;
-        let (mouth, reached) = (region.mouth, region.inside);
         let adj = adjacency(n, &s.triangles);
+        let region = crate::clone::mouth_interior::MouthInterior::of(s, &adj, Extent::LIPS)?;
+        let (mouth, reached) = (region.mouth, region.inside);
         let mut free = vec![false; n];
         let mut deep = vec![false; n];
         for (v, p) in s.positions.iter().enumerate() {

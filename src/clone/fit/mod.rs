@@ -331,7 +331,7 @@ fn register_and_correspond(
     let labels = |s: &CloneSurface| {
         let adj = adjacency(s.positions.len(), &s.triangles);
         let (sides, slits) = classify(s, &adj);
-        let inside = MouthInterior::of(s, Extent::SOCKET).map_or_else(Vec::new, |m| m.inside);
+        let inside = MouthInterior::of(s, &adj, Extent::SOCKET).map_or_else(Vec::new, |m| m.inside);
         ((adj, sides, slits, face_pieces(s)), inside)
     };
     let (
