@@ -207,3 +207,21 @@ fn real_head_page_shows_pupils_above_the_controls_in_chromium() {
     assert!((f(&r["stateAfterScrub"]["time"]) - f(&r["pickedFrame"]["time"]) / 2.0).abs() < 0.02);
     assert_eyes_and_framing(&r);
 }
+
+/// The ICT-FaceKit's whole head (`../shared`): its eye occlusion, tear film and corner blends
+/// are left out of the page (transparent in ICT's materials, they covered the eyes in the
+/// glb's one material), so both pupils show dark.
+#[test]
+fn whole_ict_head_page_shows_its_pupils_through_the_eye_layers_in_chromium() {
+    let work = tempfile::tempdir().unwrap();
+    let Some((_, face)) = support::ict_full_head::ict_full_head(work.path()) else {
+        return;
+    };
+    // No FAT (a page in pose mode): only the neutral view matters here.
+    let page = work.path().join("ict-full.html");
+    ViewerPage::new(&face, None).unwrap().write(&page).unwrap();
+    let Some(r) = check_page(&page) else { return };
+    assert_clean(&r);
+    assert_eq!(r["stateOnLoad"]["mode"], "pose");
+    assert_eyes_and_framing(&r);
+}

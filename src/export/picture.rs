@@ -6,13 +6,15 @@
 //! each mesh in its own colour, from a front camera framed on the *neutral* face so that
 //! frames of one face share a camera and motion shows as motion, not as re-framing. Contact
 //! sheets and the cloning grid frame the face from its feature points
-//! ([`FaceView::face_camera`]), not the whole head with its neck.
+//! ([`FaceView::face_camera`]), not the whole head with its neck. Eye layers resting on the
+//! lids (an eye occlusion, a tear film, corner blends: transparent in the head's own
+//! materials) are left out ([`crate::clone::face::lid_resting_layers`]).
 
 pub mod eyes;
 
 use glam::Vec3;
 
-use crate::clone::face::{clone_face, CloneOptions, Method};
+use crate::clone::face::{clone_face, lid_resting_layers, CloneOptions, Method};
 use crate::error::Result;
 use crate::face::parts::{split_mesh, FacePart};
 use crate::face::FaceModel;
@@ -63,9 +65,14 @@ impl FaceView {
     pub fn new(face: &FaceModel) -> Result<FaceView> {
         let neutral = face.neutral_world_positions();
         let eyes = eyes::eyeballs(face, &neutral);
+        // Transparent in the user's materials, opaque here: drawn, they close the eyes.
+        let layers = lid_resting_layers(face);
         let mut parts = Vec::new();
         for (i, m) in face.meshes.iter().enumerate() {
             let mut triangles = orient_outwards(&m.mesh.triangles(), &neutral[i]);
+            if let Some(l) = layers.iter().find(|l| l.mesh == i) {
+                triangles.retain(|t| !t.iter().all(|v| l.vertices.binary_search(v).is_ok()));
+            }
             let mesh_part = FacePart::of_mesh_name(&m.name);
             // Eyeballs inside another mesh (a one-mesh head) get their own parts first.
             let mut groups: Vec<(FacePart, Vec<[u32; 3]>)> = Vec::new();

@@ -105,6 +105,19 @@ pub struct ViewerModel {
     pub tracks: Vec<KeyTrack>,
     /// Eyeballs to paint an iris and pupil on (the exported glb gives a mesh one material).
     pub eyes: Vec<EyePaint>,
+    /// Eye layers resting on the lids that the page leaves out
+    /// ([`crate::clone::face::lid_resting_layers`]): transparent in the head's own materials,
+    /// opaque in the glb's one material per mesh, they would close the eyes.
+    pub hidden: Vec<HiddenLayer>,
+}
+
+/// Vertices of a glTF mesh node whose triangles the page does not draw.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HiddenLayer {
+    /// glTF node index of the mesh.
+    pub node: u32,
+    /// The vertices, ascending: a triangle with every corner among them is left out.
+    pub vertices: Vec<u32>,
 }
 
 /// An eyeball of a glTF mesh node and which of its triangles are iris and pupil (by their
@@ -465,6 +478,7 @@ impl ViewerModel {
             transforms,
             tracks,
             eyes: eye_paints(face, &mesh_node),
+            hidden: hidden_layers(face, &mesh_node),
         })
     }
 
@@ -624,6 +638,19 @@ fn camera_frame(face: &FaceModel) -> CameraFrame {
         radius,
         half_extent: ((hi - lo) * 0.5).max(Vec3::splat(radius * 0.01)).to_array(),
     }
+}
+
+/// The eye layers of `face` resting on its lids, on their glTF nodes (see [`HiddenLayer`]).
+fn hidden_layers(face: &FaceModel, mesh_node: &dyn Fn(&str) -> Option<u32>) -> Vec<HiddenLayer> {
+    crate::clone::face::lid_resting_layers(face)
+        .into_iter()
+        .filter_map(|l| {
+            Some(HiddenLayer {
+                node: mesh_node(&face.meshes[l.mesh].name)?,
+                vertices: l.vertices,
+            })
+        })
+        .collect()
 }
 
 /// The eyeballs of `face` on their glTF nodes (see [`EyePaint`]).

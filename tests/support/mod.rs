@@ -5,6 +5,7 @@ pub mod blender;
 pub mod cli;
 pub mod gltf_scenes;
 pub mod gltf_transform;
+pub mod ict_full_head;
 pub mod loader_outputs;
 pub mod node_check;
 pub mod validator;

@@ -224,6 +224,7 @@ mod fold;
 mod jaw_follow;
 mod lid_close;
 mod lid_margin;
+mod lid_resting;
 mod motions;
 mod mouth_fill;
 mod options;
@@ -245,6 +246,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 pub use align::Similarity;
+pub use lid_resting::{lid_resting_layers, LidRestingLayer};
 pub use options::{face_fmc_options, face_rbf_options, CloneOptions, Method};
 pub use parts::{identify_parts, FaceParts, Part};
 pub use report::{CloneOutcome, CloneReport, RigidReport};

@@ -683,7 +683,7 @@ fn eye_layers(
 
 /// The eye whose eyeball (`balls`: eye, centre, radius) `q` lies on: within
 /// [`EYE_LAYER_REACH`] radii of its centre, the nearest such.
-fn ball_under(balls: &[(Part, Vec3, f32)], q: Vec3) -> Option<Part> {
+pub(super) fn ball_under(balls: &[(Part, Vec3, f32)], q: Vec3) -> Option<Part> {
     balls
         .iter()
         .filter(|b| q.distance(b.1) <= EYE_LAYER_REACH * b.2)
@@ -831,20 +831,20 @@ pub(super) fn lid_layers(face: &FaceModel, frames: &FaceFrames, diag: f32) -> Ve
 /// this rests on the lids. ICT's eye blend (corner wedges) comes to 0.013 radii of the
 /// skin and its eye occlusion and lacrimal film touch it (0); VRoid's iris and highlight
 /// caps float over the eye white, clear of the lids.
-const LID_CLEARANCE: f32 = 0.05;
+pub(super) const LID_CLEARANCE: f32 = 0.05;
 
 /// The skin around the eyes, to tell the layers that rest on the lids (an eye occlusion
 /// shell, a lacrimal film, corner blends: rigid with the lids, never turning with the eye)
 /// from the eye's own layers (iris, highlight): every mesh holding a skin feature point,
 /// without its pieces lying wholly on an eyeball (the eyeballs and layers of a one-mesh
 /// head).
-struct LidSurface {
+pub(super) struct LidSurface {
     mesh: TriMesh,
 }
 
 impl LidSurface {
     /// `None` without skin triangles.
-    fn of(
+    pub(super) fn of(
         face: &FaceModel,
         frames: &FaceFrames,
         eps: f32,
@@ -889,7 +889,7 @@ impl LidSurface {
     }
 
     /// Whether `q` lies within `gap` of the surface.
-    fn within(&self, q: Vec3, gap: f32) -> bool {
+    pub(super) fn within(&self, q: Vec3, gap: f32) -> bool {
         CompositeShapeRef(&self.mesh)
             .project_local_point_and_get_location(PVec::new(q.x, q.y, q.z), gap, false)
             .is_some()

@@ -488,15 +488,22 @@
   // ---- Eyes -------------------------------------------------------------------------------
 
   /** Gives the triangles of every eyeball (model.eyes) an eye-white, iris or pupil material:
-   * the glb has one material per mesh, which would draw eyes blank. */
+   * the glb has one material per mesh, which would draw eyes blank. Leaves out the triangles
+   * of eye layers resting on the lids (model.hidden: an occlusion shell, a tear film),
+   * transparent in the head's own materials and opaque in that one. */
   function paintEyes() {
     const byNode = new Map();
-    for (const e of model.eyes || []) {
-      if (!byNode.has(e.node)) byNode.set(e.node, []);
-      byNode.get(e.node).push(e);
+    const entry = (node) => {
+      if (!byNode.has(node)) byNode.set(node, { eyes: [], hidden: new Set() });
+      return byNode.get(node);
+    };
+    for (const e of model.eyes || []) entry(e.node).eyes.push(e);
+    for (const h of model.hidden || []) {
+      const set = entry(h.node).hidden;
+      for (const v of h.vertices) set.add(v);
     }
     const keyOf = (a, b, c) => [a, b, c].sort((x, y) => x - y).join(',');
-    for (const [node, eyes] of byNode) {
+    for (const [node, { eyes, hidden }] of byNode) {
       const o = (meshObjects.get(node) || [])[0];
       if (!o || !o.geometry || !o.geometry.index || Array.isArray(o.material)) continue;
       const sets = eyes.map((e) => ({
@@ -506,10 +513,15 @@
       }));
       const index = o.geometry.index.array;
       const buckets = [[], [], [], []];
+      let left = 0;
       for (let t = 0; t + 2 < index.length; t += 3) {
         const a = index[t];
         const b = index[t + 1];
         const c = index[t + 2];
+        if (hidden.has(a) && hidden.has(b) && hidden.has(c)) {
+          left += 3;
+          continue;
+        }
         let m = 0;
         for (const s of sets) {
           if (!(s.ball.has(a) && s.ball.has(b) && s.ball.has(c))) continue;
@@ -519,8 +531,8 @@
         }
         buckets[m].push(a, b, c);
       }
-      if (buckets[1].length + buckets[2].length + buckets[3].length === 0) continue;
-      const out = new index.constructor(index.length);
+      if (buckets[1].length + buckets[2].length + buckets[3].length + left === 0) continue;
+      const out = new index.constructor(index.length - left);
       const geo = o.geometry;
       geo.clearGroups();
       let start = 0;
@@ -530,6 +542,10 @@
         start += tris.length;
       });
       geo.setIndex(new T.BufferAttribute(out, 1));
+      if (!eyes.length) {
+        geo.clearGroups();
+        continue;
+      }
       const base = o.material;
       const [white, iris, pupil] = eyes[0].colours;
       const paint = (rgb, roughness) => {
