@@ -32,6 +32,20 @@
 //! expected ~15–25 ms (parts ~33 → ~15, the factorisations ~10 % each, the unnamed time
 //! before `align` where the target check runs). Peak memory: bench 98–99 → 100 MB, probe
 //! 98–99 → 102–108 MB (not traced; the grid holds 16 bytes a vertex while it runs; within 200 MB).
+//!
+//! Helper `speed7` (lead's figure before it, quiet machine: 338.5 ms median, fastest 323.5;
+//! parts 46, fit:register 142, bound 54 ms): stop 33's eye layers made the one-mesh cut
+//! build a BVH over the whole skin (42 572 triangles) to test rims near the eyes, and find
+//! the open edges of the 24 591-vertex head through a `BTreeMap`; the tree now covers only
+//! the skin triangles near the rims it tests (none on ICT's head, so none is built) and the
+//! edges are sorted keys. Same output bit for bit (hash of the whole cloned face's `Debug`
+//! text, `6cddb682e1c1ab95` before and after). Measured on the shared machine only (load
+//! 9.4–9.9), old and new binaries alternated, three runs each: `split_view` 85 → 32 ms,
+//! `parts` in the `fit` set-up run 102 / 115 → 38 / 46 ms (fmc's 129–133 → 65–70 ms); medians
+//! 1.219 / 1.232 / 1.288 s → 1.203 / 1.151 / 1.165 s. Expected on a quiet machine: parts
+//! ~46 → ~25 ms (not measured quietly). What is left of `fit:register` (≈ 40 % searches on 2
+//! cores, 30 % the ten factorisations on one, 30 % the target's BVH beside the system's
+//! analysis, under load): the factorisations leave a core idle.
 
 use std::path::Path;
 use std::sync::OnceLock;

@@ -96,7 +96,8 @@ pub fn lid_resting_layers(face: &FaceModel) -> Vec<LidRestingLayer> {
         if !eye.iter().any(|e| matches!(e, Some(Some(_)))) {
             continue;
         }
-        let Some(lids) = lids.get_or_insert_with(|| LidSurface::of(face, &frames, eps, &on_ball))
+        let Some(lids) =
+            lids.get_or_insert_with(|| LidSurface::of(face, &frames, eps, &on_ball, None))
         else {
             return Vec::new();
         };

@@ -458,7 +458,7 @@ fn free_in_mouth(
     if !across.iter().all(|k| open.contains(k)) {
         return false;
     }
-    let Some(skin) = LidSurface::of(face, frames, eps, &|_| None) else {
+    let Some(skin) = LidSurface::of(face, frames, eps, &|_| None, None) else {
         return false;
     };
     // Seam vertices of an artist's mesh coincide with the skin's up to float rounding.
@@ -663,7 +663,7 @@ fn eye_layers(
                 continue;
             };
             let Some(lids) =
-                lids.get_or_insert_with(|| LidSurface::of(face, frames, eps, &on_ball))
+                lids.get_or_insert_with(|| LidSurface::of(face, frames, eps, &on_ball, None))
             else {
                 break;
             };
@@ -742,8 +742,23 @@ fn eye_layer_pieces(
         return;
     }
     let on_ball = |q: Vec3| ball_under(&balls, q);
-    if let Some(lids) = LidSurface::of(face, frames, eps, &on_ball) {
-        for v in rim_vertices(mesh, eps) {
+    // Only skin near the rims can be within their clearance: the surface is built over the
+    // triangles in their box (the whole skin's tree cost more than the rest of the cut).
+    let rim = rim_vertices(mesh, eps);
+    let mut near: Option<(Vec3, Vec3)> = None;
+    for &v in &rim {
+        let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
+            continue;
+        };
+        let Some(Some(part)) = on[k] else { continue };
+        let radius = balls.iter().find(|b| b.0 == part).map_or(0.0, |b| b.2);
+        let reach = Vec3::splat(2.0 * LID_CLEARANCE * radius + eps);
+        let (lo, hi) = near.get_or_insert((q, q));
+        *lo = lo.min(q - reach);
+        *hi = hi.max(q + reach);
+    }
+    if let Some(lids) = near.and_then(|n| LidSurface::of(face, frames, eps, &on_ball, Some(n))) {
+        for v in rim {
             let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
                 continue;
             };
@@ -843,12 +858,14 @@ pub(super) struct LidSurface {
 }
 
 impl LidSurface {
-    /// `None` without skin triangles.
+    /// `None` without skin triangles. With `near` (a box `(lo, hi)`), only the triangles
+    /// whose box meets it: the same answers for points whose gap reaches no farther.
     pub(super) fn of(
         face: &FaceModel,
         frames: &FaceFrames,
         eps: f32,
         on_ball: &impl Fn(Vec3) -> Option<Part>,
+        near: Option<(Vec3, Vec3)>,
     ) -> Option<LidSurface> {
         let diag = face_diagonal(face, frames);
         let mut skin: BTreeSet<usize> = BTreeSet::new();
@@ -874,8 +891,18 @@ impl LidSurface {
             }
             let base = points.len() as u32;
             points.extend(world.iter().map(|q| PVec::new(q.x, q.y, q.z)));
+            let meets = |t: &[u32; 3]| {
+                near.is_none_or(|(lo, hi)| {
+                    let [Some(p), Some(q), Some(r)] = t.map(|v| world.get(v as usize).copied())
+                    else {
+                        return true;
+                    };
+                    let (a, b) = (p.min(q).min(r), p.max(q).max(r));
+                    !(a.cmpgt(hi).any() || b.cmplt(lo).any())
+                })
+            };
             for t in mesh.triangles() {
-                if piece.get(t[0] as usize).is_some_and(|&k| off_ball[k]) {
+                if piece.get(t[0] as usize).is_some_and(|&k| off_ball[k]) && meets(&t) {
                     triangles.push(t.map(|v| v + base));
                 }
             }
@@ -901,7 +928,9 @@ impl LidSurface {
 fn rim_vertices(mesh: &Mesh, eps: f32) -> Vec<u32> {
     let rep = find_coincident_vertices(&mesh.positions, eps).representative;
     let r = |v: u32| rep.get(v as usize).copied().unwrap_or(v);
-    let mut edges: BTreeMap<(u32, u32), (usize, [u32; 2])> = BTreeMap::new();
+    // Every edge end to end as (joined key, corners), sorted by key: an edge alone in its
+    // run is open (a map of the edges cost a one-mesh head's cut 10 ms).
+    let mut edges: Vec<(u64, [u32; 2])> = Vec::with_capacity(mesh.polygons.indices().len());
     for poly in mesh.polygons.iter() {
         for (i, &a) in poly.iter().enumerate() {
             let b = poly[(i + 1) % poly.len()];
@@ -909,15 +938,21 @@ fn rim_vertices(mesh: &Mesh, eps: f32) -> Vec<u32> {
             if ra == rb {
                 continue;
             }
-            let e = edges.entry((ra.min(rb), ra.max(rb))).or_insert((0, [a, b]));
-            e.0 += 1;
+            edges.push((
+                (u64::from(ra.min(rb)) << 32) | u64::from(ra.max(rb)),
+                [a, b],
+            ));
         }
     }
-    let mut out: Vec<u32> = edges
-        .values()
-        .filter(|e| e.0 == 1)
-        .flat_map(|e| e.1)
-        .collect();
+    edges.sort_unstable_by_key(|e| e.0);
+    let mut out: Vec<u32> = Vec::new();
+    for (j, e) in edges.iter().enumerate() {
+        let alone =
+            (j == 0 || edges[j - 1].0 != e.0) && edges.get(j + 1).is_none_or(|n| n.0 != e.0);
+        if alone {
+            out.extend(e.1);
+        }
+    }
     out.sort_unstable();
     out.dedup();
     out
