@@ -486,7 +486,7 @@ impl AffineFit {
         }
         let det = qq.determinant();
         let scale = qq.col(0).x + qq.col(1).y + qq.col(2).z;
-        if !(det.abs() > 1e-12 * scale.powi(3)) {
+        if det.is_nan() || det.abs() <= 1e-12 * scale.powi(3) {
             return None;
         }
         Some(AffineFit {
