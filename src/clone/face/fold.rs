@@ -12,10 +12,9 @@
 
 use std::collections::{BTreeSet, HashMap};
 
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, DMat3, DVec3, Vec3};
 use rayon::prelude::*;
 
-use super::mouth_fill::HarmonicFill;
 use super::rigid::hierarchy_ancestors;
 use super::split::{mesh_pieces, SplitView};
 use super::{CloneReport, Part};
@@ -284,20 +283,39 @@ pub(super) fn fold_into_target(
     Ok(face)
 }
 
-/// Half the width of the band across a lip-line cut, in MNS0 ([`CutBand`]).
-const CUT_BAND: f32 = 0.5;
+/// Half the width of the band across a lip-line cut, in MNS0 ([`CutBand`]). The blend
+/// squeezes the lower jaw's drop into the band: alma's `viseme_12` drops ICT's lower gums
+/// 0.5 MNS0, and over a band half 0.5 MNS0 wide the gums' triangles turned 52° (ICT's own
+/// FAT: 3.3°); over 1 MNS0 they turn less than the inner lip corners do (under 42°). Wider
+/// takes in more of the upper gums: CANDIDE → ict `open_jaw` moves the upper row 4.0 % of
+/// the chin (2.5 % at 0.5; `teeth_follow` allows 5 %).
+const CUT_BAND: f32 = 1.0;
 
 /// The vertices of a target mesh's pieces cut along the lip line (ICT's gums, tongue and
 /// mouth socket: one piece reaching into both jaws) that lie within [`CUT_BAND`] × MNS0 of
-/// where they cross the lip line (the height between 2.2 and 2.3), and the harmonic fill
-/// over them. Each side of the cut takes its own jaw's motion
-/// (the upper still, the lower with the jaw), so the cut was a step: its vertices took the
-/// mean of both sides, and the band of triangles beside it creased and folded (CANDIDE →
-/// ict `open_jaw`: 151°). In the band, every table's motion is instead the harmonic blend of
-/// the two sides' motions around it: a smooth stretch from the upper jaw's motion to the
-/// lower's.
+/// where they cross the lip line (the height between 2.2 and 2.3), and each one's share of
+/// the lower jaw's motion. Each side of the cut takes its own jaw's motion (the upper still,
+/// the lower with the jaw), so the cut was a step: its vertices took the mean of both sides,
+/// and the band of triangles beside it creased and folded (CANDIDE → ict `open_jaw`: 151°).
+/// In the band, every table's motion is instead a blend of the two sides' motions, each
+/// side's extended over the band as the affine map that fits it best (a jaw's motion is
+/// rigid): `U + σ (L − U)`. The lower jaw's share `σ` is a smooth function of where a
+/// vertex is — its height across the band (1 at the band's foot, 0 at its top), faded into
+/// the vertex's own side (1 below the lip line, 0 above) as its distance from the crossings
+/// grows to the band's half width — so it meets each side's own motion at the band's rim
+/// and close vertices move alike whatever joins them. A harmonic blend over the band's
+/// edges (before) did not: where the band's rim ran along a wall (the upper wall at the back
+/// of ICT's gums piece, 3 mm from still vertices at the same height) its values fell to the
+/// still side's within a triangle (alma → ict `viseme_12`: 53° where ICT's own FAT turns
+/// 3.4°).
 struct CutBand {
-    fill: HarmonicFill,
+    /// The mesh's vertices at rest (the frame of its FAT entries).
+    local: Vec<Vec3>,
+    /// The cut pieces' vertices outside the band below and above the lip line: each side's
+    /// motion is fitted on them.
+    sides: [Vec<u32>; 2],
+    /// The band's vertices and their shares of the lower side's motion.
+    band: Vec<(u32, f32)>,
 }
 
 impl CutBand {
@@ -341,19 +359,38 @@ impl CutBand {
             }
         }
         let index = VertexIndex::new(&crossings);
-        let inside: Vec<bool> = (0..m.positions.len())
-            .map(|v| {
-                cut_piece[piece[v]]
-                    && index
-                        .nearest_vertex(world[v])
-                        .is_some_and(|(_, d)| d <= reach)
-            })
-            .collect();
-        let fill = HarmonicFill::new(&adj, &world, &inside)?;
-        Some(CutBand { fill })
+        let smoothstep = |t: f32| {
+            let t = t.clamp(0.0, 1.0);
+            t * t * (3.0 - 2.0 * t)
+        };
+        let mut sides: [Vec<u32>; 2] = [Vec::new(), Vec::new()];
+        let mut band: Vec<(u32, f32)> = Vec::new();
+        for v in 0..m.positions.len() {
+            if !cut_piece[piece[v]] {
+                continue;
+            }
+            let p = world[v];
+            let own = if p.y <= lip_y { 1.0 } else { 0.0 };
+            match index.nearest_vertex(p).filter(|&(_, d)| d < reach) {
+                Some((_, d)) => {
+                    let across = smoothstep((lip_y + reach - p.y) / (2.0 * reach));
+                    let near = 1.0 - smoothstep(d / reach);
+                    band.push((v as u32, own + near * (across - own)));
+                }
+                None => sides[usize::from(own == 0.0)].push(v as u32),
+            }
+        }
+        if band.is_empty() {
+            return None;
+        }
+        Some(CutBand {
+            local: m.positions.clone(),
+            sides,
+            band,
+        })
     }
 
-    /// `entry` (one table's entry on the cut mesh) with its rates in the band re-solved.
+    /// `entry` (one table's entry on the cut mesh) with its rates in the band re-set.
     fn smooth(&self, entry: FaceDefMesh) -> FaceDefMesh {
         let n = entry.interval_count();
         if n == 0 {
@@ -365,11 +402,18 @@ impl CutBand {
             .enumerate()
             .map(|(k, &v)| (v, k))
             .collect();
-        let filled = self.fill.solve(3 * n, |w, c| {
-            slot.get(&w).map_or(0.0, |&k| {
-                f64::from(entry.displacements[k * n + c / 3][c % 3])
+        let rate = |v: u32, j: usize| {
+            slot.get(&v)
+                .map_or(Vec3::ZERO, |&k| entry.displacements[k * n + j])
+        };
+        // Per interval, each side's motion as an affine map (lower, upper).
+        let maps: Vec<[Option<AffineFit>; 2]> = (0..n)
+            .map(|j| {
+                self.sides.each_ref().map(|side| {
+                    AffineFit::of(side.iter().map(|&v| (self.local[v as usize], rate(v, j))))
+                })
             })
-        });
+            .collect();
         // Vertices of the band the entry did not list join it.
         let mut rows: Vec<(u32, Vec<Vec3>)> = entry
             .coord_index
@@ -377,15 +421,16 @@ impl CutBand {
             .enumerate()
             .map(|(k, &v)| (v, entry.displacements[k * n..(k + 1) * n].to_vec()))
             .collect();
-        let mut at: HashMap<u32, usize> = slot;
-        for (k, &v) in self.fill.free().iter().enumerate() {
-            let rates: Vec<Vec3> = (0..n)
-                .map(|j| {
-                    Vec3::new(
-                        filled[(k, 3 * j)] as f32,
-                        filled[(k, 3 * j + 1)] as f32,
-                        filled[(k, 3 * j + 2)] as f32,
-                    )
+        let mut at: HashMap<u32, usize> = slot.clone();
+        for &(v, share) in &self.band {
+            let p = self.local[v as usize];
+            let rates: Vec<Vec3> = maps
+                .iter()
+                .enumerate()
+                .map(|(j, [lower, upper])| {
+                    let side = |f: &Option<AffineFit>| f.as_ref().map_or(rate(v, j), |f| f.at(p));
+                    let (l, u) = (side(lower), side(upper));
+                    u + share * (l - u)
                 })
                 .collect();
             if !rates.iter().all(|r| r.is_finite()) {
@@ -408,6 +453,51 @@ impl CutBand {
             coord_index: rows.iter().map(|r| r.0).collect(),
             displacements: rows.into_iter().flat_map(|r| r.1).collect(),
         }
+    }
+}
+
+/// The affine map `p ↦ A (p − c) + b` fitting displacements at points best (least squares).
+struct AffineFit {
+    centre: DVec3,
+    linear: DMat3,
+    offset: DVec3,
+}
+
+impl AffineFit {
+    /// The fit of `(point, displacement)` samples; `None` with fewer than four samples or
+    /// points on a plane (the map across it is not determined).
+    fn of(samples: impl Iterator<Item = (Vec3, Vec3)> + Clone) -> Option<AffineFit> {
+        let (mut sum, mut count) = (DVec3::ZERO, 0usize);
+        for (p, _) in samples.clone() {
+            sum += p.as_dvec3();
+            count += 1;
+        }
+        if count < 4 {
+            return None;
+        }
+        let centre = sum / count as f64;
+        // Normal equations of the centred points: (Σ q qᵀ) Aᵀ = Σ q dᵀ, b the mean of d.
+        let (mut qq, mut qd, mut mean) = (DMat3::ZERO, DMat3::ZERO, DVec3::ZERO);
+        for (p, d) in samples {
+            let (q, d) = (p.as_dvec3() - centre, d.as_dvec3());
+            qq += DMat3::from_cols(q * q.x, q * q.y, q * q.z);
+            qd += DMat3::from_cols(d * q.x, d * q.y, d * q.z);
+            mean += d;
+        }
+        let det = qq.determinant();
+        let scale = qq.col(0).x + qq.col(1).y + qq.col(2).z;
+        if det.is_nan() || det.abs() <= 1e-12 * scale.powi(3) {
+            return None;
+        }
+        Some(AffineFit {
+            centre,
+            linear: qd * qq.inverse(),
+            offset: mean / count as f64,
+        })
+    }
+
+    fn at(&self, p: Vec3) -> Vec3 {
+        (self.linear * (p.as_dvec3() - self.centre) + self.offset).as_vec3()
     }
 }
 
