@@ -27,6 +27,11 @@
 //!    bump within [`REACH`] ES0 of the margin. `smooth`'s second pass follows (holding the
 //!    margins there instead creased ICT's lids cloned onto alma's and bruno's: turn ratios
 //!    1.37 → 1.56, 2.03 → 2.75).
+//! 6. No vertex is moved by the change further along the closing than its lid point moves
+//!    (the point's FAP defines how far the lid closes): ICT's eye blend, lying on the
+//!    eyeball under the upper margin half way to the inner corner, went 15 % past the lid
+//!    point at alma's closing value (0.567 against 0.492), and the lashes riding the margin
+//!    followed that peak 63 %.
 //!
 //! Measured, alma → ICT at alma's closing value 512 (left eye, per band outer → inner,
 //! IRISD0): before 0.01 0.10 −0.18 −0.14 −0.02 0.01 0.00 0.01 −0.08 −0.09 −0.10 0.03, after
@@ -312,6 +317,12 @@ pub(super) fn close_lids(
             if !ch.iter().all(|c| c.is_finite()) || share <= 0.0 {
                 continue;
             }
+            // The lid point's vertical motion at the border (step 6).
+            let point = (if is_upper { up } else { low })
+                .parse::<FeaturePointId>()
+                .ok()
+                .and_then(|id| target.fp_vertices.get(&id))
+                .map(|&v| field[v as usize].y);
             let mut count = 0;
             for (v, p) in target.positions.iter().enumerate() {
                 let v32 = v as u32;
@@ -329,8 +340,10 @@ pub(super) fn close_lids(
                 }
                 let b = (a + 1).min(ch.len() - 1);
                 let c = (1.0 - t) * ch[a] + t * ch[b];
-                if c != 0.0 {
-                    field[v].y += w * c;
+                let y = field[v].y;
+                let to = no_further(y, y + w * c, point, is_upper);
+                if to != y {
+                    field[v].y = to;
                     count += 1;
                 }
             }
@@ -342,6 +355,23 @@ pub(super) fn close_lids(
         }
     }
     done
+}
+
+/// A vertex's vertical motion `y` changed to `to`, held back where the change closes the
+/// slit (down for the upper lid, up for the lower) past its lid point's motion `point`
+/// (step 6): nothing is taken back of a motion already past it, and a change that opens is
+/// kept.
+fn no_further(y: f32, to: f32, point: Option<f32>, is_upper: bool) -> f32 {
+    let Some(point) = point else {
+        return to;
+    };
+    if is_upper && to < y {
+        to.max(point.min(y))
+    } else if !is_upper && to > y {
+        to.min(point.max(y))
+    } else {
+        to
+    }
 }
 
 /// A margin point's change of the gap at the closing value, `excess`, capped by `at_far`,
@@ -371,5 +401,21 @@ mod tests {
         // The end is already past the source's: no change at all.
         assert_eq!(capped(0.2, -0.1), 0.0);
         assert_eq!(capped(-0.2, 0.1), 0.0);
+    }
+
+    #[test]
+    fn no_vertex_closes_past_its_lid_point() {
+        // Upper lid: the point goes down 1.0; a change to −1.2 stops at −1.0.
+        assert_eq!(no_further(-0.8, -1.2, Some(-1.0), true), -1.0);
+        // Within the point's motion, or opening: kept.
+        assert_eq!(no_further(-0.8, -0.9, Some(-1.0), true), -0.9);
+        assert_eq!(no_further(-0.8, -0.7, Some(-1.0), true), -0.7);
+        // Already past the point: not taken back, not pushed further.
+        assert_eq!(no_further(-1.1, -1.3, Some(-1.0), true), -1.1);
+        // Lower lid: up is closing.
+        assert_eq!(no_further(0.2, 0.6, Some(0.5), false), 0.5);
+        assert_eq!(no_further(0.2, 0.1, Some(0.5), false), 0.1);
+        // No lid point: the change as it is.
+        assert_eq!(no_further(0.2, 0.6, None, false), 0.6);
     }
 }

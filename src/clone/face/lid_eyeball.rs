@@ -8,11 +8,14 @@
 //!
 //! Each vertex within [`NEAR`] radii of an eyeball's centre has a clearance: the eye
 //! white's sphere grown by [`CLEAR`], or its own rest distance if it rests closer (a lid's
-//! inner face, the eye's corners), less [`SLACK`]. The source's own lids may dip below
-//! theirs (ICT's real lids and the eye layers sliding on the ball do, by 0.1–0.2 radii), so
-//! per motion the deepest dip of the source's chords under its own eyeball (in its radii) is
-//! allowed on the target's too, up to [`REAL_DIP`]; a source dipping deeper turns its lids
-//! about the eye (alma's lid shell: one interval to a 170° turn) and is not followed there. Then per eyeball of the target and per motion of every table,
+//! inner face, the eye's corners), less [`SLACK`]. The source's own chords may dip below
+//! theirs (ICT's real lids and the eye layers sliding on the ball do, by 0.1–0.2 radii;
+//! alma's: 0.15 under `close_t`, more under her brow FAPs, whose lid shell sinks into the
+//! ball), so per motion and eye the deepest dip of the source's chords under its own
+//! eyeball (in its radii) is allowed on the target's too — however deep: a clone that does
+//! what its source does is not changed (a self-clone is exact). An earlier cap on the
+//! copied dip (a quarter radius) pushed alma's own brow motions out of her eyes on
+//! alma → alma (7.4 % off). Then per eyeball of the target and per motion of every table,
 //! in order of its borders outwards from 0, a vertex whose chord from the previous border
 //! (or rest) to this one dips deeper has its displacement at this border pushed out along
 //! the eyeball's normal at the chord's closest point, just as far as brings the chord clear
@@ -47,14 +50,11 @@ pub(super) const SLACK: f32 = 0.02;
 /// eye corner (110° at a quarter of `close_b_l`).
 pub(super) const MAX_PUSH: f32 = 4.0;
 
-/// Deepest dip (eye-white radii) of a source's own chords under its eyeball that is copied:
-/// a real lid sliding on the ball (ICT's own FAT: 0.1–0.2). A source dipping deeper turns
-/// its lids about the eye (alma's shell: one interval to a 170° turn), and its clone is
-/// kept out.
-pub(super) const REAL_DIP: f32 = 0.25;
-
 /// How far (eye-white radii) each vertex's push spreads to its neighbours.
 pub(super) const SPREAD: f32 = 0.5;
+
+/// Dips (eye-white radii) within this of the allowed are rounding, not pushed.
+const ROUNDING: f32 = 1e-5;
 
 /// Bisection steps on the push.
 const STEPS: usize = 24;
@@ -86,12 +86,22 @@ struct NearEye {
     near: Vec<(u32, f32)>,
 }
 
-fn near_eyes(surf: &CloneSurface, margins: &LidMargins) -> Vec<NearEye> {
+/// The eye-white spheres of `margins`' eyeballs: left eye or not, centre, radius.
+fn spheres(margins: &LidMargins) -> Vec<(bool, Vec3, f32)> {
     margins
         .balls()
         .iter()
         .map(|&(left, b)| {
             let (c, r) = b.sphere();
+            (left, c, r)
+        })
+        .collect()
+}
+
+fn near_eyes(surf: &CloneSurface, spheres: &[(bool, Vec3, f32)]) -> Vec<NearEye> {
+    spheres
+        .iter()
+        .map(|&(left, c, r)| {
             let near = surf
                 .positions
                 .iter()
@@ -135,11 +145,10 @@ fn chords(motions: &[SurfaceMotion]) -> Vec<(usize, Option<usize>)> {
 
 /// Per motion and eye (left, right): how far (eye-white radii) its chords dip below their
 /// clearance at most — what the source's own lids do to its own eyeballs.
-fn dips(surf: &CloneSurface, margins: &LidMargins, motions: &[SurfaceMotion]) -> Vec<[f32; 2]> {
-    let eyes = near_eyes(surf, margins);
+fn dips(surf: &CloneSurface, eyes: &[NearEye], motions: &[SurfaceMotion]) -> Vec<[f32; 2]> {
     let mut out = vec![[0.0f32; 2]; motions.len()];
     for (k, before) in chords(motions) {
-        for e in &eyes {
+        for e in eyes {
             let mut dip = 0.0f32;
             for &(v, clear) in &e.near {
                 let d = motions[k].offset_at(v);
@@ -168,24 +177,35 @@ pub(super) fn keep_lids_out(
     source: (&CloneSurface, &LidMargins, &[SurfaceMotion]),
     motions: &mut [SurfaceMotion],
 ) -> BTreeMap<String, usize> {
-    let mut done = BTreeMap::new();
-    let eyes = near_eyes(surf, margins);
     let (ssurf, smargins, smotions) = source;
-    if eyes.iter().all(|e| e.near.is_empty())
-        || smargins.balls().is_empty()
-        || smotions.len() != motions.len()
-    {
+    let source_spheres = spheres(smargins);
+    if source_spheres.is_empty() || smotions.len() != motions.len() {
+        return BTreeMap::new();
+    }
+    let eyes = near_eyes(surf, &spheres(margins));
+    let allowed = dips(ssurf, &near_eyes(ssurf, &source_spheres), smotions);
+    keep_out(surf, &eyes, &allowed, motions)
+}
+
+/// [`keep_lids_out`] on the target's `eyes`, with the dips each motion's source `allowed`
+/// per eye (left, right; eye-white radii).
+fn keep_out(
+    surf: &CloneSurface,
+    eyes: &[NearEye],
+    allowed: &[[f32; 2]],
+    motions: &mut [SurfaceMotion],
+) -> BTreeMap<String, usize> {
+    let mut done = BTreeMap::new();
+    if eyes.iter().all(|e| e.near.is_empty()) {
         return done;
     }
-    let allowed = dips(ssurf, smargins, smotions);
     for (k, before) in chords(motions) {
         let mut field = dense_field(surf.positions.len(), &motions[k].offsets);
         let mut count = 0usize;
-        for e in &eyes {
+        for e in eyes {
             let (c, r) = (&e.centre, e.radius);
-            // The source's own dip is allowed, up to a real lid's.
-            let dip = allowed[k][usize::from(!e.left)];
-            let allow = if dip <= REAL_DIP { dip * r } else { 0.0 };
+            // The source's own dip is allowed: a clone doing what its source does is kept.
+            let allow = allowed[k][usize::from(!e.left)] * r;
             // Per vertex whose chord cuts in: how far its end must go out, along the
             // eyeball's normal at the chord's closest point (the way out of the ball there:
             // the end's own normal pushed a rising lower lid up at a quarter of the motion).
@@ -200,7 +220,8 @@ pub(super) fn keep_lids_out(
                 let a = rest + before.map_or(Vec3::ZERO, |p| motions[p].offset_at(v));
                 let b = rest + d;
                 let deficit = clear - chord_distance(a, b, *c);
-                if deficit <= 0.0 {
+                // Rounding: the source's own deepest chord measured again on its clone.
+                if deficit <= ROUNDING * r {
                     continue;
                 }
                 let n = (closest(a, b, *c) - *c).normalize_or_zero();
@@ -272,5 +293,71 @@ mod tests {
         // Along its side: clear.
         let (a2, b2) = (Vec3::new(0.0, 1.2, 1.2), Vec3::new(0.0, -1.2, 1.2));
         assert!((chord_distance(a2, b2, c) - 1.2).abs() < 1e-6);
+    }
+
+    /// A lid of three vertices resting just outside a unit eyeball at the origin (left eye),
+    /// and a far vertex.
+    fn lid() -> CloneSurface {
+        use crate::fdp::{Fapu, FapuDistances};
+        let d = FapuDistances {
+            irisd0: 1.0,
+            es0: 1.0,
+            ens0: 1.0,
+            mns0: 1.0,
+            mw0: 1.0,
+        };
+        CloneSurface {
+            positions: vec![
+                Vec3::new(0.0, 1.05, 0.2),
+                Vec3::new(0.3, 1.0, 0.3),
+                Vec3::new(-0.3, 1.0, 0.3),
+                Vec3::new(5.0, 5.0, 5.0),
+            ],
+            triangles: vec![[0, 1, 2]],
+            fp_vertices: Default::default(),
+            fp_positions: Default::default(),
+            fapu: Fapu::from_distances(d).unwrap(),
+        }
+    }
+
+    /// A lid closing straight down through the ball (a chord 0.9 radii deep, as a lid
+    /// turning about its eye leaves between two borders).
+    fn through() -> Vec<SurfaceMotion> {
+        let down = Vec3::new(0.0, -2.0, 0.0);
+        vec![SurfaceMotion {
+            key: crate::fat::TableKey::LowLevel(crate::spec::FapId::new(19).unwrap()),
+            value: 1024.0,
+            offsets: vec![(0, down), (1, down), (2, down)],
+        }]
+    }
+
+    #[test]
+    fn a_self_clone_dipping_as_deep_as_its_source_is_kept() {
+        let surf = lid();
+        let eyes = near_eyes(&surf, &[(true, Vec3::ZERO, 1.0)]);
+        let source = through();
+        let allowed = dips(&surf, &eyes, &source);
+        // Deeper than a real lid slides (the cap the step had: a quarter radius).
+        assert!(allowed[0][0] > 0.5, "{:?}", allowed);
+        let mut clone = source.clone();
+        let done = keep_out(&surf, &eyes, &allowed, &mut clone);
+        assert!(done.is_empty(), "{done:?}");
+        assert_eq!(clone[0].offsets, source[0].offsets);
+    }
+
+    #[test]
+    fn a_clone_dipping_deeper_than_its_source_is_pushed_clear() {
+        let surf = lid();
+        let eyes = near_eyes(&surf, &[(true, Vec3::ZERO, 1.0)]);
+        // The source's lid does not enter its eyeball.
+        let mut clone = through();
+        let done = keep_out(&surf, &eyes, &[[0.0, 0.0]], &mut clone);
+        assert_eq!(done.values().sum::<usize>(), 3, "{done:?}");
+        for &(v, d) in &clone[0].offsets {
+            let rest = surf.positions[v as usize];
+            let clear = rest.length().min(1.0 + CLEAR) - SLACK;
+            let dist = chord_distance(rest, rest + d, Vec3::ZERO);
+            assert!(dist >= clear - 1e-3, "vertex {v}: {dist} < {clear}");
+        }
     }
 }

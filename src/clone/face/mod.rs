@@ -113,16 +113,18 @@
 //!    the upper margin's share and the bottom FAP the lower's; each change fades into its lid
 //!    within 0.2 ES0, fades out over the margin's middle (none at the lid point, which moves
 //!    as its FAP defines), and is capped so that at the end of the first interval the slit
-//!    is no more closed than the source's there. Across styles the surface method left the
+//!    is no more closed than the source's there; no vertex is taken further along the
+//!    closing than its lid point (ICT's eye blend went 15 % past it). Across styles the surface method left the
 //!    margin's drop a plateau with a steep fall at the corners (alma → ict: 0.10 IRISD0
 //!    open, −0.18 crossed).
 //!    **`eyeball`** (with [`CloneOptions::lid_close`]; `lid_eyeball.rs`): the FAT moves a
 //!    vertex on a straight chord between borders, and a source lid turning about its eyeball
 //!    crossed the target's eyeball on the way (alma → ict 0.21 radii deep, ICT's own FAT
 //!    0.11). Skin near each eyeball part whose chord to a border passes inside the eye
-//!    white's sphere (+2 %; or its own rest distance, if closer) is pushed out along the
-//!    eyeball's normal, the push spread smoothly over half a radius; before `smooth`'s
-//!    second pass and `bound`.
+//!    white's sphere (+2 %; or its own rest distance, if closer) deeper than the source's
+//!    own chords dip into its eyeball under that motion (in radii; a self-clone is kept
+//!    exactly) is pushed out along the eyeball's normal, the push spread smoothly over half
+//!    a radius; before `smooth`'s second pass and `bound`.
 //!    **`mouth`** (every method, `mouth_fill.rs`): the target's hidden mouth interior
 //!    (skin behind the lips' front and hidden from the front, reached from the inner lip
 //!    contour) takes a harmonic extension (edges weighed by inverse length) of the lips'
