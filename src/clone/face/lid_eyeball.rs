@@ -362,7 +362,11 @@ mod tests {
             );
             // Out by the longest push (half a radius at the chord's end), not through.
             assert!(dist > dist0 + 0.2, "vertex {v}: {dist0} → {dist}");
-            assert!((d - d0).length() <= 0.5 + 1e-4, "vertex {v}: pushed {}", (d - d0).length());
+            assert!(
+                (d - d0).length() <= 0.5 + 1e-4,
+                "vertex {v}: pushed {}",
+                (d - d0).length()
+            );
         }
     }
 }

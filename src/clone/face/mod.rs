@@ -91,7 +91,7 @@
 //!    come from cloning across styles: target vertices reading unrelated parts of the source
 //!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
 //!    changed. With [`CloneOptions::smooth_shares`] (default on) the turns are checked at a
-//!    quarter and a half of each motion too (the FAT interpolates: a lid turning about its
+//!    quarter and a half of each lid FAP's (19–22) motion too (the FAT interpolates: a lid turning about its
 //!    eyeball folds on the way, beyond a border check's reach), and under a lid FAP the middle
 //!    of its lid's margin (from the lid point half way to each corner) is held with the
 //!    point, so the lashes riding it follow the lid. Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more

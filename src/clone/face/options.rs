@@ -60,7 +60,7 @@ pub struct CloneOptions {
     /// Alignment rotations up to this many degrees are dropped (upright faces of other
     /// proportions; [`Similarity::fit_snapped`](super::Similarity::fit_snapped)). Default 3°.
     pub align_snap_degrees: f64,
-    /// `smooth` checks the turns at a quarter and a half of each motion too (module docs,
+    /// `smooth` checks the turns at a quarter and a half of each lid FAP's motion too (module docs,
     /// `smooth`): alma's lids onto ICT no longer fold at the eye corners. The middle of a lid
     /// FAP's margin is held with its lid point then, so the lashes riding it follow the lid.
     /// Default on.
