@@ -602,20 +602,19 @@ fn max_turn(face: &FaceModel, acts: &[Activation]) -> f32 {
 /// nothing), and the clone's lids folded at the eye corners on the way (167° at `close_t_l`
 /// 512, ICT's own FAT 97°), and its slit stayed 0.10 IRISD0 open near the outer corner
 /// with the lids crossing by 0.18 further in. Under each lid FAP at 256 and 512 the clone
-/// turns at most 1.2× what ICT's own FAT turns, and at alma's closing value the slit is
-/// closed band by band.
+/// turns at most 1.25× what ICT's own FAT turns, at alma's closing value the slit is closed
+/// band by band, and no lid goes more than 0.06 eyeball radii deeper into the eyeball than
+/// ICT's own FAT takes it (the old clone's went 0.21 radii deep under the blink and 0.34
+/// under `close_b` at 1024, ICT's own 0.11 and 0.16) — under the blink and under each lid
+/// FAP at every border and half way between.
 #[test]
 fn alma_onto_ict_lids() {
     let (Ok(alma), Ok(ict)) = (fbakit::face::read("alma"), fbakit::face::read("ict")) else {
         eprintln!("note: bundled faces alma / ict not readable; skipped");
         return;
     };
-    // Both lid options on (their docs say why they are off by default).
-    let opts = CloneOptions {
-        smooth_shares: true,
-        lid_close: true,
-        ..fit()
-    };
+    // The default options: `smooth_shares` and `lid_close` on.
+    let opts = fit();
     let bare = fbakit::export::picture::strip_fat(&ict);
     let out = fbakit::clone::face::clone_face(&alma, &bare, &opts).unwrap();
     let c = &out.face;
@@ -628,7 +627,10 @@ fn alma_onto_ict_lids() {
             }];
             let (clone, own) = (max_turn(c, &a), max_turn(&ict, &a));
             eprintln!("FAP {f} @{v}: clone {clone:.1}°, ICT's own {own:.1}°");
-            if clone > 1.2 * own {
+            // 1.25×: the `eyeball` step's push on the lower lid at 1024 shows at a quarter
+            // of it (`close_b` @256 76.8° → 80.9°, ICT's own 65.2°) for 0.05–0.12 radii
+            // less depth into the eyeball; 1.2× held without it.
+            if clone > 1.25 * own {
                 worst.push(format!("FAP {f} @{v}: {clone:.1}° against {own:.1}°"));
             }
         }
@@ -664,12 +666,62 @@ fn alma_onto_ict_lids() {
         let ball = eyeball_vertices(&out, part);
         let depth = eyeball_depth(c, &ball, &blink(c, eye, value));
         let own_depth = eyeball_depth(&ict, &ball, &blink(&ict, eye, own));
-        // Not asserted (left, issue 21): the lid points move straight by their FAPU, as
-        // alma's turning lid does chord by chord, and pass 0.21–0.23 radii into the
-        // eyeball (ICT's own 0.11); a forward push of the lid skin folded the lower lid.
         eprintln!(
-            "eye {:?}: depth {depth:.3} against ICT's own {own_depth:.3}",
+            "eye {:?}: blink depth {depth:.3} against ICT's own {own_depth:.3}",
             eye.faps
         );
+        // Lids into the eyeball: under the blink, and under each lid FAP alone at each
+        // border of its table and half way between (a FAT moves a vertex on a straight
+        // chord between borders, and a lid turning about its eyeball in the source cut
+        // through it on the way). Measured: within 0.055 radii of ICT's own everywhere
+        // (blink 0.160 against 0.109; `close_b` 0.214 / 0.336 at 512 / 1024 before the
+        // `eyeball` step, now 0.160 / 0.217 against 0.103 / 0.164). Issue 21 asks no deeper
+        // than ICT's own: not met — alma's own `close_t` chords dip 0.15 radii into her
+        // eyes, which `eyeball` copies as a real lid's slide.
+        assert!(
+            depth <= own_depth + 0.06,
+            "eye {:?}: the blink takes a lid {depth:.3} radii into the eyeball (ICT's own {own_depth:.3})",
+            eye.faps
+        );
+        for f in [eye.faps.0, eye.faps.1] {
+            for v in border_values(c, f) {
+                let a = [Activation {
+                    key: key(f),
+                    value: v,
+                }];
+                let (d, o) = (eyeball_depth(c, &ball, &a), eyeball_depth(&ict, &ball, &a));
+                eprintln!("FAP {f} @{v}: depth {d:.3} against ICT's own {o:.3}");
+                assert!(
+                    d <= o + 0.06,
+                    "FAP {f} @{v}: a lid goes {d:.3} radii into the eyeball (ICT's own {o:.3})"
+                );
+            }
+        }
     }
+}
+
+/// The borders of FAP `f`'s table in `face` and the values half way between them (and 0).
+fn border_values(face: &FaceModel, f: u8) -> Vec<f64> {
+    let mut b: Vec<f64> = face
+        .fat
+        .tables
+        .iter()
+        .filter(|t| t.key == key(f))
+        .flat_map(|t| {
+            t.meshes
+                .iter()
+                .flat_map(|m| m.interval_borders.iter().copied())
+        })
+        .chain([0.0])
+        .collect();
+    b.sort_by(f64::total_cmp);
+    b.dedup();
+    let mut out: Vec<f64> = b
+        .windows(2)
+        .flat_map(|w| [0.5 * (w[0] + w[1]), w[0], w[1]])
+        .filter(|v| *v != 0.0)
+        .collect();
+    out.sort_by(f64::total_cmp);
+    out.dedup();
+    out
 }

@@ -14,17 +14,31 @@
 //!    FAP and by the lower one through the bottom FAP, in the shares each FAP closes the
 //!    source's lid points by, as a vertical change of each margin vertex's motion (the FAPs'
 //!    own feature points and the corners keep theirs).
-//! 3. Each change spreads over its lid's side of the corner line, fading out by a Wendland
+//! 3. The change fades out over the margin's middle ([`LidMargins::middle_weights`]: none at
+//!    the lid point, all of it from half way to each corner on). The lid point moves as its
+//!    FAP defines, and the lashes over the lid's middle ride the margin beside it: a change
+//!    there left alone took them off their lid (alma → ICT's lower lashes 0.14 of the lid
+//!    opening past the lid point at 1024).
+//! 4. The change grows with the FAP value over the table's first interval, so it is capped
+//!    where that would close (or open) the slit at the interval's end further than the
+//!    source's own slit is closed there (the source over-closes past `v`; the target by no
+//!    more): a change of `v`'s full size doubled at 1024 for alma's `v` = 512.
+//! 5. Each change spreads over its lid's side of the corner line, fading out by a Wendland
 //!    bump within [`REACH`] ES0 of the margin. `smooth`'s second pass follows (holding the
 //!    margins there instead creased ICT's lids cloned onto alma's and bruno's: turn ratios
 //!    1.37 → 1.56, 2.03 → 2.75).
+//! 6. No vertex is moved by the change further along the closing than its lid point moves
+//!    (the point's FAP defines how far the lid closes): ICT's eye blend, lying on the
+//!    eyeball under the upper margin half way to the inner corner, went 15 % past the lid
+//!    point at alma's closing value (0.567 against 0.492), and the lashes riding the margin
+//!    followed that peak 63 %.
 //!
 //! Measured, alma → ICT at alma's closing value 512 (left eye, per band outer → inner,
 //! IRISD0): before 0.01 0.10 −0.18 −0.14 −0.02 0.01 0.00 0.01 −0.08 −0.09 −0.10 0.03, after
 //! 0.05 −0.01 −0.05 −0.07 −0.01 0.07 0.00 0.02 −0.01 −0.00 −0.00 0.04 (ICT's own FAT at its
 //! closing value 493: −0.11 … 0.02, its lids crossing where alma's just meet).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 
 use glam::Vec3;
 
@@ -126,7 +140,7 @@ fn source_close(
     margins: &LidMargins,
     eye: (bool, u8, u8, &str, &str),
 ) -> Option<SourceClose> {
-    let (left, top, bottom, up, low) = eye;
+    let (_, top, bottom, up, low) = eye;
     let (kt, vt) = first_motion(motions, top)?;
     let (kb, vb) = first_motion(motions, bottom)?;
     let fp = |s: &str| {
@@ -147,6 +161,23 @@ fn source_close(
     if !(value.is_finite() && value <= vt.min(vb)) {
         return None;
     }
+    let mut sc = source_at(source, motions, margins, eye, value)?;
+    sc.top_share = (rate_t / rate).clamp(0.0, 1.0);
+    Some(sc)
+}
+
+/// The source's margins of one eye posed with both lid FAPs at `value` (within both tables'
+/// first interval); `top_share` is left at ½.
+fn source_at(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    margins: &LidMargins,
+    eye: (bool, u8, u8, &str, &str),
+    value: f64,
+) -> Option<SourceClose> {
+    let (left, top, bottom, ..) = eye;
+    let (kt, vt) = first_motion(motions, top)?;
+    let (kb, vb) = first_motion(motions, bottom)?;
     let corners = margins.corners(left)?;
     let n = source.positions.len();
     let (dt, db) = (
@@ -162,7 +193,7 @@ fn source_close(
     let irisd = source.fapu.distances.irisd0 as f32;
     (irisd > 0.0).then_some(SourceClose {
         value,
-        top_share: (rate_t / rate).clamp(0.0, 1.0),
+        top_share: 0.5,
         upper,
         lower,
         irisd,
@@ -197,42 +228,86 @@ pub(super) fn close_lids(
         else {
             continue;
         };
+        // Where both tables are still in their first interval the change grows linearly with
+        // the FAP value; at `far` it is capped (step 4).
+        let far = vt.min(vb);
+        let Some(sfar) = source_at(source, motions, sm, eye, far) else {
+            continue;
+        };
         let (st, sb) = ((sc.value / vt) as f32, (sc.value / vb) as f32);
         let mut dt = dense_field(n, &out[kt].offsets);
         let mut db = dense_field(n, &out[kb].offsets);
         let fields = [(dt.as_slice(), st), (db.as_slice(), sb)];
         let pu = posed(target, upper.1, corners, fields);
         let pl = posed(target, lower.1, corners, fields);
-        // Kept: corners (on both margins) and the FAPs' own feature points.
-        let fixed: Vec<u32> = [up, low]
+        let fields_far = [
+            (dt.as_slice(), (far / vt) as f32),
+            (db.as_slice(), (far / vb) as f32),
+        ];
+        let (fu, fl) = (
+            posed(target, upper.1, corners, fields_far),
+            posed(target, lower.1, corners, fields_far),
+        );
+        // Kept: the corners (on both margins) and the FAPs' own feature points; the change
+        // fades out over the margins' middles (step 3).
+        let upper_set: HashSet<u32> = upper.1.iter().copied().collect();
+        let lower_set: HashSet<u32> = lower.1.iter().copied().collect();
+        let fixed: HashSet<u32> = [up, low]
             .iter()
             .filter_map(|s| s.parse::<FeaturePointId>().ok())
             .filter_map(|id| target.fp_vertices.get(&id).copied())
-            .chain(upper.1.iter().copied().filter(|v| lower.1.contains(v)))
+            .chain(upper_set.intersection(&lower_set).copied())
             .collect();
         // Per margin vertex, the change of its height at the closing value.
-        let change = |own: &[(f32, f32)], other: &[(f32, f32)], is_upper: bool| -> Vec<f32> {
+        let change = |own: &[(f32, f32)],
+                      other: &[(f32, f32)],
+                      own_far: &[(f32, f32)],
+                      other_far: &[(f32, f32)],
+                      is_upper: bool|
+         -> Vec<f32> {
+            let fade = tm.middle_weights(left, is_upper);
             own.iter()
-                .map(|&(t, y)| {
-                    let (Some(o), Some(want)) = (height(other, t), sc.gap(t)) else {
+                .zip(own_far)
+                .zip(fade)
+                .map(|((&(t, y), &(_, y_far)), fade)| {
+                    let (Some(o), Some(want), Some(o_far), Some(want_far)) = (
+                        height(other, t),
+                        sc.gap(t),
+                        height(other_far, t),
+                        sfar.gap(t),
+                    ) else {
                         return 0.0;
                     };
                     let gap = if is_upper { y - o } else { o - y };
-                    let excess = gap - want * irisd;
-                    if is_upper {
-                        -sc.top_share * excess
+                    let gap_far = if is_upper {
+                        y_far - o_far
                     } else {
-                        (1.0 - sc.top_share) * excess
+                        o_far - y_far
+                    };
+                    let excess = capped(
+                        gap - want * irisd,
+                        (gap_far - want_far * irisd) * (sc.value / far) as f32,
+                    );
+                    let faded = excess * fade;
+                    if is_upper {
+                        -sc.top_share * faded
+                    } else {
+                        (1.0 - sc.top_share) * faded
                     }
                 })
                 .collect()
         };
-        let cu = change(&pu, &pl, true);
-        let cl = change(&pl, &pu, false);
+        let cu = change(&pu, &pl, &fu, &fl, true);
+        let cl = change(&pl, &pu, &fl, &fu, false);
         let reach = REACH * tm.es();
-        for ((line, verts), ch, share, field, is_upper) in [
-            (upper, cu, st, &mut dt, true),
-            (lower, cl, sb, &mut db, false),
+        let (o, i) = corners;
+        let side = |p: Vec3| {
+            let t = along(corners, p).clamp(0.0, 1.0);
+            p.y - (o.y + t * (i.y - o.y))
+        };
+        for ((line, verts), own, across, ch, share, field, is_upper) in [
+            (upper, &upper_set, &lower_set, cu, st, &mut dt, true),
+            (lower, &lower_set, &upper_set, cl, sb, &mut db, false),
         ] {
             let ch: Vec<f32> = verts
                 .iter()
@@ -242,18 +317,19 @@ pub(super) fn close_lids(
             if !ch.iter().all(|c| c.is_finite()) || share <= 0.0 {
                 continue;
             }
-            let (o, i) = corners;
-            let side = |p: Vec3| {
-                let t = along(corners, p).clamp(0.0, 1.0);
-                p.y - (o.y + t * (i.y - o.y))
-            };
+            // The lid point's vertical motion at the border (step 6).
+            let point = (if is_upper { up } else { low })
+                .parse::<FeaturePointId>()
+                .ok()
+                .and_then(|id| target.fp_vertices.get(&id))
+                .map(|&v| field[v as usize].y);
             let mut count = 0;
             for (v, p) in target.positions.iter().enumerate() {
-                let on = verts.contains(&(v as u32));
-                let across = if is_upper { lower.1 } else { upper.1 };
+                let v32 = v as u32;
+                let on = own.contains(&v32);
                 if (!on && (side(*p) > 0.0) != is_upper)
-                    || fixed.contains(&(v as u32))
-                    || across.contains(&(v as u32))
+                    || fixed.contains(&v32)
+                    || across.contains(&v32)
                 {
                     continue;
                 }
@@ -264,8 +340,10 @@ pub(super) fn close_lids(
                 }
                 let b = (a + 1).min(ch.len() - 1);
                 let c = (1.0 - t) * ch[a] + t * ch[b];
-                if c != 0.0 {
-                    field[v].y += w * c;
+                let y = field[v].y;
+                let to = no_further(y, y + w * c, point, is_upper);
+                if to != y {
+                    field[v].y = to;
                     count += 1;
                 }
             }
@@ -277,4 +355,67 @@ pub(super) fn close_lids(
         }
     }
     done
+}
+
+/// A vertex's vertical motion `y` changed to `to`, held back where the change closes the
+/// slit (down for the upper lid, up for the lower) past its lid point's motion `point`
+/// (step 6): nothing is taken back of a motion already past it, and a change that opens is
+/// kept.
+fn no_further(y: f32, to: f32, point: Option<f32>, is_upper: bool) -> f32 {
+    let Some(point) = point else {
+        return to;
+    };
+    if is_upper && to < y {
+        to.max(point.min(y))
+    } else if !is_upper && to > y {
+        to.min(point.max(y))
+    } else {
+        to
+    }
+}
+
+/// A margin point's change of the gap at the closing value, `excess`, capped by `at_far`,
+/// the change that would bring the gap at the end of the first interval to the source's
+/// there (scaled back to the closing value): the change grows linearly with the FAP value,
+/// so past the closing value it must not close (or open) the slit more than the source's
+/// own over-closure at that end. Opposite signs: no change.
+fn capped(excess: f32, at_far: f32) -> f32 {
+    if excess * at_far <= 0.0 {
+        0.0
+    } else {
+        excess.signum() * excess.abs().min(at_far.abs())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_change_is_capped_by_what_the_end_of_the_interval_allows() {
+        // Closing by 0.2 at the closing value, but only 0.1 (scaled back) keeps the end of
+        // the interval no more closed than the source's there.
+        assert_eq!(capped(0.2, 0.1), 0.1);
+        assert_eq!(capped(0.05, 0.1), 0.05);
+        assert_eq!(capped(-0.2, -0.05), -0.05);
+        // The end is already past the source's: no change at all.
+        assert_eq!(capped(0.2, -0.1), 0.0);
+        assert_eq!(capped(-0.2, 0.1), 0.0);
+    }
+
+    #[test]
+    fn no_vertex_closes_past_its_lid_point() {
+        // Upper lid: the point goes down 1.0; a change to −1.2 stops at −1.0.
+        assert_eq!(no_further(-0.8, -1.2, Some(-1.0), true), -1.0);
+        // Within the point's motion, or opening: kept.
+        assert_eq!(no_further(-0.8, -0.9, Some(-1.0), true), -0.9);
+        assert_eq!(no_further(-0.8, -0.7, Some(-1.0), true), -0.7);
+        // Already past the point: not taken back, not pushed further.
+        assert_eq!(no_further(-1.1, -1.3, Some(-1.0), true), -1.1);
+        // Lower lid: up is closing.
+        assert_eq!(no_further(0.2, 0.6, Some(0.5), false), 0.5);
+        assert_eq!(no_further(0.2, 0.1, Some(0.5), false), 0.1);
+        // No lid point: the change as it is.
+        assert_eq!(no_further(0.2, 0.6, None, false), 0.6);
+    }
 }

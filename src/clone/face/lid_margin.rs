@@ -52,13 +52,20 @@ pub(super) const ONE_SIDE: f32 = 0.8;
 /// A tie to the skin surface: three surface vertices and their weights.
 pub(super) type Tie = ([u32; 3], [f32; 3]);
 
-/// One lid's margin: points (the surface's frame) and the surface vertex each moves as.
+/// Share of the way from a lid point to each corner that is the margin's middle: it moves
+/// as the lid point (the FAP defines that point's motion, and the lashes over the lid's
+/// middle ride it), so `smooth` holds it and `lid_close` fades its change out over it.
+pub(super) const MIDDLE: f32 = 0.5;
+
+/// One lid's margin: points (the surface's frame), the surface vertex each moves as, and the
+/// index of the lid's feature point among them.
 #[derive(Clone, Debug)]
 struct Lid {
     left: bool,
     upper: bool,
     points: Vec<Vec3>,
     vertices: Vec<u32>,
+    mid: usize,
 }
 
 /// The lid margins of a skin surface, with the eyes' landmarks.
@@ -78,12 +85,18 @@ pub(super) struct LidMargins {
 pub(super) struct Ball {
     centre: Vec3,
     radius: f32,
+    /// Median distance of its points from the centre: the sphere of the eye's white, under a
+    /// bulging cornea.
+    inner: f32,
 }
 
 impl Ball {
     /// The ball around `points` (bounding-box centre, farthest point: a cornea bulging from
     /// the sphere counts), `None` without points.
     fn around(points: &[Vec3]) -> Option<Ball> {
+        if points.is_empty() {
+            return None;
+        }
         let lo = points
             .iter()
             .fold(Vec3::splat(f32::INFINITY), |a, &p| a.min(p));
@@ -91,11 +104,20 @@ impl Ball {
             .iter()
             .fold(Vec3::splat(f32::NEG_INFINITY), |a, &p| a.max(p));
         let centre = (lo + hi) / 2.0;
-        let radius = points
-            .iter()
-            .map(|p| p.distance(centre))
-            .fold(0.0, f32::max);
-        (centre.is_finite() && radius > 0.0).then_some(Ball { centre, radius })
+        let mut dist: Vec<f32> = points.iter().map(|p| p.distance(centre)).collect();
+        dist.sort_by(f32::total_cmp);
+        let radius = dist.last().copied().unwrap_or(0.0);
+        let inner = dist[dist.len() / 2];
+        (centre.is_finite() && radius > 0.0 && inner > 0.0).then_some(Ball {
+            centre,
+            radius,
+            inner,
+        })
+    }
+
+    /// Centre and median radius (the eye white's sphere).
+    pub fn sphere(&self) -> (Vec3, f32) {
+        (self.centre, self.inner)
     }
 
     /// Displacement `d` of a point resting at `rest`, cut short on the ball's surface where it
@@ -137,6 +159,48 @@ impl LidMargins {
             .map(|&(_, _, o, i)| (o, i))
     }
 
+    /// Per vertex of one lid's margin (in the order of [`Self::lid`]), how far it lies from
+    /// the margin's middle ([`MIDDLE`]): 0 at the lid point, rising smoothly (by length along
+    /// the margin) to 1 at `MIDDLE` of the way to each corner and beyond.
+    pub fn middle_weights(&self, left: bool, upper: bool) -> Vec<f32> {
+        let Some(l) = self
+            .lids
+            .iter()
+            .find(|l| l.left == left && l.upper == upper)
+        else {
+            return Vec::new();
+        };
+        let mut run = vec![0.0f32];
+        for w in l.points.windows(2) {
+            run.push(run[run.len() - 1] + w[0].distance(w[1]));
+        }
+        let (at, last) = (run[l.mid], run[run.len() - 1]);
+        run.iter()
+            .map(|&r| {
+                let span = MIDDLE * if r <= at { at } else { last - at };
+                if span <= 0.0 {
+                    return 1.0;
+                }
+                let x = ((r - at).abs() / span).min(1.0);
+                x * x * (3.0 - 2.0 * x)
+            })
+            .collect()
+    }
+
+    /// The middle of one lid's margin: its vertices short of [`MIDDLE`] of the way from the
+    /// lid point to either corner.
+    pub fn middle(&self, left: bool, upper: bool) -> Vec<u32> {
+        let Some((_, vertices)) = self.lid(left, upper) else {
+            return Vec::new();
+        };
+        vertices
+            .iter()
+            .zip(self.middle_weights(left, upper))
+            .filter(|(_, w)| *w < 1.0)
+            .map(|(&v, _)| v)
+            .collect()
+    }
+
     /// Pupil distance (ES0 in the surface's frame).
     pub fn es(&self) -> f32 {
         self.es
@@ -172,12 +236,13 @@ impl LidMargins {
             out.eyes.push((left, pupil, o, i));
             for (mid, upper) in lids {
                 let ids = [outer, mid, inner].map(fp);
-                if let Some((points, vertices)) = margin(surf, &graph, ids) {
+                if let Some((points, vertices, mid)) = margin(surf, &graph, ids) {
                     out.lids.push(Lid {
                         left,
                         upper,
                         points,
                         vertices,
+                        mid,
                     });
                 }
             }
@@ -208,6 +273,11 @@ impl LidMargins {
             }
         }
         self
+    }
+
+    /// The eyeballs (left eye or not, ball).
+    pub fn balls(&self) -> &[(bool, Ball)] {
+        &self.balls
     }
 
     /// The eyeball of lid `lid`'s eye, if known.
@@ -311,13 +381,13 @@ fn fp_vertex(surf: &CloneSurface, id: FeaturePointId) -> Option<u32> {
     })
 }
 
-/// The margin through the feature points `ids` (outer corner, lid, inner corner): its points
-/// and the vertex each moves as (module docs).
+/// The margin through the feature points `ids` (outer corner, lid, inner corner): its points,
+/// the vertex each moves as (module docs) and the lid point's index among them.
 fn margin(
     surf: &CloneSurface,
     graph: &EdgeGraph,
     ids: [FeaturePointId; 3],
-) -> Option<(Vec<Vec3>, Vec<u32>)> {
+) -> Option<(Vec<Vec3>, Vec<u32>, usize)> {
     let vs = ids.map(|id| fp_vertex(surf, id));
     let [Some(a), Some(m), Some(b)] = vs else {
         return None;
@@ -331,14 +401,15 @@ fn margin(
     let dense = |p: &Option<Vec<u32>>| p.as_ref().is_some_and(|p| p.len() >= MIN_INTERIOR + 2);
     if a != m && m != b && dense(&first) && dense(&second) {
         let mut vertices = first?;
+        let mid = vertices.len() - 1;
         vertices.extend(second?.into_iter().skip(1));
         let points = vertices
             .iter()
             .map(|&v| surf.positions[v as usize])
             .collect();
-        return Some((points, vertices));
+        return Some((points, vertices, mid));
     }
-    Some((vec![pa, pm, pb], vec![a, m, b]))
+    Some((vec![pa, pm, pb], vec![a, m, b], 1))
 }
 
 /// The surface's edges (CSR adjacency with lengths).
@@ -621,6 +692,24 @@ mod tests {
         // Above and at the margin.
         let row = [Vec3::new(1.0, 0.05, 0.1), Vec3::new(3.0, 0.3, 0.1)];
         assert_eq!(margins.row_lid(&row), Some(0));
+    }
+
+    #[test]
+    fn the_margin_middle_fades_in_from_the_lid_point_to_half_way() {
+        let surf = strip();
+        let margins = LidMargins::of(&surf);
+        // Vertices 0..=8 along x, the lid point 3.1 at 4: half way to each corner is two
+        // vertices out.
+        let w = margins.middle_weights(true, true);
+        assert_eq!(w.len(), 9);
+        assert_eq!(w[4], 0.0);
+        assert!(
+            (w[3] - 0.5).abs() < 1e-6 && (w[5] - 0.5).abs() < 1e-6,
+            "{w:?}"
+        );
+        assert!(w[..=2].iter().chain(&w[6..]).all(|&x| x == 1.0), "{w:?}");
+        assert_eq!(margins.middle(true, true), [3, 4, 5]);
+        assert!(margins.middle(false, true).is_empty());
     }
 
     #[test]

@@ -90,9 +90,11 @@
 //!    (the FAP's own feature point held) until none is rough, at most 40 rounds. Such defects
 //!    come from cloning across styles: target vertices reading unrelated parts of the source
 //!    (lips or lids at the slit's corners, a nearest-vertex repair). A smooth clone is not
-//!    changed. With [`CloneOptions::smooth_shares`] the turns are checked at a quarter and a
-//!    half of each motion too (the FAT interpolates: a lid turning about its eyeball folds on
-//!    the way, beyond a border check's reach). Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more
+//!    changed. With [`CloneOptions::smooth_shares`] (default on) the turns are checked at a
+//!    quarter and a half of each lid FAP's (19–22) motion too (the FAT interpolates: a lid turning about its
+//!    eyeball folds on the way, beyond a border check's reach), and under a lid FAP the middle
+//!    of its lid's margin (from the lid point half way to each corner) is held with the
+//!    point, so the lashes riding it follow the lid. Smoothed motions are listed in [`CloneReport::smoothed`]. It runs once more
 //!    after `gain` and `lid_close`, whose changes can crease a motion again (bruno → ict's
 //!    lip corner).
 //!    **`gain`** (every method): each low-level translation FAP's feature point is brought to
@@ -103,14 +105,26 @@
 //!    feature point off the source's peak (a stylised brow onto a real one) no longer leaves
 //!    the FAP half as strong. Not with FAPU scaling off
 //!    ([`CloneOptions::rbf_fapu_rescale`] for RBF, `fapu_scale` for fit).
-//!    **`lid_close`** (every method, with [`CloneOptions::lid_close`]; `lid_close.rs`),
-//!    after `gain`: where the source's blink
+//!    **`lid_close`** (every method, with [`CloneOptions::lid_close`], default on;
+//!    `lid_close.rs`), after `gain`: where the source's blink
 //!    closes its eye (its lid points meet under both lid FAPs at one value, in both tables'
 //!    first interval), the target's lid margins are moved vertically so that at that value
 //!    the slit's gap along the corner line is the source's (in IRISD0), the top FAP taking
 //!    the upper margin's share and the bottom FAP the lower's; each change fades into its lid
-//!    within 0.2 ES0. Across styles the surface method left the margin's drop a plateau
-//!    with a steep fall at the corners (alma → ict: 0.10 IRISD0 open, −0.18 crossed).
+//!    within 0.2 ES0, fades out over the margin's middle (none at the lid point, which moves
+//!    as its FAP defines), and is capped so that at the end of the first interval the slit
+//!    is no more closed than the source's there; no vertex is taken further along the
+//!    closing than its lid point (ICT's eye blend went 15 % past it). Across styles the surface method left the
+//!    margin's drop a plateau with a steep fall at the corners (alma → ict: 0.10 IRISD0
+//!    open, −0.18 crossed).
+//!    **`eyeball`** (with [`CloneOptions::lid_close`]; `lid_eyeball.rs`): the FAT moves a
+//!    vertex on a straight chord between borders, and a source lid turning about its eyeball
+//!    crossed the target's eyeball on the way (alma → ict 0.21 radii deep, ICT's own FAT
+//!    0.11). Skin near each eyeball part whose chord to a border passes inside the eye
+//!    white's sphere (+2 %; or its own rest distance, if closer) deeper than the source's
+//!    own chords dip into its eyeball under that motion (in radii; a self-clone is kept
+//!    exactly) is pushed out along the eyeball's normal, the push spread smoothly over half
+//!    a radius; before `smooth`'s second pass and `bound`.
 //!    **`mouth`** (every method, `mouth_fill.rs`): the target's hidden mouth interior
 //!    (skin behind the lips' front and hidden from the front, reached from the inner lip
 //!    contour) takes a harmonic extension (edges weighed by inverse length) of the lips'
@@ -211,7 +225,7 @@
 //! `parts` step 1 (`split` cuts one-mesh heads, `target_check` warns about damaged targets),
 //! `align` step 2, `skin_surface` step 3 (welding), `motions` the moves between meshes and
 //! the surface (steps 4 and 8), `rescale` step 6, the guard and the gain, `smooth` the smooth
-//! step, `lid_close` the slits' closure, `turn_bound` the bound, `rigid`, `part_motion` and `jaw_follow`
+//! step, `lid_close` the slits' closure, `lid_eyeball` the lids' clearance of the eyeballs, `turn_bound` the bound, `rigid`, `part_motion` and `jaw_follow`
 //! step 7, `assemble`, `attached` and `lid_margin` step 8 and `fold` step 9. This file runs them in order.
 //!
 //! [`fat_from_morph_targets`]: crate::fat::morph::fat_from_morph_targets
@@ -223,6 +237,7 @@ mod eyeball;
 mod fold;
 mod jaw_follow;
 mod lid_close;
+mod lid_eyeball;
 mod lid_margin;
 mod lid_resting;
 mod motions;
@@ -369,13 +384,20 @@ pub fn clone_face(
         .timings
         .push("motions", clock.elapsed().as_secs_f64());
     // 5, 6. Surface method and FAPU rescale.
-    let (mut cloned_motions, [tmargins, smargins]) =
-        clone_skin_motions(&ssurf, &tsurf, &motions, &alignment, opts, &mut report)?;
+    let (mut cloned_motions, [tmargins, smargins]) = clone_skin_motions(
+        &ssurf,
+        &tsurf,
+        &motions,
+        [(source, &sparts), (target, &tparts)],
+        &alignment,
+        opts,
+        &mut report,
+    )?;
     // Lashes ride on their own lid's margin: rows that are pieces of the skin take its
     // motion here, rows of their own mesh in step 8. A source with rows of lashes in its own
     // skin has them mapped onto the target's by the surface method, like for like (and a
     // target one mesh with the source keeps the source's lash motion vertex to vertex).
-    let margins = tmargins.with_eyeballs(target, &tparts, &alignment);
+    let margins = tmargins;
     let source_rows = lid_margin::SkinRows::of(source, &ssurf, &smargins);
     if !whole && source_rows.is_empty() {
         lid_margin::SkinRows::of(target, &tsurf, &margins).carry(&mut cloned_motions);
@@ -521,6 +543,7 @@ fn clone_skin_motions(
     ssurf: &SkinSurface,
     tsurf: &SkinSurface,
     motions: &[SurfaceMotion],
+    [(source, sparts), (target, tparts)]: [(&FaceModel, &FaceParts); 2],
     alignment: &Similarity,
     opts: &CloneOptions,
     report: &mut CloneReport,
@@ -561,6 +584,14 @@ fn clone_skin_motions(
         },
     );
     let mut result = result?;
+    let topology = topology.with_lid_middles(&margins[0]);
+    // The target's margins know its eyeballs (lashes and lids stay out of them).
+    let [tm, sm] = margins;
+    let margins = [
+        tm.with_eyeballs(target, tparts, alignment),
+        sm.with_eyeballs(source, sparts, &Similarity::IDENTITY),
+    ];
+
     for (name, s) in &result.timings.steps {
         report
             .timings
@@ -651,6 +682,20 @@ fn clone_skin_motions(
     report
         .timings
         .push("lid_close", clock.elapsed().as_secs_f64());
+    // No lid through an eyeball on its way to any border; before `smooth2` and `bound`,
+    // which settle what the push turns.
+    let clock = Instant::now();
+    if opts.lid_close {
+        lid_eyeball::keep_lids_out(
+            &tsurf.surface,
+            &margins[0],
+            (&ssurf.surface, &margins[1], &moving),
+            &mut result.motions,
+        );
+    }
+    report
+        .timings
+        .push("eyeball", clock.elapsed().as_secs_f64());
     // The gain's bump changes the motion after `smooth` looked at it (bruno → ict's lip
     // corner under `viseme_1` turned 12× the source's): the same rule once more. A smooth
     // motion is not changed. Not after the mouth fill: smoothing the uniform-Laplacian way
@@ -669,6 +714,7 @@ fn clone_skin_motions(
     report
         .timings
         .push("smooth2", clock.elapsed().as_secs_f64());
+
     // The hidden mouth interior: a smooth extension of the lips into the jaw's motion.
     let clock = Instant::now();
     if let Some(interior) = interior {

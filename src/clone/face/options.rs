@@ -60,14 +60,15 @@ pub struct CloneOptions {
     /// Alignment rotations up to this many degrees are dropped (upright faces of other
     /// proportions; [`Similarity::fit_snapped`](super::Similarity::fit_snapped)). Default 3°.
     pub align_snap_degrees: f64,
-    /// `smooth` checks the turns at a quarter and a half of each motion too (module docs,
-    /// `smooth`): alma's lids onto ICT no longer fold at the eye corners. Default off: the
-    /// extra smoothing lowers the middle of a closing lid's margin against its lid point
-    /// (alma → ICT's lashes follow 75 % of it), which `lashes_follow_lids` rejects.
+    /// `smooth` checks the turns at a quarter and a half of each lid FAP's motion too (module docs,
+    /// `smooth`): alma's lids onto ICT no longer fold at the eye corners. The middle of a lid
+    /// FAP's margin is held with its lid point then, so the lashes riding it follow the lid.
+    /// Default on.
     pub smooth_shares: bool,
-    /// Run `lid_close` (module docs): the slit closes band by band where the source's does.
-    /// Default off: at ±1024 the doubled change takes the lower lashes past their lid point
-    /// (alma → ICT 0.14 of the lid opening).
+    /// Run `lid_close` (module docs): the slit closes band by band where the source's does,
+    /// the change faded out over the margins' middles and capped past the closing value; and
+    /// `eyeball`: no lid vertex passes into an eyeball part on its way to any border. Default
+    /// on.
     pub lid_close: bool,
 }
 
@@ -81,8 +82,8 @@ impl Default for CloneOptions {
             rbf_fapu_rescale: true,
             align: true,
             align_snap_degrees: 3.0,
-            smooth_shares: false,
-            lid_close: false,
+            smooth_shares: true,
+            lid_close: true,
         }
     }
 }

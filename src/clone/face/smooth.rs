@@ -30,10 +30,13 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::lid_margin::LidMargins;
 use super::rescale::fap_fp;
 use crate::clone::quality::{max_normal_turn, NORMAL_TURN_FLOOR};
 use crate::clone::{CloneSurface, SurfaceMotion};
+use crate::fat::TableKey;
 use crate::mesh::geometry::adjacency;
+use crate::spec::FapId;
 
 /// Slack over the source's largest turn before a target triangle counts as rough.
 const SLACK: f64 = 1.25;
@@ -96,6 +99,30 @@ fn rough_at(
         return true;
     }
     n0.dot(n1) / l < cos_tau
+}
+
+/// The turn of triangle `t` (neutral unit normal `n0`) under `share` of the displacements
+/// `d`, over the angle whose cosine is `cos_tau` (a collapsed triangle: a half turn).
+fn turn_ratio(
+    positions: &[Vec3],
+    d: &[Vec3],
+    share: f32,
+    t: &[u32; 3],
+    n0: Vec3,
+    cos_tau: f32,
+) -> f32 {
+    if n0 == Vec3::ZERO {
+        return 0.0;
+    }
+    let p = |k: usize| positions[t[k] as usize] + share * d[t[k] as usize];
+    let n1 = (p(1) - p(0)).cross(p(2) - p(0));
+    let l = n1.length();
+    let angle = if l.is_finite() && l > 0.0 {
+        (n0.dot(n1) / l).clamp(-1.0, 1.0).acos()
+    } else {
+        std::f32::consts::PI
+    };
+    angle / cos_tau.clamp(-1.0, 1.0).acos().max(1e-6)
 }
 
 /// The triangles using each of `n` vertices.
@@ -175,6 +202,10 @@ pub(super) struct SmoothTopology {
     /// The same at each of the [`SHARES`] of each source motion (empty unless built
     /// `with_shares`).
     pub(super) share_turns: Vec<[f64; SHARES.len()]>,
+    /// Per lid FAP, the middle of its lid's margin on the target
+    /// ([`LidMargins::middle`]), held with the FAP's own feature point when the shares are
+    /// checked (empty until [`Self::with_lid_middles`]).
+    pub(super) lid_middles: Vec<(TableKey, Vec<u32>)>,
 }
 
 impl SmoothTopology {
@@ -196,7 +227,13 @@ impl SmoothTopology {
         let share_turns = if with_shares {
             motions
                 .par_iter()
-                .map(|m| SHARES.map(|s| source_turn(source, &source_incident, m, s)))
+                .map(|m| {
+                    if on_the_way(m.key) {
+                        SHARES.map(|s| source_turn(source, &source_incident, m, s))
+                    } else {
+                        [0.0; SHARES.len()]
+                    }
+                })
                 .collect()
         } else {
             Vec::new()
@@ -208,8 +245,39 @@ impl SmoothTopology {
             tn: normals(&target.positions, &target.triangles),
             source_turns,
             share_turns,
+            lid_middles: Vec::new(),
         }
     }
+
+    /// The same holding the middles of the target's lid margins (`margins`) under their lid
+    /// FAPs (19–22) when the shares are checked: smoothing a fold at an eye corner at a
+    /// quarter of the motion otherwise drew the margin's middle up against its held lid
+    /// point (alma → ICT's lashes, riding the margin, followed 75 % of the lid point).
+    pub(super) fn with_lid_middles(mut self, margins: &LidMargins) -> Self {
+        self.lid_middles = [
+            (19, true, true),
+            (20, false, true),
+            (21, true, false),
+            (22, false, false),
+        ]
+        .into_iter()
+        .filter_map(|(fap, left, upper)| {
+            let key = TableKey::LowLevel(FapId::new(fap)?);
+            let middle = margins.middle(left, upper);
+            (!middle.is_empty()).then_some((key, middle))
+        })
+        .collect();
+        self
+    }
+}
+
+/// Whether the turns of a motion of `key` are checked at [`SHARES`] of it too (with
+/// [`CloneOptions::smooth_shares`](super::CloneOptions::smooth_shares)): the lid FAPs (19–22)
+/// alone, the motions that turn a lid about its eyeball between borders. On other FAPs the
+/// shares smoothed motions that were right: ICT's identity head +2.5/−3, cloned vertex to
+/// vertex, `stretch_r_cornerlip` 0.00 → 0.32 % off at ICT's tiny lip-corner triangles.
+fn on_the_way(key: TableKey) -> bool {
+    matches!(key, TableKey::LowLevel(f) if (19..=22).contains(&f.number()))
 }
 
 /// The largest normal turn of source motion `src` at `share` of it ([`max_normal_turn`],
@@ -253,6 +321,7 @@ pub(super) fn smooth_motions(
         tn,
         source_turns,
         share_turns,
+        lid_middles,
     } = topology;
     let results: Vec<Option<(String, usize)>> = motions
         .par_iter()
@@ -262,6 +331,8 @@ pub(super) fn smooth_motions(
             if dst.offsets.is_empty() {
                 return None;
             }
+            // The shares only under the lid FAPs (`on_the_way`).
+            let with_shares = with_shares && on_the_way(src.key);
             let theta = source_turns
                 .get(k)
                 .copied()
@@ -315,6 +386,37 @@ pub(super) fn smooth_motions(
                     *p = true;
                 }
             }
+            // So does the middle of a lid FAP's margin when the shares are checked
+            // ([`SmoothTopology::with_lid_middles`]).
+            let mut held_middle = false;
+            if with_shares {
+                for (_, middle) in lid_middles.iter().filter(|m| m.0 == src.key) {
+                    held_middle = true;
+                    for &v in middle {
+                        if let Some(p) = pinned.get_mut(v as usize) {
+                            *p = true;
+                        }
+                    }
+                }
+            }
+            // The worst turn over the checks, against each check's limit.
+            let worst = |d: &[Vec3], offsets: &[(u32, Vec3)]| -> f32 {
+                touching(incident, offsets)
+                    .into_iter()
+                    .map(|i| {
+                        let (t, n0) = (&tris[i as usize], tn[i as usize]);
+                        checks
+                            .iter()
+                            .map(|&(s, c)| turn_ratio(pos, d, s, t, n0, c))
+                            .fold(0.0, f32::max)
+                    })
+                    .fold(0.0, f32::max)
+            };
+            let before = if held_middle {
+                worst(&d, &dst.offsets)
+            } else {
+                0.0
+            };
             let mut touched = vec![false; n];
             let mut count = 0usize;
             let mut next = d.clone();
@@ -376,7 +478,13 @@ pub(super) fn smooth_motions(
                     break;
                 }
             }
-            dst.offsets = sparse_offsets(&d);
+            let smoothed = sparse_offsets(&d);
+            // With a lid's middle held the smoothing can fold the lid next to it (ICT's
+            // `close_t_l_eyelid` onto alma: 31° → 178°): then it is undone.
+            if held_middle && worst(&d, &smoothed) > before {
+                return None;
+            }
+            dst.offsets = smoothed;
             Some((format!("{}@{}", src.key.name(), src.value), count))
         })
         .collect();
@@ -386,9 +494,7 @@ pub(super) fn smooth_motions(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fat::TableKey;
     use crate::fdp::{Fapu, FapuDistances};
-    use crate::spec::FapId;
 
     /// A flat grid of `k × k` vertices (spacing 1) in the xy plane.
     fn grid(k: u32) -> CloneSurface {
