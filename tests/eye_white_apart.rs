@@ -549,7 +549,9 @@ fn iris_and_eye_white_held_apart_turn_as_one_eye() {
         let stderr = support::cli::text(&o.stderr);
         eprintln!("{}: {stderr}", case.name);
         assert!(o.status.success(), "{}: {stderr}", case.name);
-        assert!(!stderr.contains("is not turned"), "{}: {stderr}", case.name);
+        if stderr.contains("is not turned") {
+            failures.push(format!("{}: an eye node is not turned", case.name));
+        }
         // The document comes back whole.
         let (input, _) = glb_parts(&glb);
         let (patched, _) = glb_parts(&out);
@@ -563,10 +565,13 @@ fn iris_and_eye_white_held_apart_turn_as_one_eye() {
             .unwrap()
             .face;
         let back = fbakit::face::read(&out).unwrap();
-        let report = diff(&cloned, &back, &DiffOptions::default());
-        assert!(report.equal, "{}: {report}", case.name);
         failures.extend(check_eyes(&format!("{} (clone)", case.name), &cloned));
         failures.extend(check_eyes(&format!("{} (read back)", case.name), &back));
+        let report = diff(&cloned, &back, &DiffOptions::default());
+        assert!(report.equal, "{}: {report}", case.name);
+        if !failures.is_empty() {
+            continue;
+        }
         let played = check_play(d, case.name, &out, &back, case.nodes);
         files.extend([glb, out, played]);
     }

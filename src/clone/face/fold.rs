@@ -108,12 +108,21 @@ pub(super) fn fold_into_target(
         let band = (report.mouth_interior > 0)
             .then(|| CutBand::new(target, target_mesh, &multiplicity))
             .flatten();
+        // A rest that is one part while other pieces are another part's (both eye whites in
+        // one primitive, an iris mesh of its own keeping the left eye's transform): the mesh
+        // goes back whole, so it cannot sit in that part's transform; its home is above it
+        // and every piece is baked.
+        let parts: BTreeSet<Part> = meshes.iter().filter_map(|m| m.part).collect();
+        let mut home_t = home(cloned, rest, &baked);
+        if cut.rest.is_some() && parts.len() > 1 {
+            home_t = home_t.and_then(|t| cloned.transforms[t].parent);
+        }
         cuts.push(CutMeshes {
             target: target_mesh,
             name: &cut.mesh,
             meshes,
             multiplicity,
-            home: home(cloned, rest, &baked),
+            home: home_t,
             band,
         });
     }
@@ -128,7 +137,7 @@ pub(super) fn fold_into_target(
         let gone = hierarchy_ancestors(cloned, Some(t))
             .iter()
             .any(|&a| baked.contains(&cloned.transforms[a].name));
-        let away = cut.meshes.first().is_some_and(|r| r.index != m.index) && cut.home != Some(t);
+        let away = cut.home != Some(t);
         (gone || away).then_some(t)
     };
     // Transforms whose motion such a part takes apart from its cut mesh's home: a table
@@ -279,7 +288,8 @@ pub(super) fn fold_into_target(
         report.warnings.append(&mut warnings);
         fat.tables.extend(table);
     }
-    let face = layout_face(cloned, target, &baked, fat);
+    let homes: HashMap<&str, Option<usize>> = cuts.iter().map(|c| (c.name, c.home)).collect();
+    let face = layout_face(cloned, target, &baked, &homes, fat);
     correct_report(report, &baked);
     Ok(face)
 }
@@ -635,11 +645,13 @@ fn merge_entries(mut entries: Vec<FaceDefMesh>, multiplicity: &[u8]) -> Option<F
 }
 
 /// The target's meshes (vertices, polygons, attributes as the user gave them) under the
-/// cloned view's transforms, minus the baked ones, with `fat`.
+/// cloned view's transforms, minus the baked ones, with `fat`; a cut mesh under its home
+/// (`homes`, by name).
 fn layout_face(
     cloned: &FaceModel,
     target: &FaceModel,
     baked: &BTreeSet<String>,
+    homes: &HashMap<&str, Option<usize>>,
     fat: Fat,
 ) -> FaceModel {
     let mut face = cloned.clone();
@@ -661,7 +673,11 @@ fn layout_face(
         .map(|m| {
             let mut out = m.clone();
             if let Some(c) = cloned.mesh_index(&m.name) {
-                out.transform = home(cloned, c, baked).and_then(|t| new_index.get(&t).copied());
+                let at = match homes.get(m.name.as_str()) {
+                    Some(&h) => h,
+                    None => home(cloned, c, baked),
+                };
+                out.transform = at.and_then(|t| new_index.get(&t).copied());
                 if cloned.meshes[c].mesh.positions.len() == m.mesh.positions.len() {
                     // Same mesh (not cut): positions as the clone left them (a part moved
                     // under a new transform is re-expressed in its frame).
