@@ -17,7 +17,8 @@
 //! baked into per-vertex rows with the same turn; under the lid FAPs and `open_jaw` the eyes
 //! stay; the document comes back whole (nodes, hierarchy, skin, meshes, vertex counts, the
 //! user's animation); the glb reads back with the library clone's FAT; `play` turns the eye
-//! joints or nodes as the FAT turns the iris; the files add no validator issue.
+//! joints or nodes as the FAT turns the iris; the files add no validator issue (no error, no
+//! warning beyond the avatar's one skinned mesh under its scaled root).
 
 mod support;
 
@@ -576,10 +577,20 @@ fn iris_and_eye_white_held_apart_turn_as_one_eye() {
         files.extend([glb, out, played]);
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // Per avatar (input, clone, played): no error, and no warning the input lacks (the
+    // avatar's skinned `Body` under the 0.01-scaled `Armature` is the one it has by design).
     if let Some(reports) = support::validator::validate(&files) {
-        for (f, r) in files.iter().zip(&reports) {
-            assert_eq!(r["errors"], 0, "{}: {r}", f.display());
-            assert_eq!(r["warnings"], 0, "{}: {r}", f.display());
+        for (f, r) in files.chunks(3).zip(reports.chunks(3)) {
+            for (file, report) in f.iter().zip(r) {
+                assert_eq!(report["errors"], 0, "{}: {report}", file.display());
+                assert_eq!(
+                    report["warnings"],
+                    r[0]["warnings"],
+                    "{}: {report}",
+                    file.display()
+                );
+            }
+            assert!(r[0]["warnings"].as_u64().unwrap() <= 1, "{}", r[0]);
         }
     }
 }

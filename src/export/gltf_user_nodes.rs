@@ -14,6 +14,12 @@
 //! centre, the transform's `center`, by the FAT's axis and angle), mapped into the node's
 //! parent frame; when the node's origin is not that centre its translation moves with the
 //! turn, so the mesh moves exactly as the FAT says.
+//!
+//! The eye's transform may also hold meshes the node does not move at all: an eye white on
+//! a node of its own or in another mesh, beside the iris under the eye node. The node then
+//! shows the turn of what it holds, and those meshes take the same turn as per-vertex
+//! targets ([`EyeNode::apart`]), recorded above the transform so the file reads back with
+//! their motion once.
 
 use glam::{Affine3A, Mat4, Quat, Vec3};
 use serde_json::Value;

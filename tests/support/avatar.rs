@@ -196,8 +196,10 @@ pub fn eye_layer(
         layer
             .triangles
             .extend(t.iter().map(|tr| tr.map(|i| i + base)));
+        // A joint of zero weight is slot 0, as the validator asks.
+        let rest = if share < 1.0 { 2 } else { 0 };
         layer.joints.extend(std::iter::repeat_n(
-            [(slot, share), (2, 1.0 - share)],
+            [(slot, share), (rest, 1.0 - share)],
             p.len(),
         ));
         layer

@@ -112,10 +112,19 @@ pub(super) fn fold_into_target(
         // one primitive, an iris mesh of its own keeping the left eye's transform): the mesh
         // goes back whole, so it cannot sit in that part's transform; its home is above it
         // and every piece is baked.
-        let parts: BTreeSet<Part> = meshes.iter().filter_map(|m| m.part).collect();
+        let chains: Vec<Vec<usize>> = meshes
+            .iter()
+            .skip(1)
+            .map(|m| hierarchy_ancestors(cloned, cloned.meshes[m.index].transform))
+            .collect();
         let mut home_t = home(cloned, rest, &baked);
-        if cut.rest.is_some() && parts.len() > 1 {
-            home_t = home_t.and_then(|t| cloned.transforms[t].parent);
+        let mut steps = 0;
+        while let Some(t) = home_t.filter(|&t| chains.iter().any(|c| !c.contains(&t))) {
+            steps += 1;
+            if cut.rest.is_none() || steps > cloned.transforms.len() {
+                break;
+            }
+            home_t = cloned.transforms[t].parent;
         }
         cuts.push(CutMeshes {
             target: target_mesh,
