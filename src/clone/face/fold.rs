@@ -6,7 +6,9 @@
 //! per-vertex displacements of those vertices ([`crate::fat::bake`]) — so is that of a part
 //! transform kept for a whole mesh (an iris) when it also turns pieces cut out of a mesh that
 //! goes back elsewhere (a highlight cut from a primitive whose occlusion shell is skin) —, within 1 % of the part's
-//! size at every FAP value the table covers. The face returned has exactly the target's
+//! size at every FAP value the table covers. A cut mesh goes back under a transform above
+//! every piece's (both eye whites of one primitive: not the left eye's transform, which an
+//! iris mesh of its own keeps). The face returned has exactly the target's
 //! meshes, vertices and polygons; its transforms are the target's plus those that still hold
 //! a mesh (a created root `head`).
 
