@@ -210,9 +210,13 @@ pub fn patch_face(
         .iter()
         .map(|t| recorded_user.contains(&t.name))
         .collect();
-    for (t, n) in eye_transforms(face, source, nodes, &transform_nodes, &mut warnings) {
-        transform_nodes[t] = Some(n);
-        user_nodes[t] = true;
+    let mut apart: Vec<(usize, Vec<usize>)> = Vec::new();
+    for e in eye_transforms(face, source, nodes, &transform_nodes, &mut warnings) {
+        transform_nodes[e.transform] = Some(e.node);
+        user_nodes[e.transform] = true;
+        if !e.apart.is_empty() {
+            apart.push((e.transform, e.apart));
+        }
     }
     // Eyeballs that are vertices of a bigger mesh, turned by the eye joints carrying them:
     // their rows under the eye's tables leave the targets (never a rotation and a morph).
@@ -271,7 +275,7 @@ pub fn patch_face(
         }
         None => face,
     };
-    let world_pieces = face_pieces(face, &transform_nodes)?;
+    let world_pieces = face_pieces(face, &transform_nodes, &apart)?;
     let mut meshes: BTreeMap<usize, MeshTargets> = BTreeMap::new();
     // A glTF mesh shown by several nodes is patched once: from its first instance.
     let mut taken: BTreeMap<(usize, usize), String> = BTreeMap::new();
@@ -415,7 +419,17 @@ pub fn patch_face(
             },
         );
     }
-    patch.scene_extras = gltf_fat::scene_record(face, unit, &transform_nodes);
+    // Meshes a node-shown transform moves apart from the node (an eye white beside the iris
+    // under the eye node) carry its motion as targets: recorded above that transform, so the
+    // file reads back with their motion once.
+    let lifted;
+    let recorded = if apart.is_empty() {
+        face
+    } else {
+        lifted = lift_apart(face, &apart);
+        &lifted
+    };
+    patch.scene_extras = gltf_fat::scene_record(recorded, unit, &transform_nodes);
     gltf_fat::mark_user_nodes(&mut patch.scene_extras, &user_nodes);
     if !parts.is_empty() {
         if let Some(Value::Object(record)) = patch.scene_extras.get_mut(gltf_fat::KEY) {
@@ -692,11 +706,37 @@ fn piece_names(pieces: &[TargetPiece], taken: &[String]) -> Vec<String> {
         .collect()
 }
 
+/// `face` with each mesh of `apart` (transform, meshes) moved from that transform to its
+/// parent, its positions re-expressed there.
+fn lift_apart(face: &FaceModel, apart: &[(usize, Vec<usize>)]) -> FaceModel {
+    let mut out = face.clone();
+    let frames = face.frames();
+    for (t, meshes) in apart {
+        let parent = face.transforms.get(*t).and_then(|x| x.parent);
+        let to_parent = parent
+            .map_or(Affine3A::IDENTITY, |p| frames.transforms[p])
+            .inverse();
+        for &m in meshes {
+            let Some(fm) = out.meshes.get_mut(m) else {
+                continue;
+            };
+            let map = to_parent * frames.meshes[m];
+            for q in &mut fm.mesh.positions {
+                *q = map.transform_point3(*q);
+            }
+            fm.transform = parent;
+        }
+    }
+    out
+}
+
 /// Per face mesh, the world-frame motion of every piece: the FAT's vertex tables, then its
-/// transform motion baked.
+/// transform motion baked — for a transform a node shows, only on the meshes it moves apart
+/// from that node (`apart`: transform, meshes).
 fn face_pieces(
     face: &FaceModel,
     transform_nodes: &[Option<usize>],
+    apart: &[(usize, Vec<usize>)],
 ) -> Result<Vec<Vec<FaceMeshPiece>>> {
     let morphs = FaceMorphs::new(face)?;
     let frames = face.frames();
@@ -733,16 +773,26 @@ fn face_pieces(
                 .is_none()
         });
         if !baked.transforms.is_empty() {
-            bake_transforms(face, &baked, &mut out)?;
+            bake_transforms(face, &baked, None, &mut out)?;
+        }
+        for (t, meshes) in apart {
+            let mut only = table.clone();
+            only.transforms
+                .retain(|x| face.transform_index(&x.transform) == Some(*t));
+            if !only.transforms.is_empty() {
+                bake_transforms(face, &only, Some(meshes), &mut out)?;
+            }
         }
     }
     Ok(out)
 }
 
-/// The transform motion of `table` as per-vertex pieces of the meshes it moves.
+/// The transform motion of `table` as per-vertex pieces of the meshes it moves (of `meshes`
+/// only, when given).
 fn bake_transforms(
     face: &FaceModel,
     table: &crate::fat::FaceDefTable,
+    meshes: Option<&[usize]>,
     out: &mut [Vec<FaceMeshPiece>],
 ) -> Result<()> {
     let mut only = face.clone();
@@ -776,6 +826,9 @@ fn bake_transforms(
         let (lo, hi) = (borders[j], borders[j + 1]);
         let span = if hi <= 0.0 { lo - hi } else { hi - lo };
         for (mi, list) in out.iter_mut().enumerate() {
+            if meshes.is_some_and(|m| !m.contains(&mi)) {
+                continue;
+            }
             let mut vertices = Vec::new();
             let mut world = Vec::new();
             let (lo_at, hi_at) = (&at[j][mi], &at[j + 1][mi]);
@@ -1049,7 +1102,7 @@ mod tests {
         }];
         let mut pieces: Vec<Vec<FaceMeshPiece>> =
             (0..face.meshes.len()).map(|_| Vec::new()).collect();
-        bake_transforms(&face, table, &mut pieces).unwrap();
+        bake_transforms(&face, table, None, &mut pieces).unwrap();
         assert!(pieces.iter().any(|p| !p.is_empty()));
         let v = default_value(table.key);
         let neutral = only.pose(&[]).unwrap();

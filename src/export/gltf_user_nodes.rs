@@ -14,6 +14,12 @@
 //! centre, the transform's `center`, by the FAT's axis and angle), mapped into the node's
 //! parent frame; when the node's origin is not that centre its translation moves with the
 //! turn, so the mesh moves exactly as the FAT says.
+//!
+//! The eye's transform may also hold meshes the node does not move at all: an eye white on
+//! a node of its own or in another mesh, beside the iris under the eye node. The node then
+//! shows the turn of what it holds, and those meshes take the same turn as per-vertex
+//! targets ([`EyeNode::apart`]), recorded above the transform so the file reads back with
+//! their motion once.
 
 use glam::{Affine3A, Mat4, Quat, Vec3};
 use serde_json::Value;
@@ -44,7 +50,7 @@ pub(super) fn eye_node_refusal(source: &GltfSource, node: usize, why: &str) -> D
     ))
 }
 
-/// The face transforms of `face` that the user's eye nodes show, as `(transform, node)`.
+/// The face transforms of `face` that the user's eye nodes show.
 /// Nodes already showing a transform (`taken`) are left as they are. An eye node shows an
 /// eyeball when it moves that eyeball alone: a plain mesh under it, or a skinned mesh
 /// weighted to it (or the joints below it) by at least 95 % (the usual VRM, Mixamo or
@@ -60,7 +66,7 @@ pub fn eye_transforms(
     names: &RotationNodes,
     taken: &[Option<usize>],
     warnings: &mut Vec<Diagnostic>,
-) -> Vec<(usize, usize)> {
+) -> Vec<EyeNode> {
     let (left, right) = eye_nodes(source, names);
     let json = &source.json;
     let reader = ShareReader::new(source);
@@ -197,8 +203,14 @@ pub fn eye_transforms(
             }));
             continue;
         }
+        // Meshes of the eyeball the node does not move at all (an eye white beside an iris
+        // under the eye node): the node shows the turn of its own meshes, and theirs is
+        // baked into per-vertex targets with the same motion.
+        let apart: Vec<usize> = (0..face.meshes.len())
+            .filter(|&m| moved_by(m) && shares[m].iter().all(|&s| s <= STRAY_SHARE))
+            .collect();
         let partly = (0..face.meshes.len())
-            .filter(|&m| moved_by(m))
+            .filter(|&m| moved_by(m) && !apart.contains(&m))
             .find_map(|m| {
                 let s = &shares[m];
                 let mean = s.iter().sum::<f32>() / s.len().max(1) as f32;
@@ -223,9 +235,25 @@ pub fn eye_transforms(
             ));
             continue;
         }
-        out.push((transform, node));
+        out.push(EyeNode {
+            transform,
+            node,
+            apart,
+        });
     }
     out
+}
+
+/// A face transform shown by a user's eye node.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EyeNode {
+    /// The face transform.
+    pub transform: usize,
+    /// The glTF node showing it.
+    pub node: usize,
+    /// Face meshes the transform moves that the node does not (an eye white beside the iris
+    /// it holds): their share of the motion is baked into per-vertex targets.
+    pub apart: Vec<usize>,
 }
 
 /// A user's node showing a face transform: its rest frames in the file.

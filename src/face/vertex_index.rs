@@ -24,6 +24,9 @@ impl FaceVertexIndex {
     }
 
     /// Indexes the vertices of the meshes `meshes` of `face` (indices; unknown ones skipped).
+    /// A vertex no polygon of its mesh uses is left out (a mesh without polygons keeps all):
+    /// it is never seen and never moves, as a UV sphere's unused pole copies, so a point
+    /// bound to it would not follow its part.
     pub fn of_meshes(face: &FaceModel, meshes: &[usize]) -> FaceVertexIndex {
         let frames = face.frames();
         let mut owners = Vec::with_capacity(face.vertex_count());
@@ -32,7 +35,17 @@ impl FaceVertexIndex {
             let Some(m) = face.meshes.get(mi) else {
                 continue;
             };
+            let indices = m.mesh.polygons.indices();
+            let mut used = vec![indices.is_empty(); m.mesh.positions.len()];
+            for &v in indices {
+                if let Some(u) = used.get_mut(v as usize) {
+                    *u = true;
+                }
+            }
             for (vi, p) in m.mesh.positions.iter().enumerate() {
+                if !used[vi] {
+                    continue;
+                }
                 owners.push((mi, vi as u32));
                 world.push(frames.meshes[mi].transform_point3(*p));
             }

@@ -113,7 +113,39 @@ pub struct Options {
     /// pupil), each holding both eyes and skinned to the same joints. Not with the other eye
     /// options.
     pub vroid_eyes: Option<VroidEyes>,
+    /// With [`Options::vroid_eyes`]: the eye whites (`Body`'s `eyes` primitive) weighted
+    /// wholly to `Head`, not to the eye joints, as VRoid's `EyeWhite` is; only the irises
+    /// (and highlights) are skinned to the eye joints.
+    pub white_on_head: bool,
+    /// The eye nodes `LeftEye` / `RightEye` (as [`Options::eye_nodes`]: nodes
+    /// [`LEFT_EYE_NODE`], [`RIGHT_EYE_NODE`] under `Eyes`) hold iris caps (meshes `LeftIris`,
+    /// `RightIris`: 2 and 3) while the eye whites sit elsewhere: in `Body`'s `eyes` primitive
+    /// on `Head`, or ([`IrisNodes::white_nodes`]) on nodes of their own. Not with the other
+    /// eye options.
+    pub iris_nodes: Option<IrisNodes>,
 }
+
+/// Where the eye whites of [`Options::iris_nodes`] are.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct IrisNodes {
+    /// On nodes `LeftEyeWhite` / `RightEyeWhite` of their own under `Head`
+    /// ([`LEFT_WHITE_NODE`], [`RIGHT_WHITE_NODE`]; meshes 4 and 5) instead of `Body`'s `eyes`
+    /// primitive.
+    pub white_nodes: bool,
+}
+
+/// With [`IrisNodes::white_nodes`]: the eye whites' nodes.
+pub const LEFT_WHITE_NODE: usize = 11;
+pub const RIGHT_WHITE_NODE: usize = 12;
+
+/// The pole of an iris cap of [`Options::vroid_eyes`] or [`Options::iris_nodes`] (cm,
+/// armature frame): where an artist puts the pupil.
+pub fn iris_pole(left: bool) -> Vec3 {
+    eye_centre(left) + Vec3::Z * IRIS_RADIUS
+}
+
+/// Radius of the eye white (cm).
+pub const EYE_WHITE_RADIUS: f32 = 1.2;
 
 /// The eye layers of [`Options::vroid_eyes`].
 #[derive(Clone, Copy, Debug)]
@@ -164,8 +196,10 @@ pub fn eye_layer(
         layer
             .triangles
             .extend(t.iter().map(|tr| tr.map(|i| i + base)));
+        // A joint of zero weight is slot 0, as the validator asks.
+        let rest = if share < 1.0 { 2 } else { 0 };
         layer.joints.extend(std::iter::repeat_n(
-            [(slot, share), (2, 1.0 - share)],
+            [(slot, share), (rest, 1.0 - share)],
             p.len(),
         ));
         layer
@@ -259,7 +293,18 @@ pub fn eye_node_world(left: bool) -> Mat4 {
 
 /// One eyeball sphere as the `eyes` primitive has it.
 fn eyeball(left: bool) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
-    sphere(eye_centre(left), 1.2, 4, 8, std::f32::consts::PI)
+    sphere(
+        eye_centre(left),
+        EYE_WHITE_RADIUS,
+        4,
+        8,
+        std::f32::consts::PI,
+    )
+}
+
+/// One iris cap of [`Options::iris_nodes`] about the eye's centre.
+fn iris_cap(left: bool) -> (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
+    sphere(eye_centre(left), IRIS_RADIUS, 2, 8, IRIS_HALF_ANGLE)
 }
 
 /// Lip line height and front of the teeth rows (cm, armature frame): just behind the lips
@@ -369,7 +414,7 @@ pub fn teeth_fp_lines() -> String {
 pub fn body_prims_with(opts: &Options) -> Vec<Prim> {
     let mut prims = body_prims();
     let vrm_share = opts.vrm_eyes.or(opts.vroid_eyes.map(|_| 1.0));
-    if let Some(share) = vrm_share {
+    if let Some(share) = vrm_share.filter(|_| !opts.white_on_head) {
         // `eyes` holds the right eyeball, then the left ([`body_prims`]).
         let eyes = &mut prims[2];
         let half = eyes.positions.len() / 2;
@@ -631,7 +676,8 @@ pub fn build_with(opts: &Options) -> Avatar {
     let image_view = b.view(&png, None);
     let mut primitives = Vec::new();
     for (k, p) in prims.iter().enumerate() {
-        if (opts.eye_nodes || opts.skinned_eyes.is_some()) && p.name == "eyes" {
+        let white_apart = opts.iris_nodes.is_some_and(|i| i.white_nodes);
+        if (opts.eye_nodes || opts.skinned_eyes.is_some() || white_apart) && p.name == "eyes" {
             continue;
         }
         let mut primitive = skinned_primitive(&mut b, p, k);
@@ -670,9 +716,18 @@ pub fn build_with(opts: &Options) -> Avatar {
         b.acc(json!({"bufferView": hat_iv, "componentType": 5123, "count": 12, "type": "SCALAR"}));
     // The eye meshes of `Options::eye_nodes`: each sphere in its node's own frame.
     let mut eye_meshes = Vec::new();
-    if opts.eye_nodes {
+    assert!(
+        !(opts.eye_nodes && opts.iris_nodes.is_some()),
+        "eye nodes or iris nodes, not both"
+    );
+    if opts.eye_nodes || opts.iris_nodes.is_some() {
+        let irises = opts.iris_nodes.is_some();
         for left in [true, false] {
-            let (p, n, uv, t) = eyeball(left);
+            let (p, n, uv, t) = if irises {
+                iris_cap(left)
+            } else {
+                eyeball(left)
+            };
             let to_local = eye_node_world(left).inverse();
             let p: Vec<Vec3> = p.iter().map(|&x| to_local.transform_point3(x)).collect();
             let n: Vec<Vec3> = n
@@ -691,8 +746,38 @@ pub fn build_with(opts: &Options) -> Avatar {
             let ib: Vec<u8> = t.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
             let iv = b.view(&ib, Some(34963));
             let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": t.len() * 3, "type": "SCALAR"}));
+            let name = match (irises, left) {
+                (false, true) => "LeftEyeMesh",
+                (false, false) => "RightEyeMesh",
+                (true, true) => "LeftIris",
+                (true, false) => "RightIris",
+            };
             eye_meshes.push(json!({
-                "name": if left { "LeftEyeMesh" } else { "RightEyeMesh" },
+                "name": name,
+                "primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv}, "indices": idx, "material": 2}]
+            }));
+        }
+    }
+    // The eye whites of `IrisNodes::white_nodes`: each sphere about its node's origin (the
+    // eye's centre, in `Head`'s frame).
+    if opts.iris_nodes.is_some_and(|i| i.white_nodes) {
+        for left in [true, false] {
+            let (p, n, uv, t) = eyeball(left);
+            let p: Vec<Vec3> = p.iter().map(|&x| x - eye_centre(left)).collect();
+            let pos = b.vec3(&p, true);
+            let nrm = b.vec3(&n, false);
+            let uv_bytes: Vec<u8> = uv
+                .iter()
+                .flat_map(|v| v.to_array())
+                .flat_map(f32::to_le_bytes)
+                .collect();
+            let uv_view = b.view(&uv_bytes, Some(34962));
+            let uv = b.acc(json!({"bufferView": uv_view, "componentType": 5126, "count": p.len(), "type": "VEC2"}));
+            let ib: Vec<u8> = t.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+            let iv = b.view(&ib, Some(34963));
+            let idx = b.acc(json!({"bufferView": iv, "componentType": 5123, "count": t.len() * 3, "type": "SCALAR"}));
+            eye_meshes.push(json!({
+                "name": if left { "LeftEyeWhite" } else { "RightEyeWhite" },
                 "primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv}, "indices": idx, "material": 2}]
             }));
         }
@@ -836,8 +921,13 @@ pub fn build_with(opts: &Options) -> Avatar {
         "bufferViews": b.views,
         "buffers": [{"byteLength": b.bin.len()}]
     });
-    if opts.eye_nodes {
+    if opts.eye_nodes || opts.iris_nodes.is_some() {
         json["nodes"][3]["children"] = json!([4, 6, EYES_NODE]);
+        let white_nodes = opts.iris_nodes.is_some_and(|i| i.white_nodes);
+        if white_nodes {
+            json["nodes"][3]["children"] =
+                json!([4, 6, EYES_NODE, LEFT_WHITE_NODE, RIGHT_WHITE_NODE]);
+        }
         let nodes = json["nodes"].as_array_mut().unwrap();
         let q = |q: glam::Quat| json!(q.to_array());
         nodes.push(
@@ -848,6 +938,12 @@ pub fn build_with(opts: &Options) -> Avatar {
             nodes.push(json!({"name": name, "mesh": mesh,
                 "translation": eye_node_translation(left).to_array(),
                 "rotation": q(eye_node_rotation(left))}));
+        }
+        if white_nodes {
+            for (left, name, mesh) in [(true, "LeftEyeWhite", 4), (false, "RightEyeWhite", 5)] {
+                nodes.push(json!({"name": name, "mesh": mesh,
+                    "translation": (eye_centre(left) - HEAD_CENTRE).to_array()}));
+            }
         }
         json["meshes"].as_array_mut().unwrap().extend(eye_meshes);
     } else if opts.skinned_eyes.is_some() {

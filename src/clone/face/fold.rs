@@ -6,7 +6,9 @@
 //! per-vertex displacements of those vertices ([`crate::fat::bake`]) — so is that of a part
 //! transform kept for a whole mesh (an iris) when it also turns pieces cut out of a mesh that
 //! goes back elsewhere (a highlight cut from a primitive whose occlusion shell is skin) —, within 1 % of the part's
-//! size at every FAP value the table covers. The face returned has exactly the target's
+//! size at every FAP value the table covers. A cut mesh goes back under a transform above
+//! every piece's (both eye whites of one primitive: not the left eye's transform, which an
+//! iris mesh of its own keeps). The face returned has exactly the target's
 //! meshes, vertices and polygons; its transforms are the target's plus those that still hold
 //! a mesh (a created root `head`).
 
@@ -107,12 +109,30 @@ pub(super) fn fold_into_target(
         let band = (report.mouth_interior > 0)
             .then(|| CutBand::new(target, target_mesh, &multiplicity))
             .flatten();
+        // A rest that is one part while other pieces are another part's (both eye whites in
+        // one primitive, an iris mesh of its own keeping the left eye's transform): the mesh
+        // goes back whole, so it cannot sit in that part's transform; its home is above it
+        // and every piece is baked.
+        let chains: Vec<Vec<usize>> = meshes
+            .iter()
+            .skip(1)
+            .map(|m| hierarchy_ancestors(cloned, cloned.meshes[m.index].transform))
+            .collect();
+        let mut home_t = home(cloned, rest, &baked);
+        let mut steps = 0;
+        while let Some(t) = home_t.filter(|&t| chains.iter().any(|c| !c.contains(&t))) {
+            steps += 1;
+            if cut.rest.is_none() || steps > cloned.transforms.len() {
+                break;
+            }
+            home_t = cloned.transforms[t].parent;
+        }
         cuts.push(CutMeshes {
             target: target_mesh,
             name: &cut.mesh,
             meshes,
             multiplicity,
-            home: home(cloned, rest, &baked),
+            home: home_t,
             band,
         });
     }
@@ -127,7 +147,7 @@ pub(super) fn fold_into_target(
         let gone = hierarchy_ancestors(cloned, Some(t))
             .iter()
             .any(|&a| baked.contains(&cloned.transforms[a].name));
-        let away = cut.meshes.first().is_some_and(|r| r.index != m.index) && cut.home != Some(t);
+        let away = cut.home != Some(t);
         (gone || away).then_some(t)
     };
     // Transforms whose motion such a part takes apart from its cut mesh's home: a table
@@ -278,7 +298,8 @@ pub(super) fn fold_into_target(
         report.warnings.append(&mut warnings);
         fat.tables.extend(table);
     }
-    let face = layout_face(cloned, target, &baked, fat);
+    let homes: HashMap<&str, Option<usize>> = cuts.iter().map(|c| (c.name, c.home)).collect();
+    let face = layout_face(cloned, target, &baked, &homes, fat);
     correct_report(report, &baked);
     Ok(face)
 }
@@ -725,11 +746,13 @@ fn merge_entries(mut entries: Vec<FaceDefMesh>, multiplicity: &[u8]) -> Option<F
 }
 
 /// The target's meshes (vertices, polygons, attributes as the user gave them) under the
-/// cloned view's transforms, minus the baked ones, with `fat`.
+/// cloned view's transforms, minus the baked ones, with `fat`; a cut mesh under its home
+/// (`homes`, by name).
 fn layout_face(
     cloned: &FaceModel,
     target: &FaceModel,
     baked: &BTreeSet<String>,
+    homes: &HashMap<&str, Option<usize>>,
     fat: Fat,
 ) -> FaceModel {
     let mut face = cloned.clone();
@@ -751,7 +774,11 @@ fn layout_face(
         .map(|m| {
             let mut out = m.clone();
             if let Some(c) = cloned.mesh_index(&m.name) {
-                out.transform = home(cloned, c, baked).and_then(|t| new_index.get(&t).copied());
+                let at = match homes.get(m.name.as_str()) {
+                    Some(&h) => h,
+                    None => home(cloned, c, baked),
+                };
+                out.transform = at.and_then(|t| new_index.get(&t).copied());
                 if cloned.meshes[c].mesh.positions.len() == m.mesh.positions.len() {
                     // Same mesh (not cut): positions as the clone left them (a part moved
                     // under a new transform is re-expressed in its frame).
