@@ -51,6 +51,13 @@ fn clone_writes_a_face_and_reports() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
+    // It says how to make the missing file.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("head.obj: an OBJ face needs its feature points")
+            && err.contains("fbakit fp from-landmarks"),
+        "{err}"
+    );
     // A face without any feature points: exit 2 saying what to give, nothing written.
     let bare = dir.path().join("bare.wrl");
     let mut none = fbakit::synth::bruno().to_face_model();

@@ -226,7 +226,9 @@ pub struct SelfCloneArgs {
 fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
     if fp.is_none() && FaceFormat::of_extension(path) == Some(FaceFormat::Obj) {
         return Err(Error::Usage(format!(
-            "{}: an OBJ face needs its feature points (--fp-source / --fp-target / --fp FILE)",
+            "{}: an OBJ face needs its feature points (--fp-source / --fp-target / --fp FILE: \
+             CSV `fp,x,y,z` or vertex ids, or the XML; `fbakit fp from-landmarks` makes one from \
+             iBUG-68 or MediaPipe-468 landmarks)",
             path.display()
         )));
     }
