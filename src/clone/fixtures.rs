@@ -11,7 +11,19 @@ use glam::Vec3;
 
 use super::{CloneSurface, SurfaceMotion};
 use crate::fat::TableKey;
-use crate::fdp::Fapu;
+use crate::fdp::{Fapu, FapuDistances};
+
+/// FAP units whose every distance is 1: synthetic test surfaces measured in them directly.
+pub fn unit_fapu() -> Fapu {
+    let d = FapuDistances {
+        irisd0: 1.0,
+        es0: 1.0,
+        ens0: 1.0,
+        mns0: 1.0,
+        mw0: 1.0,
+    };
+    Fapu::from_distances(d).expect("unit distances are valid FAP units")
+}
 
 /// The shared Candide-3 folder, or `None` (callers then skip).
 pub fn candide_dir() -> Option<PathBuf> {

@@ -298,14 +298,6 @@ mod tests {
     /// A lid of three vertices resting just outside a unit eyeball at the origin (left eye),
     /// and a far vertex.
     fn lid() -> CloneSurface {
-        use crate::fdp::{Fapu, FapuDistances};
-        let d = FapuDistances {
-            irisd0: 1.0,
-            es0: 1.0,
-            ens0: 1.0,
-            mns0: 1.0,
-            mw0: 1.0,
-        };
         CloneSurface {
             positions: vec![
                 Vec3::new(0.0, 1.05, 0.2),
@@ -316,7 +308,7 @@ mod tests {
             triangles: vec![[0, 1, 2]],
             fp_vertices: Default::default(),
             fp_positions: Default::default(),
-            fapu: Fapu::from_distances(d).unwrap(),
+            fapu: crate::clone::fixtures::unit_fapu(),
         }
     }
 

@@ -15,17 +15,14 @@
 //! lashes reach past the eyeball and the eyeball itself wraps round behind its centre, so
 //! none of these is one.
 
-use std::collections::BTreeMap;
-
 use glam::Vec3;
 
 use super::eyeball::eyeballs;
 use super::parts::face_diagonal;
-use super::split::{ball_under, LidSurface, LID_CLEARANCE};
+use super::split::{ball_under, open_edge_vertices, LidSurface, LID_CLEARANCE};
 use super::Part;
 use crate::face::FaceModel;
 use crate::mesh::components::connected_components;
-use crate::mesh::Mesh;
 use crate::spec::FeaturePointId;
 
 /// Vertices of one mesh that belong to eye layers resting on the lids.
@@ -102,7 +99,7 @@ pub fn lid_resting_layers(face: &FaceModel) -> Vec<LidRestingLayer> {
             return Vec::new();
         };
         let mut resting = vec![false; count];
-        for v in open_border(&m.mesh) {
+        for v in open_edge_vertices(&m.mesh, |v| v) {
             let (Some(&k), Some(&q)) = (piece.get(v as usize), world.get(v as usize)) else {
                 continue;
             };
@@ -120,28 +117,6 @@ pub fn lid_resting_layers(face: &FaceModel) -> Vec<LidRestingLayer> {
             out.push(LidRestingLayer { mesh: mi, vertices });
         }
     }
-    out
-}
-
-/// Vertices on an edge of one polygon only, by vertex index (a layer glued to the lids by
-/// coincident vertices keeps its border).
-fn open_border(mesh: &Mesh) -> Vec<u32> {
-    let mut edges: BTreeMap<(u32, u32), usize> = BTreeMap::new();
-    for poly in mesh.polygons.iter() {
-        for (i, &a) in poly.iter().enumerate() {
-            let b = poly[(i + 1) % poly.len()];
-            if a != b {
-                *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-            }
-        }
-    }
-    let mut out: Vec<u32> = edges
-        .into_iter()
-        .filter(|&(_, n)| n == 1)
-        .flat_map(|((a, b), _)| [a, b])
-        .collect();
-    out.sort_unstable();
-    out.dedup();
     out
 }
 

@@ -79,6 +79,15 @@ pub(super) fn rough(positions: &[Vec3], d: &[Vec3], t: &[u32; 3], n0: Vec3, cos_
     rough_at(positions, d, 1.0, t, n0, cos_tau)
 }
 
+/// The cosine of triangle `t`'s turn from its neutral unit normal `n0` under `share` of the
+/// displacements `d`; `None` when it collapses (a fold, [`max_normal_turn`]).
+fn posed_cos(positions: &[Vec3], d: &[Vec3], share: f32, t: &[u32; 3], n0: Vec3) -> Option<f32> {
+    let p = |k: usize| positions[t[k] as usize] + share * d[t[k] as usize];
+    let n1 = (p(1) - p(0)).cross(p(2) - p(0));
+    let l = n1.length();
+    (l.is_finite() && l > 0.0).then(|| n0.dot(n1) / l)
+}
+
 /// [`rough`] under `share` of the displacements `d`.
 fn rough_at(
     positions: &[Vec3],
@@ -91,14 +100,7 @@ fn rough_at(
     if n0 == Vec3::ZERO {
         return false;
     }
-    let p = |k: usize| positions[t[k] as usize] + share * d[t[k] as usize];
-    let n1 = (p(1) - p(0)).cross(p(2) - p(0));
-    let l = n1.length();
-    // A collapsed triangle is a fold ([`max_normal_turn`]).
-    if !(l.is_finite() && l > 0.0) {
-        return true;
-    }
-    n0.dot(n1) / l < cos_tau
+    posed_cos(positions, d, share, t, n0).is_none_or(|c| c < cos_tau)
 }
 
 /// The turn of triangle `t` (neutral unit normal `n0`) under `share` of the displacements
@@ -114,14 +116,8 @@ fn turn_ratio(
     if n0 == Vec3::ZERO {
         return 0.0;
     }
-    let p = |k: usize| positions[t[k] as usize] + share * d[t[k] as usize];
-    let n1 = (p(1) - p(0)).cross(p(2) - p(0));
-    let l = n1.length();
-    let angle = if l.is_finite() && l > 0.0 {
-        (n0.dot(n1) / l).clamp(-1.0, 1.0).acos()
-    } else {
-        std::f32::consts::PI
-    };
+    let angle = posed_cos(positions, d, share, t, n0)
+        .map_or(std::f32::consts::PI, |c| c.clamp(-1.0, 1.0).acos());
     angle / cos_tau.clamp(-1.0, 1.0).acos().max(1e-6)
 }
 
@@ -494,7 +490,6 @@ pub(super) fn smooth_motions(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fdp::{Fapu, FapuDistances};
 
     /// A flat grid of `k × k` vertices (spacing 1) in the xy plane.
     fn grid(k: u32) -> CloneSurface {
@@ -505,19 +500,12 @@ mod tests {
             }
         }
         let triangles = crate::clone::fixtures::grid_triangles(k);
-        let d = FapuDistances {
-            irisd0: 1.0,
-            es0: 1.0,
-            ens0: 1.0,
-            mns0: 1.0,
-            mw0: 1.0,
-        };
         CloneSurface {
             positions,
             triangles,
             fp_vertices: Default::default(),
             fp_positions: Default::default(),
-            fapu: Fapu::from_distances(d).unwrap(),
+            fapu: crate::clone::fixtures::unit_fapu(),
         }
     }
 

@@ -927,7 +927,13 @@ impl LidSurface {
 /// so a UV seam is no rim): empty for closed shells.
 fn rim_vertices(mesh: &Mesh, eps: f32) -> Vec<u32> {
     let rep = find_coincident_vertices(&mesh.positions, eps).representative;
-    let r = |v: u32| rep.get(v as usize).copied().unwrap_or(v);
+    open_edge_vertices(mesh, |v: u32| rep.get(v as usize).copied().unwrap_or(v))
+}
+
+/// Vertices on an edge that one polygon alone uses, vertices being the same when `r` maps
+/// them to the same representative (identity: by index, so a layer glued to the skin by
+/// coincident vertices keeps its border), ascending.
+pub(super) fn open_edge_vertices(mesh: &Mesh, r: impl Fn(u32) -> u32) -> Vec<u32> {
     // Every edge end to end as (joined key, corners), sorted by key: an edge alone in its
     // run is open (a map of the edges cost a one-mesh head's cut 10 ms).
     let mut edges: Vec<(u64, [u32; 2])> = Vec::with_capacity(mesh.polygons.indices().len());

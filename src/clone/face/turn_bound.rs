@@ -576,23 +576,15 @@ mod tests {
     use super::*;
     use crate::clone::quality::max_normal_turn;
     use crate::fat::TableKey;
-    use crate::fdp::{Fapu, FapuDistances};
     use crate::spec::FapId;
 
     fn surface(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> CloneSurface {
-        let d = FapuDistances {
-            irisd0: 1.0,
-            es0: 1.0,
-            ens0: 1.0,
-            mns0: 1.0,
-            mw0: 1.0,
-        };
         CloneSurface {
             positions,
             triangles,
             fp_vertices: Default::default(),
             fp_positions: Default::default(),
-            fapu: Fapu::from_distances(d).unwrap(),
+            fapu: crate::clone::fixtures::unit_fapu(),
         }
     }
 
