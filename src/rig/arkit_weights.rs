@@ -31,6 +31,13 @@
 //! (an ARKit shape a rig splits in halves, ICT's `browInnerUp_L` + `_R`, is one unknown
 //! playing both).
 //!
+//! A low-level FAP the bridge has a side for moves the points by that side's motion scaled
+//! linearly, `(x / V_k) a_k`, not by the FAT played at `x`: the shapes are linear, and a FAT
+//! whose side has several intervals (alma's `open_jaw` moves most of the jaw 0.32×, not 0.5×,
+//! at half its calibrated value) would otherwise be read as other shapes (half an open jaw came
+//! back as `jawOpen` 0.42 with `jawForward` 0.70 and `mouthFunnel` 1). So a FAP value maps to
+//! the same weight both ways; visemes, expressions and FAPs without a side are played on the FAT.
+//!
 //! **Rotations.** Head and eye rotation columns ([`super::capture::ROTATIONS`]) are not
 //! fitted: they set FAPs 48–50 and 23–26 directly (replacing what the fit gave the eyeball
 //! FAPs). The other way, head rotation FAPs are left out of the posed frames (rigid motion
@@ -495,6 +502,25 @@ impl<'a> ArkitBridge<'a> {
                     unplayable.push(a.key);
                 }
             }
+            // Calibrated sides move linearly (module docs).
+            let mut linear = vec![0.0; neutral.len()];
+            let (sides, columns) = (&self.sides, &self.side_columns);
+            acts.retain(|a| {
+                let TableKey::LowLevel(f) = a.key else {
+                    return true;
+                };
+                let side = sides.iter().position(|s| {
+                    s.fap == f && a.value != 0.0 && (s.value > 0.0) == (a.value > 0.0)
+                });
+                let Some(k) = side else {
+                    return true;
+                };
+                let t = a.value / sides[k].value;
+                for (l, c) in linear.iter_mut().zip(&columns[k]) {
+                    *l += t * c;
+                }
+                false
+            });
             let moved = probe_positions(
                 face,
                 &self.probes,
@@ -503,7 +529,11 @@ impl<'a> ArkitBridge<'a> {
                 &mut self.pose,
                 &acts,
             );
-            let (w, r, nn) = self.fit_weights(&diff(&moved, &neutral));
+            let mut d = diff(&moved, &neutral);
+            for (di, l) in d.iter_mut().zip(&linear) {
+                *di += l;
+            }
+            let (w, r, nn) = self.fit_weights(&d);
             res += r;
             norm += nn;
             frames.push(w);
