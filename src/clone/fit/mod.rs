@@ -371,9 +371,10 @@ impl SurfaceLabels {
 /// bundled ICT head: the symbolic analysis, the source's labels and its skin surface were
 /// ~10–15 ms on the registration's path).
 pub(crate) struct SourcePrep {
-    /// The surface's vertex count and the membrane weight the system was built for: a
-    /// preparation for another surface or weight is not used.
-    vertices: usize,
+    /// The surface (its positions and triangles) and the membrane weight the system was
+    /// built for: a preparation for another surface or weight is not used.
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
     membrane: f64,
     labels: SurfaceLabels,
     system: Result<SmoothSystem>,
@@ -387,11 +388,19 @@ impl SourcePrep {
         let labels = SurfaceLabels::of(source);
         let system = SmoothSystem::new(&labels.adj, opts.membrane);
         Some(SourcePrep {
-            vertices: source.positions.len(),
+            positions: source.positions.clone(),
+            triangles: source.triangles.clone(),
             membrane: opts.membrane,
             labels,
             system,
         })
+    }
+
+    /// Whether this is the preparation of `source` for a clone with `opts`.
+    fn fits(&self, source: &CloneSurface, opts: &FitOptions) -> bool {
+        self.positions == source.positions
+            && self.triangles == source.triangles
+            && self.membrane == opts.membrane
     }
 }
 
@@ -413,9 +422,7 @@ fn register_and_correspond(
 )> {
     // 1. Sides.
     let clock = Instant::now();
-    let (s_labels, system) = match prep
-        .filter(|p| p.vertices == source.positions.len() && p.membrane == opts.membrane)
-    {
+    let (s_labels, system) = match prep.filter(|p| p.fits(source, opts)) {
         Some(p) => (Some(p.labels), Some(p.system)),
         None => (None, None),
     };
