@@ -270,7 +270,7 @@ pub use rigid::install_center;
 pub use skin_surface::{build_skin_surface, build_skin_surface_like, SkinSurface};
 pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 
-use super::fit::clone_fit;
+use super::fit::{clone_fit, clone_fit_prepared, SourcePrep};
 use super::fmc::clone_fmc;
 use super::rbf::clone_rbf;
 use super::{CloneError, CloneSurface, SurfaceCloneResult, SurfaceMotion};
@@ -332,11 +332,25 @@ pub fn clone_face(
     let whole = opts.method == Method::Fit
         && opts.fit.shared_topology
         && one_mesh_with(source, &sparts, &bare);
-    let view = if whole {
-        None
-    } else {
-        split::split_view(&bare)
-    };
+    // The cut is serial: the source's skin surface, and what `fit` reads of it alone, are
+    // built beside it (errors reported in their own step, 3).
+    let (view, (ssurf, fit_prep)) = rayon::join(
+        || {
+            if whole {
+                None
+            } else {
+                split::split_view(&bare)
+            }
+        },
+        || {
+            let ssurf = build_skin_surface(source, &sparts.skin, &Similarity::IDENTITY);
+            let prep = match (&ssurf, opts.method) {
+                (Ok(s), Method::Fit) if !whole => SourcePrep::new(&s.surface, &opts.fit),
+                _ => None,
+            };
+            (ssurf, prep)
+        },
+    );
     let (split_target, split) = match &view {
         Some(v) => (v.face.clone(), v.parts.clone()),
         None => (bare.clone(), Vec::new()),
@@ -369,7 +383,7 @@ pub fn clone_face(
     report.timings.push("align", clock.elapsed().as_secs_f64());
     // 3. Surfaces.
     let clock = Instant::now();
-    let ssurf = build_skin_surface(source, &sparts.skin, &Similarity::IDENTITY)?;
+    let ssurf = ssurf?;
     let tsurf = build_skin_surface_like(target, &tparts.skin, &alignment, Some(&ssurf))?;
     report.surface_vertices = [ssurf.surface.positions.len(), tsurf.surface.positions.len()];
     report
@@ -385,7 +399,7 @@ pub fn clone_face(
         .push("motions", clock.elapsed().as_secs_f64());
     // 5, 6. Surface method and FAPU rescale.
     let (mut cloned_motions, [tmargins, smargins]) = clone_skin_motions(
-        &ssurf,
+        (&ssurf, fit_prep),
         &tsurf,
         &motions,
         [(source, &sparts), (target, &tparts)],
@@ -540,7 +554,7 @@ pub fn clone_face(
 /// `alignment`'s rotation). Returns one cloned motion per moving source motion, and the lid
 /// margins of the target's and the source's skin (found while the surface method runs).
 fn clone_skin_motions(
-    ssurf: &SkinSurface,
+    (ssurf, fit_prep): (&SkinSurface, Option<SourcePrep>),
     tsurf: &SkinSurface,
     motions: &[SurfaceMotion],
     [(source, sparts), (target, tparts)]: [(&FaceModel, &FaceParts); 2],
@@ -558,7 +572,16 @@ fn clone_skin_motions(
     // margins found once for all of them) is built while the surface method runs: its
     // sequential steps (`fit`'s factorisations) leave a core free.
     let (result, ((topology, margins), interior)) = rayon::join(
-        || clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts),
+        || match (opts.method, fit_prep) {
+            (Method::Fit, Some(prep)) => clone_fit_prepared(
+                &ssurf.surface,
+                &moving,
+                &tsurf.surface,
+                &opts.fit,
+                Some(prep),
+            ),
+            _ => clone_surface(opts.method, &ssurf.surface, &moving, &tsurf.surface, opts),
+        },
         || {
             rayon::join(
                 || {

@@ -92,6 +92,7 @@ pub(crate) use correspond::Correspondence;
 use regions::{classify, face_pieces, triangle_masks};
 use register::{register, Moving};
 use surface::{adjacency, QuerySurface};
+use system::SmoothSystem;
 
 /// Settings of [`clone_fit`].
 #[derive(Clone, Debug, PartialEq)]
@@ -244,15 +245,28 @@ pub fn clone_fit(
     target: &CloneSurface,
     opts: &FitOptions,
 ) -> Result<SurfaceCloneResult> {
+    clone_fit_prepared(source, motions, target, opts, None)
+}
+
+/// [`clone_fit`] with what it reads of the source alone built ahead ([`SourcePrep`]; `None`:
+/// built here). The same result bit for bit.
+pub(crate) fn clone_fit_prepared(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    target: &CloneSurface,
+    opts: &FitOptions,
+    prep: Option<SourcePrep>,
+) -> Result<SurfaceCloneResult> {
     source.check("source")?;
     target.check("target")?;
     let mut timings = StepTimings::default();
     let mut stats = BTreeMap::new();
     let mut warnings: Vec<String> = Vec::new();
-    let (corr, rotations) = correspondences(
+    let (corr, rotations) = prepared_correspondences(
         source,
         target,
         opts,
+        prep,
         &mut timings,
         &mut stats,
         &mut warnings,
@@ -291,6 +305,20 @@ pub(crate) fn correspondences(
     stats: &mut BTreeMap<String, f64>,
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<Option<Correspondence>>, Option<Vec<glam::Mat3>>)> {
+    prepared_correspondences(source, target, opts, None, timings, stats, warnings)
+}
+
+/// [`correspondences`] with the source's [`SourcePrep`] built ahead (or `None`).
+#[allow(clippy::type_complexity)]
+fn prepared_correspondences(
+    source: &CloneSurface,
+    target: &CloneSurface,
+    opts: &FitOptions,
+    prep: Option<SourcePrep>,
+    timings: &mut StepTimings,
+    stats: &mut BTreeMap<String, f64>,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<Option<Correspondence>>, Option<Vec<glam::Mat3>>)> {
     if opts.shared_topology && same_topology(source, target) {
         let clock = Instant::now();
         let corr = (0..target.positions.len() as u32)
@@ -306,7 +334,73 @@ pub(crate) fn correspondences(
         timings.push("correspond", clock.elapsed().as_secs_f64());
         Ok((corr, None))
     } else {
-        register_and_correspond(source, target, opts, timings, stats, warnings)
+        register_and_correspond(source, target, opts, prep, timings, stats, warnings)
+    }
+}
+
+/// What `fit` reads of one surface alone: its vertex adjacency, slit sides (and how many of
+/// the three slits were found), face pieces and mouth interior (socket extent; empty
+/// without one).
+struct SurfaceLabels {
+    adj: Vec<Vec<u32>>,
+    sides: Vec<regions::Side>,
+    slits: usize,
+    face: Vec<bool>,
+    inside: Vec<bool>,
+}
+
+impl SurfaceLabels {
+    fn of(s: &CloneSurface) -> Self {
+        let adj = adjacency(s.positions.len(), &s.triangles);
+        let (sides, slits) = classify(s, &adj);
+        let inside = MouthInterior::of(s, &adj, Extent::SOCKET).map_or_else(Vec::new, |m| m.inside);
+        SurfaceLabels {
+            face: face_pieces(s),
+            adj,
+            sides,
+            slits,
+            inside,
+        }
+    }
+}
+
+/// What `fit` reads of the source surface alone: its labels and its smoothness system (the
+/// symbolic analysis of the registration's matrix). The whole-face pipeline builds it while
+/// its serial cut of the target leaves a core free (`clone::face`, step 1); the clone is the
+/// same bit for bit as with everything built in [`clone_fit`] (dense CANDIDE-3 onto the
+/// bundled ICT head: the symbolic analysis, the source's labels and its skin surface were
+/// ~10–15 ms on the registration's path).
+pub(crate) struct SourcePrep {
+    /// The surface (its positions and triangles) and the membrane weight the system was
+    /// built for: a preparation for another surface or weight is not used.
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    membrane: f64,
+    labels: SurfaceLabels,
+    system: Result<SmoothSystem>,
+}
+
+impl SourcePrep {
+    /// The preparation of `source` for a clone with `opts`; `None` when the surface fails
+    /// [`CloneSurface::check`] (the clone reports that itself).
+    pub(crate) fn new(source: &CloneSurface, opts: &FitOptions) -> Option<Self> {
+        source.check("source").ok()?;
+        let labels = SurfaceLabels::of(source);
+        let system = SmoothSystem::new(&labels.adj, opts.membrane);
+        Some(SourcePrep {
+            positions: source.positions.clone(),
+            triangles: source.triangles.clone(),
+            membrane: opts.membrane,
+            labels,
+            system,
+        })
+    }
+
+    /// Whether this is the preparation of `source` for a clone with `opts`.
+    fn fits(&self, source: &CloneSurface, opts: &FitOptions) -> bool {
+        self.positions == source.positions
+            && self.triangles == source.triangles
+            && self.membrane == opts.membrane
     }
 }
 
@@ -318,6 +412,7 @@ fn register_and_correspond(
     source: &CloneSurface,
     target: &CloneSurface,
     opts: &FitOptions,
+    prep: Option<SourcePrep>,
     timings: &mut StepTimings,
     stats: &mut BTreeMap<String, f64>,
     warnings: &mut Vec<String>,
@@ -327,21 +422,34 @@ fn register_and_correspond(
 )> {
     // 1. Sides.
     let clock = Instant::now();
-    // The two surfaces' labels are independent: one core each.
-    let labels = |s: &CloneSurface| {
-        let adj = adjacency(s.positions.len(), &s.triangles);
-        let (sides, slits) = classify(s, &adj);
-        let inside = MouthInterior::of(s, &adj, Extent::SOCKET).map_or_else(Vec::new, |m| m.inside);
-        ((adj, sides, slits, face_pieces(s)), inside)
+    let (s_labels, system) = match prep.filter(|p| p.fits(source, opts)) {
+        Some(p) => (Some(p.labels), Some(p.system)),
+        None => (None, None),
     };
+    // The two surfaces' labels are independent: one core each.
     let (
-        ((adj, s_sides, s_slits, s_face), s_inside),
-        (((_, t_sides, t_slits, t_face), t_inside), loose),
+        SurfaceLabels {
+            adj,
+            sides: s_sides,
+            slits: s_slits,
+            face: s_face,
+            inside: s_inside,
+        },
+        (
+            SurfaceLabels {
+                sides: t_sides,
+                slits: t_slits,
+                face: t_face,
+                inside: t_inside,
+                ..
+            },
+            loose,
+        ),
     ) = rayon::join(
-        || labels(source),
+        || s_labels.unwrap_or_else(|| SurfaceLabels::of(source)),
         || {
-            let t = labels(target);
-            let loose = loose_duplicates(target, &(t.0).1);
+            let t = SurfaceLabels::of(target);
+            let loose = loose_duplicates(target, &t.sides);
             (t, loose)
         },
     );
@@ -435,6 +543,7 @@ fn register_and_correspond(
             landmark_weight: beta,
             ..opts.clone()
         },
+        system,
     )?;
     stats.insert("fit_solves".into(), reg.solves as f64);
     stats.insert("fit_matched".into(), reg.matched);

@@ -85,12 +85,14 @@ pub(crate) struct Registered {
 }
 
 /// Registers `m` onto the surface `fixed` builds (module docs). The fixed surface is built
-/// while the smoothness system is analysed and the landmark-only step solved, which need
-/// only the moving surface.
+/// while the smoothness system is analysed (unless `system` holds it, analysed ahead for
+/// `m.adjacency` and `opts.membrane`) and the landmark-only step solved, which need only
+/// the moving surface.
 pub(crate) fn register(
     m: &Moving,
     fixed: impl FnOnce() -> QuerySurface + Send,
     opts: &FitOptions,
+    system: Option<Result<SmoothSystem>>,
 ) -> Result<Registered> {
     let n = m.positions.len();
     let p: Vec<DVec3> = m.positions.iter().map(|v| v.as_dvec3()).collect();
@@ -121,7 +123,10 @@ pub(crate) fn register(
     };
     let stiff = opts.stiffness.first().copied().unwrap_or(1.0);
     let start = || -> Result<(SmoothSystem, Vec<DVec3>, usize)> {
-        let mut system = SmoothSystem::new(m.adjacency, opts.membrane)?;
+        let mut system = match system {
+            Some(s) => s?,
+            None => SmoothSystem::new(m.adjacency, opts.membrane)?,
+        };
         let mut u = vec![DVec3::ZERO; n];
         if m.landmarks.is_empty() {
             return Ok((system, u, 0));

@@ -247,3 +247,56 @@ fn bad_targets_warn_and_stay_finite() {
     empty.triangles.clear();
     assert!(clone_fit(s, &src.motions, &empty, &FitOptions::default()).is_err());
 }
+
+#[test]
+fn a_source_prepared_ahead_clones_the_same_bits() {
+    let (s, t) = (grid_face(31, 0.1), grid_face(45, 0.25));
+    let key = crate::fat::TableKey::LowLevel(crate::spec::FapId::new(19).unwrap());
+    let m = SurfaceMotion {
+        key,
+        value: 512.0,
+        offsets: s
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(v, &p)| (v as u32, Vec3::new(0.02 * p.x, -0.05 * p.y * p.y, 0.01)))
+            .collect(),
+    };
+    let motions = [m];
+    let opts = FitOptions::default();
+    let bits = |r: SurfaceCloneResult| -> Vec<(u32, [u32; 3])> {
+        r.motions
+            .iter()
+            .flat_map(|m| m.offsets.iter())
+            .map(|&(v, d)| (v, d.to_array().map(f32::to_bits)))
+            .collect()
+    };
+    let plain = bits(clone_fit(&s, &motions, &t, &opts).unwrap());
+    assert!(!plain.is_empty());
+    let run = |prep: Option<SourcePrep>| {
+        assert!(prep.is_some());
+        bits(clone_fit_prepared(&s, &motions, &t, &opts, prep).unwrap())
+    };
+    let prep = SourcePrep::new(&s, &opts).unwrap();
+    assert!(prep.fits(&s, &opts));
+    assert_eq!(run(Some(prep)), plain);
+    // A preparation for another membrane weight or another surface is not used.
+    let stiff = FitOptions {
+        membrane: 1.0,
+        ..opts.clone()
+    };
+    let other = bits(clone_fit(&s, &motions, &t, &stiff).unwrap());
+    assert_ne!(other, plain, "the membrane weight changes the clone");
+    let reshaped = grid_face(31, 0.3);
+    for (prep, what) in [
+        (SourcePrep::new(&s, &stiff), "another membrane weight"),
+        (SourcePrep::new(&t, &opts), "another surface"),
+        (
+            SourcePrep::new(&reshaped, &opts),
+            "the same triangles elsewhere",
+        ),
+    ] {
+        assert!(!prep.as_ref().unwrap().fits(&s, &opts), "{what}");
+        assert_eq!(run(prep), plain, "{what}");
+    }
+}
