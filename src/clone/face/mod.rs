@@ -195,13 +195,13 @@
 //!    for bidirectional FAPs) and left out of the face. The output has exactly the target's
 //!    meshes with every vertex, polygon and attribute in its order.
 //! 10. **`turns`** — eyeball (23–26) and head (48–50) FAPs the source's FAT has no table for
-//!    become the standard's rotations on the target ([`standard`]): about each eye white's
-//!    centre and about 7.1 (derived where missing), on the target's eye and head transforms
-//!    where it has them, else as per-vertex tables (the head's faded down the neck). A
-//!    source's own eye and head turns given as vertex motion (a rig's) are re-made this way
-//!    too, about the target's centres; given as transform rotations they map in step 7. The
-//!    target's `head` transform is created in step 7 only when the source's head motion
-//!    drives it.
+//!     become the standard's rotations on the target ([`standard`]): about each eye white's
+//!     centre and about 7.1 (derived where missing), on the target's eye and head transforms
+//!     where it has them, else as per-vertex tables (the head's faded down the neck). A
+//!     source's own eye and head turns given as vertex motion (a rig's) are re-made this way
+//!     too, about the target's centres; given as transform rotations they map in step 7. The
+//!     target's `head` transform is created in step 7 only when the source's head motion
+//!     drives it.
 //!
 //! Rotations from the FAT are taken as composed after the neutral rotation (`R₀·ΔR`), so their
 //! axes live in the transform's own rotated frame.
