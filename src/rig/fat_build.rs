@@ -21,6 +21,11 @@
 //! and `V` is that angle about the FAP's axis in AU. Linear vertex motion approximates the
 //! rotation well for the shapes' own range (a few tens of degrees).
 //!
+//! **Eye and head turns the shapes lack.** Eyeball (23–26) and head (48–50) FAPs no shape
+//! realises get the standard's rotation tables about the face's own eyeball centres and neck
+//! pivot ([`crate::clone::face::standard`]), so a rig without `eyeLook*` shapes or head joints
+//! (the bundled `ict`) still turns its eyes and head.
+//!
 //! **Visemes and expressions** come from named rig shapes when the map finds them (VRM `aa`,
 //! Oculus `viseme_aa`, `happy`), at full strength 63; otherwise from the low-level FAT just built,
 //! evaluated at the FAP vectors of [`crate::synth::viseme_faps`] / [`crate::synth::expression_faps`].
@@ -101,6 +106,10 @@ pub struct RigFatReport {
     pub unmapped: Vec<Unmapped>,
     /// Rig shapes no table uses.
     pub unused_shapes: Vec<String>,
+    /// The standard's eyeball and head rotation tables added where the shapes gave none
+    /// ([`crate::clone::face::standard`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standard_rotations: Option<crate::clone::face::standard::StandardRotations>,
     /// Feature points given by position, snapped to their nearest vertex.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub fp_matches: Vec<crate::face::vrml::FeaturePointMatch>,
@@ -408,6 +417,19 @@ pub fn face_from_rig(
         });
     }
     face.fat.tables.extend(high);
+    // 5. Eye and head turns the shapes did not give: the standard's rotations about the
+    // face's own eyeball centres and neck (they need the feature points, as calibration does).
+    if fapu.is_some() {
+        let added = crate::clone::face::standard::add_standard_rotations(&mut face);
+        let names: Vec<String> = added.added.iter().map(|k| k.name()).collect();
+        report.unmapped.retain(|u| {
+            let key = u.key.split(" (").next().unwrap_or(&u.key);
+            !names.iter().any(|n| n == key)
+        });
+        if !added.added.is_empty() {
+            report.standard_rotations = Some(added);
+        }
+    }
     report.unused_shapes = rig
         .shapes
         .iter()

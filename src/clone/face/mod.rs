@@ -194,6 +194,14 @@
 //!    within 1 % of the part's size at every FAP value the source's table covers, both signs
 //!    for bidirectional FAPs) and left out of the face. The output has exactly the target's
 //!    meshes with every vertex, polygon and attribute in its order.
+//! 10. **`turns`** — eyeball (23–26) and head (48–50) FAPs the source's FAT has no table for
+//!     become the standard's rotations on the target ([`standard`]): about each eye white's
+//!     centre and about 7.1 (derived where missing), on the target's eye and head transforms
+//!     where it has them, else as per-vertex tables (the head's faded down the neck). A
+//!     source's own eye and head turns given as vertex motion (a rig's) are re-made this way
+//!     too, about the target's centres; given as transform rotations they map in step 7. The
+//!     target's `head` transform is created in step 7 only when the source's head motion
+//!     drives it.
 //!
 //! Rotations from the FAT are taken as composed after the neutral rotation (`R₀·ΔR`), so their
 //! axes live in the transform's own rotated frame.
@@ -267,6 +275,7 @@ pub use parts::{identify_parts, FaceParts, Part};
 pub use report::{CloneOutcome, CloneReport, RigidReport};
 pub use rescale::{FapFailure, FapRepair};
 pub use rigid::install_center;
+pub use rigid::standard;
 pub use skin_surface::{build_skin_surface, build_skin_surface_like, SkinSurface};
 pub use split::{mesh_pieces, split_embedded_parts, SplitPart};
 
@@ -322,6 +331,25 @@ pub fn clone_face(
         }
         .into());
     }
+    // Eye and head turns a source moves as vertex motion (a rig's, the bundled `ict`'s) are
+    // rotations by definition: the target gets them about its own centres (`standard`) rather
+    // than through the skin's surface method, which cannot carry a rigid turn of its parts.
+    let own_turns;
+    let source = if source
+        .fat
+        .tables
+        .iter()
+        .any(|t| standard::is_standard_rotation(t.key) && t.transforms.is_empty())
+    {
+        let mut s = source.clone();
+        s.fat
+            .tables
+            .retain(|t| !standard::is_standard_rotation(t.key) || !t.transforms.is_empty());
+        own_turns = s;
+        &own_turns
+    } else {
+        source
+    };
     // 1. Parts (a one-mesh target first has its eyes, teeth and gums cut into part meshes).
     let clock = Instant::now();
     // The target's own FAT is replaced anyway; without it its skin mesh can be cut.
@@ -543,6 +571,10 @@ pub fn clone_face(
     face.fat
         .tables
         .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
+    // Eye and head turns the source does not give (module docs, step 10).
+    let clock = Instant::now();
+    report.standard_rotations = standard::add_standard_rotations(&mut face);
+    report.timings.push("turns", clock.elapsed().as_secs_f64());
     report.tables = face.fat.tables.len();
     report.source_parts = sparts;
     report.target_parts = tparts;

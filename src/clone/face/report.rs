@@ -68,6 +68,9 @@ pub struct CloneReport {
     pub rigid: RigidReport,
     /// Part meshes cut out of a one-mesh target (step 1).
     pub split_parts: Vec<SplitPart>,
+    /// The standard's eyeball and head rotation tables the target got where the source had
+    /// none (or had them as vertex motion, which is re-made about the target's own centres).
+    pub standard_rotations: super::standard::StandardRotations,
     /// Cloned FAPs that failed the guard (step 6), repaired or dropped.
     pub failed_faps: Vec<FapFailure>,
     /// Meshes of neither skin nor a part that ride on the skin (lashes; step 8).

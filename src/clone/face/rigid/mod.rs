@@ -5,6 +5,7 @@
 mod centres;
 mod entries;
 mod hierarchy;
+pub mod standard;
 
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
@@ -110,7 +111,15 @@ impl RigidPlan {
         let (sroles, shead) = roles(source, sparts);
         let drive = SourceDrive::of(source, sparts, &sroles);
         let mut created = Vec::new();
-        let head = head_transform(face, tparts, &mut created);
+        // A head transform is created only for the source's head motion to drive: the
+        // standard's head turns (`standard`) bake into a face without one.
+        let head_driven =
+            shead.is_some_and(|h| drive.driven.contains(source.transforms[h].name.as_str()));
+        let head = if head_driven {
+            Some(head_transform(face, tparts, &mut created))
+        } else {
+            lowest_enclosing(face, &tparts.face_meshes())
+        };
         let part_tf = part_transforms(face, tparts, head, &drive.needed, &mut created);
         if !created.is_empty() {
             // The kept scene stays: its writer inserts the new transforms where their
@@ -122,7 +131,9 @@ impl RigidPlan {
         }
         let mut installed = Vec::new();
         install_eye_centres(face, tparts, &part_tf, &mut installed);
-        install_head_centre(face, head, &mut installed, &mut report.warnings);
+        if let Some(head) = head.filter(|_| head_driven) {
+            install_head_centre(face, head, &mut installed, &mut report.warnings);
+        }
         install_rotated_part_centres(
             source,
             &sroles,
@@ -139,14 +150,14 @@ impl RigidPlan {
             &drive.driven,
             &mut report.warnings,
         );
-        if let Some(sh) = shead {
+        if let (Some(sh), Some(head)) = (shead, head) {
             map.entry(sh).or_insert((Role::Head, head));
         }
         report.rigid.part_transforms = part_tf
             .iter()
             .map(|(&p, &t)| (p, face.transforms[t].name.clone()))
             .collect();
-        report.rigid.head_transform = Some(face.transforms[head].name.clone());
+        report.rigid.head_transform = head.map(|h| face.transforms[h].name.clone());
         report.rigid.created_transforms = created;
         report.rigid.installed_centres = installed;
         warn_unmatched_parts(sparts, tparts, &mut report.warnings);
@@ -178,11 +189,12 @@ fn head_transform(face: &mut FaceModel, tparts: &FaceParts, created: &mut Vec<St
 
 /// The transform of each target part: its lowest enclosing transform when that holds only
 /// the part (the lower teeth may share theirs with the tongue), else — for `needed` parts — a
-/// new transform (its name goes to `created`).
+/// new transform under that one or the head (a root without either; its name goes to
+/// `created`).
 fn part_transforms(
     face: &mut FaceModel,
     tparts: &FaceParts,
-    head: usize,
+    head: Option<usize>,
     needed: &BTreeSet<Part>,
     created: &mut Vec<String>,
 ) -> BTreeMap<Part, usize> {
@@ -192,7 +204,7 @@ fn part_transforms(
         // The enclosing transform when the part's meshes are all it holds; an `Option` so
         // the exclusive case carries its transform and needs no unwrap.
         let exclusive = low.filter(|&t| {
-            t != head
+            Some(t) != head
                 && (0..face.meshes.len()).all(|m| {
                     !encloses(face, t, m)
                         || meshes.contains(&m)
@@ -206,7 +218,7 @@ fn part_transforms(
         if let Some(t) = exclusive {
             part_tf.insert(p, t);
         } else if needed.contains(&p) {
-            let (name, new_t) = add_part_transform(face, p, meshes, low.unwrap_or(head));
+            let (name, new_t) = add_part_transform(face, p, meshes, low.or(head));
             created.push(name);
             part_tf.insert(p, new_t);
         }
@@ -214,19 +226,19 @@ fn part_transforms(
     part_tf
 }
 
-/// Adds a transform for part `p` under `parent` and moves the part's meshes into it, their
+/// Adds a transform for part `p` under `parent` (a root for `None`) and moves the part's meshes into it, their
 /// world positions unchanged. Returns its name and index.
 fn add_part_transform(
     face: &mut FaceModel,
     p: Part,
     meshes: &[usize],
-    parent: usize,
+    parent: Option<usize>,
 ) -> (String, usize) {
     let name = unique_name(face, &format!("{}_tf", p.name()));
     let frames = face.frames();
-    let parent_world = frames.transforms[parent];
+    let parent_world = parent.map_or(Affine3A::IDENTITY, |t| frames.transforms[t]);
     face.transforms
-        .push(FaceTransform::new(name.clone(), Some(parent), Vec3::ZERO));
+        .push(FaceTransform::new(name.clone(), parent, Vec3::ZERO));
     let new_t = face.transforms.len() - 1;
     for &m in meshes {
         // Re-express the mesh in the new transform's frame (= the parent's).
