@@ -9,6 +9,9 @@
 
 use serde_json::Value;
 
+/// A walk over one kind of reference (accessor or buffer view indices) of a document.
+type Visit = fn(&mut Value, &mut dyn FnMut(&mut Value));
+
 /// Calls `f` on every accessor reference of `json`.
 fn for_each_accessor_ref(json: &mut Value, f: &mut impl FnMut(&mut Value)) {
     let on_map = |m: &mut Value, f: &mut dyn FnMut(&mut Value)| {
@@ -98,11 +101,7 @@ fn for_each_view_ref(json: &mut Value, f: &mut impl FnMut(&mut Value)) {
 }
 
 /// How often each of `n` objects is referenced through `visit`.
-fn counts(
-    json: &mut Value,
-    n: usize,
-    visit: fn(&mut Value, &mut dyn FnMut(&mut Value)),
-) -> Vec<usize> {
+fn counts(json: &mut Value, n: usize, visit: Visit) -> Vec<usize> {
     let mut c = vec![0; n];
     visit(json, &mut |v: &mut Value| {
         if let Some(i) = v.as_u64().map(|i| i as usize).filter(|&i| i < n) {
@@ -113,12 +112,7 @@ fn counts(
 }
 
 /// Removes the entries `drop` of the array `key` and renumbers the references `visit` finds.
-fn remove_and_renumber(
-    json: &mut Value,
-    key: &str,
-    drop: &[bool],
-    visit: fn(&mut Value, &mut dyn FnMut(&mut Value)),
-) {
+fn remove_and_renumber(json: &mut Value, key: &str, drop: &[bool], visit: Visit) {
     let mut next = 0;
     let map: Vec<Option<usize>> = drop
         .iter()

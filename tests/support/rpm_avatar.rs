@@ -142,19 +142,18 @@ fn prim(name: &'static str) -> Prim {
     }
 }
 
-/// A UV sphere about `centre` of radius `r` whose pole points along `pole` (its seam meridian
-/// turned by `turn` about the pole), cut at `cap` radians from the pole, skinned wholly to
-/// `slot`.
+/// A UV sphere about `centre` of radius `r` with `grid` = (rings, segments, cap: radians from
+/// the pole where it is cut), turned by `orient` (the unturned pole points along +z), skinned
+/// wholly to `slot`.
 fn sphere_prim(
     name: &'static str,
     centre: Vec3,
     r: f32,
-    rings: usize,
-    segs: usize,
-    cap: f32,
+    grid: (usize, usize, f32),
     orient: Quat,
     slot: u8,
 ) -> Prim {
+    let (rings, segs, cap) = grid;
     let (p, n, uv, t) = avatar::sphere(Vec3::ZERO, r, rings, segs, cap);
     let mut out = prim(name);
     out.positions = p.iter().map(|&x| centre + orient * x).collect();
@@ -174,9 +173,7 @@ pub fn head_prim() -> Prim {
         "Wolf3D_Head",
         HEAD_CENTRE,
         HEAD_RADIUS,
-        30,
-        48,
-        2.5,
+        (30, 48, 2.5),
         orient,
         SLOT_HEAD,
     )
@@ -206,9 +203,7 @@ pub fn eye_prim(left: bool) -> Prim {
         if left { "EyeLeft" } else { "EyeRight" },
         eye_centre(left),
         EYE_RADIUS,
-        8,
-        16,
-        std::f32::consts::PI,
+        (8, 16, std::f32::consts::PI),
         Quat::IDENTITY,
         if left { SLOT_LEFT_EYE } else { SLOT_RIGHT_EYE },
     )
@@ -221,9 +216,7 @@ fn hair_prim() -> Prim {
         "Wolf3D_Hair",
         HEAD_CENTRE + Vec3::new(0.0, 0.004, -0.004),
         HEAD_RADIUS * 1.06,
-        6,
-        24,
-        1.1,
+        (6, 24, 1.1),
         orient,
         SLOT_HEAD,
     )
@@ -432,7 +425,11 @@ pub fn build() -> avatar::Avatar {
                     Vec4::new(t.x, t.y, t.z, 1.0).to_array()
                 })
                 .collect();
-            primitive["attributes"]["TANGENT"] = json!(b.floats(&t, "VEC4", false));
+            let bytes: Vec<u8> = t.iter().flat_map(|x| x.to_le_bytes()).collect();
+            let view = b.view(&bytes, Some(34962));
+            let tangents = b.acc(json!({"bufferView": view, "componentType": 5126,
+                "count": p.positions.len(), "type": "VEC4"}));
+            primitive["attributes"]["TANGENT"] = json!(tangents);
         }
         if k < 2 {
             let teeth = k == 1;
