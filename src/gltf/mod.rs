@@ -81,6 +81,7 @@ pub mod json;
 mod layout;
 mod normals;
 pub mod patch;
+mod reclaim;
 mod scene_data;
 pub mod source;
 

@@ -9,7 +9,9 @@
 //! cameras, scenes, extensions and extras are carried over as they were; only `buffers` and
 //! the `buffer` / `byteOffset` of buffer views change (the buffers are merged), and weight
 //! channels of the user's animations on patched meshes get zero weights for the new targets
-//! (glTF requires one weight per target).
+//! (glTF requires one weight per target). Writing over a document fbakit patched before
+//! replaces fbakit's own targets in their slots and drops their old accessors, views and bytes
+//! (`reclaim`), so a file does not grow with each write.
 //!
 //! glTF rules the patch follows: every primitive of a mesh has the same number of targets, so
 //! a primitive a new target does not move gets a zero target (a sparse accessor with one zero
@@ -114,6 +116,9 @@ fn content(at: impl Into<String>, what: impl Into<String>) -> crate::error::Erro
 struct Builder {
     json: Value,
     bin: Vec<u8>,
+    /// Accessors of fbakit's own targets that new ones replaced (dropped at the end when
+    /// nothing else uses them).
+    released: Vec<usize>,
 }
 
 impl Builder {
@@ -220,6 +225,7 @@ impl GltfPatch {
         let mut b = Builder {
             json: source.json.clone(),
             bin: Vec::new(),
+            released: Vec::new(),
         };
         merge_buffers(&mut b, source)?;
         for (&m, patch) in &self.meshes {
@@ -241,6 +247,7 @@ impl GltfPatch {
         if let Some(anim) = &self.animation {
             add_animation(&mut b, anim);
         }
+        super::reclaim::drop_released(&mut b.json, &mut b.bin, &b.released);
         if let Some(buffers) = b.json.get_mut("buffers") {
             if let Some(first) = buffers.get_mut(0) {
                 first["byteLength"] = json!(b.bin.len());
@@ -351,6 +358,7 @@ fn patch_mesh(
         ));
     }
     let mut new_prims = Vec::with_capacity(prims.len());
+    let mut released = Vec::new();
     for (p, prim) in prims.iter().enumerate() {
         let mut prim = prim.clone();
         let count = accessor_count(&b.json, prim["attributes"]["POSITION"].as_u64());
@@ -404,7 +412,14 @@ fn patch_mesh(
             .or_insert_with(|| json!([]));
         if let Some(list) = targets.as_array_mut() {
             for (i, t) in replaced {
-                list[i] = t;
+                let old = std::mem::replace(&mut list[i], t);
+                released.extend(
+                    old.as_object()
+                        .into_iter()
+                        .flat_map(|o| o.values())
+                        .filter_map(Value::as_u64)
+                        .map(|a| a as usize),
+                );
             }
             list.extend(added);
         }
@@ -415,6 +430,7 @@ fn patch_mesh(
             .filter(|&t| slot_of(t).is_none())
             .map(|t| json!(patch.names[t])),
     );
+    b.released.extend(released);
     let mesh_json = &mut b.json["meshes"][m];
     mesh_json["primitives"] = Value::Array(new_prims);
     let mut extras = patch.extras.clone();
@@ -719,6 +735,7 @@ mod target_tests {
         Builder {
             json: json!({}),
             bin: Vec::new(),
+            released: Vec::new(),
         }
     }
 

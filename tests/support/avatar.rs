@@ -47,7 +47,7 @@ pub struct Avatar {
     pub prims: Vec<Prim>,
 }
 
-fn sphere(
+pub fn sphere(
     centre: Vec3,
     r: f32,
     rings: usize,
@@ -527,14 +527,15 @@ pub fn body_prims() -> Vec<Prim> {
     vec![skin, mouth, eyes, lashes]
 }
 
-struct Bin {
-    bin: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+/// A binary buffer being written with its buffer views and accessors.
+pub struct Bin {
+    pub bin: Vec<u8>,
+    pub views: Vec<Value>,
+    pub accessors: Vec<Value>,
 }
 
 impl Bin {
-    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+    pub fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         while self.bin.len() % 4 != 0 {
             self.bin.push(0);
         }
@@ -546,11 +547,11 @@ impl Bin {
         self.views.push(v);
         self.views.len() - 1
     }
-    fn acc(&mut self, a: Value) -> usize {
+    pub fn acc(&mut self, a: Value) -> usize {
         self.accessors.push(a);
         self.accessors.len() - 1
     }
-    fn vec3(&mut self, v: &[Vec3], minmax: bool) -> usize {
+    pub fn vec3(&mut self, v: &[Vec3], minmax: bool) -> usize {
         let bytes: Vec<u8> = v
             .iter()
             .flat_map(|p| p.to_array())
@@ -569,7 +570,7 @@ impl Bin {
         }
         self.acc(a)
     }
-    fn floats(&mut self, v: &[f32], ty: &str, minmax: bool) -> usize {
+    pub fn floats(&mut self, v: &[f32], ty: &str, minmax: bool) -> usize {
         let bytes: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
         let view = self.view(&bytes, None);
         let per = match ty {
@@ -593,7 +594,7 @@ impl Bin {
 
 /// A skinned primitive of `p` (positions, normals, UVs, joints and weights, indices) with
 /// `material`, its data appended to `b`.
-fn skinned_primitive(b: &mut Bin, p: &Prim, material: usize) -> Value {
+pub fn skinned_primitive(b: &mut Bin, p: &Prim, material: usize) -> Value {
     let pos = b.vec3(&p.positions, true);
     let nrm = b.vec3(&p.normals, false);
     let uv_bytes: Vec<u8> = p
@@ -641,7 +642,7 @@ fn skinned_primitive(b: &mut Bin, p: &Prim, material: usize) -> Value {
 }
 
 /// A 4×4 checker PNG.
-fn png() -> Vec<u8> {
+pub fn png() -> Vec<u8> {
     let mut img = fbakit::render::Image::new(4, 4, [200, 160, 140, 255]);
     img.fill_rect(0, 0, 2, 2, [120, 80, 60, 255]);
     let mut out = Vec::new();

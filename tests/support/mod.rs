@@ -8,4 +8,5 @@ pub mod gltf_transform;
 pub mod ict_full_head;
 pub mod loader_outputs;
 pub mod node_check;
+pub mod rpm_avatar;
 pub mod validator;
