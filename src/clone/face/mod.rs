@@ -240,6 +240,7 @@ mod lid_close;
 mod lid_eyeball;
 mod lid_margin;
 mod lid_resting;
+mod lid_seam;
 mod motions;
 mod mouth_fill;
 mod options;
@@ -682,6 +683,20 @@ fn clone_skin_motions(
     report
         .timings
         .push("lid_close", clock.elapsed().as_secs_f64());
+    // Where the slits close, the lids meet along one smooth line.
+    let clock = Instant::now();
+    if opts.lid_close {
+        lid_seam::seam_lids(
+            &ssurf.surface,
+            &moving,
+            &tsurf.surface,
+            [&margins[0], &margins[1]],
+            &mut result.motions,
+        );
+    }
+    report
+        .timings
+        .push("lid_seam", clock.elapsed().as_secs_f64());
     // No lid through an eyeball on its way to any border; before `smooth2` and `bound`,
     // which settle what the push turns.
     let clock = Instant::now();
