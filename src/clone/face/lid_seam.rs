@@ -79,14 +79,14 @@ pub(super) fn smoothed(c: &[f32], held: &[usize]) -> Vec<f32> {
     }
     // Gaussian elimination (the matrix is symmetric positive definite: no pivoting).
     for k in 0..n {
-        let d = a[k][k];
+        let pivot = a[k].clone();
         for r in k + 1..n {
-            let f = a[r][k] / d;
+            let f = a[r][k] / pivot[k];
             if f == 0.0 {
                 continue;
             }
-            for col in k..n {
-                a[r][col] -= f * a[k][col];
+            for (x, p) in a[r][k..].iter_mut().zip(&pivot[k..]) {
+                *x -= f * p;
             }
             b[r] -= f * b[k];
         }
