@@ -725,3 +725,238 @@ fn border_values(face: &FaceModel, f: u8) -> Vec<f64> {
     out.dedup();
     out
 }
+
+/// The shortest edge path of mesh `mi` of `face` (neutral) from vertex `a` to `b`.
+fn edge_path(face: &FaceModel, mi: usize, a: u32, b: u32) -> Vec<u32> {
+    let mesh = &face.meshes[mi].mesh;
+    let n = mesh.positions.len();
+    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for poly in mesh.polygons.iter() {
+        for k in 0..poly.len() {
+            let (p, q) = (poly[k], poly[(k + 1) % poly.len()]);
+            adj[p as usize].push(q);
+            adj[q as usize].push(p);
+        }
+    }
+    let pos = &mesh.positions;
+    let mut dist = vec![f32::INFINITY; n];
+    let mut prev = vec![u32::MAX; n];
+    let mut heap = std::collections::BinaryHeap::new();
+    dist[a as usize] = 0.0;
+    heap.push((std::cmp::Reverse(0u64), a));
+    while let Some((std::cmp::Reverse(d), u)) = heap.pop() {
+        let d = f32::from_bits(d as u32);
+        if u == b {
+            break;
+        }
+        if d > dist[u as usize] {
+            continue;
+        }
+        for &w in &adj[u as usize] {
+            let nd = d + pos[u as usize].distance(pos[w as usize]);
+            if nd < dist[w as usize] {
+                dist[w as usize] = nd;
+                prev[w as usize] = u;
+                heap.push((std::cmp::Reverse(nd.to_bits() as u64), w));
+            }
+        }
+    }
+    let mut out = vec![b];
+    while *out.last().unwrap() != a {
+        let p = prev[*out.last().unwrap() as usize];
+        assert!(p != u32::MAX, "no edge path {a} → {b}");
+        out.push(p);
+    }
+    out.reverse();
+    out
+}
+
+/// One eye's lid margins on a one-mesh head: the edge paths outer corner → lid point →
+/// inner corner, upper and lower (mesh, vertices).
+fn margin_rows(face: &FaceModel, eye: &Eye) -> (usize, Vec<u32>, Vec<u32>) {
+    let v = |s: &str| face.fp_vertex(s.parse().unwrap()).unwrap();
+    let (u, l, o, i) = (
+        v(eye.points[0]),
+        v(eye.points[1]),
+        v(eye.points[2]),
+        v(eye.points[3]),
+    );
+    let mi = u.0;
+    let row = |m: u32| {
+        let mut p = edge_path(face, mi, o.1, m);
+        p.extend(edge_path(face, mi, m, i.1).into_iter().skip(1));
+        p
+    };
+    (mi, row(u.1), row(l.1))
+}
+
+/// The closed line of one eye posed with `acts`, in IRISD0 of `face`: per upper margin
+/// vertex (corners left out) its gap to the lower margin (linear in x between the lower
+/// margin's vertices), and the largest second difference of the upper margin's posed
+/// height less its neutral one along the row (the lid's own curve is not roughness).
+fn closed_line(face: &FaceModel, eye: &Eye, acts: &[Activation]) -> (Vec<f32>, f32) {
+    let irisd = face.fapu().unwrap().distances.irisd0 as f32;
+    let (mi, up, low) = margin_rows(face, eye);
+    let (n, p) = (face.pose(&[]).unwrap(), face.pose(acts).unwrap());
+    let at = |v: u32| p[mi][v as usize];
+    let lower: Vec<(f32, f32)> = low.iter().map(|&v| (at(v).x, at(v).y)).collect();
+    let height = |x: f32| {
+        lower
+            .windows(2)
+            .find(|w| (w[0].0 - x) * (w[1].0 - x) <= 0.0)
+            .map(|w| {
+                let s = if w[1].0 != w[0].0 {
+                    (x - w[0].0) / (w[1].0 - w[0].0)
+                } else {
+                    0.0
+                };
+                w[0].1 + s * (w[1].1 - w[0].1)
+            })
+    };
+    let gaps: Vec<f32> = up[1..up.len() - 1]
+        .iter()
+        .filter_map(|&v| height(at(v).x).map(|h| (at(v).y - h) / irisd))
+        .collect();
+    let dy: Vec<f32> = up
+        .iter()
+        .map(|&v| (at(v).y - n[mi][v as usize].y) / irisd)
+        .collect();
+    let rough = dy
+        .windows(3)
+        .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
+        .fold(0.0, f32::max);
+    (gaps, rough)
+}
+
+/// Vertices of `ball` (an eye part's vertices) that a ray along +z (towards the viewer)
+/// from their posed place leaves without passing through any other triangle of the face:
+/// the eye seen through the lids.
+fn visible_eye(face: &FaceModel, ball: &HashSet<(usize, u32)>, acts: &[Activation]) -> usize {
+    let p = face.pose(acts).unwrap();
+    let pts: Vec<Vec3> = ball.iter().map(|&(a, b)| p[a][b as usize]).collect();
+    let lo = pts
+        .iter()
+        .fold(Vec3::splat(f32::INFINITY), |a, &q| a.min(q));
+    let hi = pts
+        .iter()
+        .fold(Vec3::splat(f32::NEG_INFINITY), |a, &q| a.max(q));
+    let mut tris = Vec::new();
+    for (mi, fm) in face.meshes.iter().enumerate() {
+        for poly in fm.mesh.polygons.iter() {
+            for k in 1..poly.len().saturating_sub(1) {
+                let t = [poly[0], poly[k], poly[k + 1]];
+                let q = t.map(|v| p[mi][v as usize]);
+                let out = q.iter().all(|c| c.x < lo.x)
+                    || q.iter().all(|c| c.x > hi.x)
+                    || q.iter().all(|c| c.y < lo.y)
+                    || q.iter().all(|c| c.y > hi.y);
+                if !out {
+                    tris.push((mi, t, q));
+                }
+            }
+        }
+    }
+    let in_front = |o: Vec3, q: &[Vec3; 3]| {
+        let d = |a: Vec3, b: Vec3| (a.x - o.x) * (b.y - o.y) - (b.x - o.x) * (a.y - o.y);
+        let (d1, d2, d3) = (d(q[0], q[1]), d(q[1], q[2]), d(q[2], q[0]));
+        let inside = (d1 >= 0.0 && d2 >= 0.0 && d3 >= 0.0) || (d1 <= 0.0 && d2 <= 0.0 && d3 <= 0.0);
+        let s = d1 + d2 + d3;
+        inside && s != 0.0 && (d2 * q[0].z + d3 * q[1].z + d1 * q[2].z) / s > o.z + 1e-6
+    };
+    ball.iter()
+        .filter(|&&(a, b)| {
+            let o = p[a][b as usize];
+            !tris
+                .iter()
+                .any(|(mi, t, q)| !(*mi == a && t.contains(&b)) && in_front(o, q))
+        })
+        .count()
+}
+
+/// Issue 21 §1, the closed line as a picture shows it: alma's blink on the ICT head. At
+/// alma's closing value the old clone's upper margin dropped as a plateau with a step where
+/// `smooth`'s held middle ended (0.0049 → 0.0013 between neighbours, roughness 0.36 IRISD0
+/// against ICT's own 0.08): the closed line was jagged, and the iris shows through the slit
+/// beside the lid point (69 eye vertices per eye seen from the front; ICT's own blink at its
+/// closing value hides them all). Checked per margin
+/// vertex (the edge paths corner → lid point → corner) at alma's closing value and at the
+/// full blink (1024): the gap within ICT's own range (its lids cross where alma's just
+/// meet) widened by 0.05 IRISD0 and the line's roughness at most 2.2× ICT's own (at least
+/// 0.02 IRISD0).
+#[test]
+fn alma_onto_ict_closed_line() {
+    closed_line_check(false);
+}
+
+/// The same, and no eye vertex seen through the closed lids at alma's closing value.
+/// **Not met** (issue 21 §1 open): the clone's margins meet, but in front of the lid points
+/// ICT's cornea lies 0.0008 (0.06 eye-white radii) in front of where they meet — the
+/// lids move straight down as alma's FAT moves hers, and alma's own closed lids lie behind
+/// her protruding eyes, so a rule that keeps self-clones exact allows it (69 / 70 eye
+/// vertices seen per eye, ICT's own blink 0).
+#[test]
+#[ignore = "issue 21 §1: the cornea shows through alma's blink on ICT (69 eye vertices seen)"]
+fn alma_onto_ict_blink_hides_the_eye() {
+    closed_line_check(true);
+}
+
+/// The closed-line checks of the two tests above; with `eyes_hidden` also the eye seen.
+fn closed_line_check(eyes_hidden: bool) {
+    let (Ok(alma), Ok(ict)) = (fbakit::face::read("alma"), fbakit::face::read("ict")) else {
+        eprintln!("note: bundled faces alma / ict not readable; skipped");
+        return;
+    };
+    let bare = fbakit::export::picture::strip_fat(&ict);
+    let out = fbakit::clone::face::clone_face(&alma, &bare, &fit()).unwrap();
+    let c = &out.face;
+    let mut bad = Vec::new();
+    for eye in &EYES {
+        let value = closing_value(&alma, eye).expect("alma's blink closes its eyes");
+        let own = closing_value(&ict, eye).expect("ICT's blink closes its eyes");
+        let part = if eye.faps.0 == 19 {
+            Part::LeftEye
+        } else {
+            Part::RightEye
+        };
+        let ball = eyeball_vertices(&out, part);
+        for (v, ov) in [(value, own), (1024.0, 1024.0)] {
+            let (gaps, rough) = closed_line(c, eye, &blink(c, eye, v));
+            let (own_gaps, own_rough) = closed_line(&ict, eye, &blink(&ict, eye, ov));
+            let seen = visible_eye(c, &ball, &blink(c, eye, v));
+            let own_seen = visible_eye(&ict, &ball, &blink(&ict, eye, ov));
+            let range = |g: &[f32]| {
+                (
+                    g.iter().copied().fold(f32::INFINITY, f32::min),
+                    g.iter().copied().fold(f32::NEG_INFINITY, f32::max),
+                )
+            };
+            let ((lo, hi), (olo, ohi)) = (range(&gaps), range(&own_gaps));
+            eprintln!(
+                "eye {:?} @{v:.0}: gaps {lo:.3}…{hi:.3} (ICT's own @{ov:.0} {olo:.3}…{ohi:.3}), roughness {rough:.3} ({own_rough:.3}), eye vertices seen {seen} ({own_seen})",
+                eye.faps
+            );
+            if lo < olo - 0.05 || hi > ohi.max(0.0) + 0.05 {
+                bad.push(format!(
+                    "eye {:?} @{v:.0}: gaps {lo:.3}…{hi:.3} against {olo:.3}…{ohi:.3}",
+                    eye.faps
+                ));
+            }
+            // 2.2×: the old clone's line was 4.3× as rough as ICT's own at alma's closing
+            // value (0.357 against 0.083), `lid_seam`'s 2.1× (0.172): what is left is the lid's
+            // bend where `smooth`'s held middle ends, now spread over three vertices.
+            if rough > 2.2 * own_rough.max(0.02) {
+                bad.push(format!(
+                    "eye {:?} @{v:.0}: roughness {rough:.3} against {own_rough:.3}",
+                    eye.faps
+                ));
+            }
+            if eyes_hidden && seen > own_seen {
+                bad.push(format!(
+                    "eye {:?} @{v:.0}: {seen} eye vertices seen through the lids ({own_seen})",
+                    eye.faps
+                ));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "closed line: {bad:#?}");
+}

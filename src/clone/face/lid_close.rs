@@ -53,11 +53,11 @@ use crate::spec::{FapId, FeaturePointId};
 pub(super) const REACH: f32 = 0.2;
 
 /// One eye: left or not, top and bottom lid FAPs, upper and lower lid points.
-const EYES: [(bool, u8, u8, &str, &str); 2] =
+pub(super) const EYES: [(bool, u8, u8, &str, &str); 2] =
     [(true, 19, 21, "3.1", "3.3"), (false, 20, 22, "3.2", "3.4")];
 
 /// Index of the motion of FAP `fap` at its smallest positive border, with that border.
-fn first_motion(motions: &[SurfaceMotion], fap: u8) -> Option<(usize, f64)> {
+pub(super) fn first_motion(motions: &[SurfaceMotion], fap: u8) -> Option<(usize, f64)> {
     let key = TableKey::LowLevel(FapId::new(fap)?);
     motions
         .iter()
@@ -77,7 +77,7 @@ fn offset(m: &SurfaceMotion, v: u32) -> Vec3 {
 
 /// A margin posed at the closing value: per vertex, its place along the corner line (0 at
 /// the outer corner, 1 at the inner) and its height.
-fn posed(
+pub(super) fn posed(
     surf: &CloneSurface,
     vertices: &[u32],
     corners: (Vec3, Vec3),
@@ -94,7 +94,7 @@ fn posed(
 }
 
 /// Place of `p` along the corner line (0 outer, 1 inner), by x.
-fn along((o, i): (Vec3, Vec3), p: Vec3) -> f32 {
+pub(super) fn along((o, i): (Vec3, Vec3), p: Vec3) -> f32 {
     if (i.x - o.x).abs() > 0.0 {
         (p.x - o.x) / (i.x - o.x)
     } else {
@@ -104,7 +104,7 @@ fn along((o, i): (Vec3, Vec3), p: Vec3) -> f32 {
 
 /// Height of a posed margin at place `t` (linear between its vertices, the nearest end
 /// outside them).
-fn height(line: &[(f32, f32)], t: f32) -> Option<f32> {
+pub(super) fn height(line: &[(f32, f32)], t: f32) -> Option<f32> {
     for w in line.windows(2) {
         let ((t0, y0), (t1, y1)) = (w[0], w[1]);
         if (t0 <= t && t <= t1) || (t1 <= t && t <= t0) {
@@ -119,22 +119,22 @@ fn height(line: &[(f32, f32)], t: f32) -> Option<f32> {
 
 /// The source side of one eye: closing value, share of the closing done by the top FAP,
 /// and the gap between its margins along the corner line (IRISD0).
-struct SourceClose {
-    value: f64,
-    top_share: f32,
-    upper: Vec<(f32, f32)>,
-    lower: Vec<(f32, f32)>,
-    irisd: f32,
+pub(super) struct SourceClose {
+    pub(super) value: f64,
+    pub(super) top_share: f32,
+    pub(super) upper: Vec<(f32, f32)>,
+    pub(super) lower: Vec<(f32, f32)>,
+    pub(super) irisd: f32,
 }
 
 impl SourceClose {
-    fn gap(&self, t: f32) -> Option<f32> {
+    pub(super) fn gap(&self, t: f32) -> Option<f32> {
         Some((height(&self.upper, t)? - height(&self.lower, t)?) / self.irisd)
     }
 }
 
 /// Step 1 for one eye of the source.
-fn source_close(
+pub(super) fn source_close(
     source: &CloneSurface,
     motions: &[SurfaceMotion],
     margins: &LidMargins,
@@ -300,11 +300,6 @@ pub(super) fn close_lids(
         let cu = change(&pu, &pl, &fu, &fl, true);
         let cl = change(&pl, &pu, &fl, &fu, false);
         let reach = REACH * tm.es();
-        let (o, i) = corners;
-        let side = |p: Vec3| {
-            let t = along(corners, p).clamp(0.0, 1.0);
-            p.y - (o.y + t * (i.y - o.y))
-        };
         for ((line, verts), own, across, ch, share, field, is_upper) in [
             (upper, &upper_set, &lower_set, cu, st, &mut dt, true),
             (lower, &lower_set, &upper_set, cl, sb, &mut db, false),
@@ -318,35 +313,22 @@ pub(super) fn close_lids(
                 continue;
             }
             // The lid point's vertical motion at the border (step 6).
-            let point = (if is_upper { up } else { low })
-                .parse::<FeaturePointId>()
-                .ok()
-                .and_then(|id| target.fp_vertices.get(&id))
-                .map(|&v| field[v as usize].y);
-            let mut count = 0;
-            for (v, p) in target.positions.iter().enumerate() {
-                let v32 = v as u32;
-                let on = own.contains(&v32);
-                if (!on && (side(*p) > 0.0) != is_upper)
-                    || fixed.contains(&v32)
-                    || across.contains(&v32)
-                {
-                    continue;
-                }
-                let (a, t, dist) = nearest_on(line, *p);
-                let w = if on { 1.0 } else { bump(dist / reach) };
-                if w <= 0.0 {
-                    continue;
-                }
-                let b = (a + 1).min(ch.len() - 1);
-                let c = (1.0 - t) * ch[a] + t * ch[b];
-                let y = field[v].y;
-                let to = no_further(y, y + w * c, point, is_upper);
-                if to != y {
-                    field[v].y = to;
-                    count += 1;
-                }
-            }
+            let point = lid_point_motion(target, if is_upper { up } else { low }, field);
+            let count = spread(
+                target,
+                Row {
+                    line,
+                    own,
+                    across,
+                    fixed: &fixed,
+                    corners,
+                    is_upper,
+                },
+                &ch,
+                point,
+                reach,
+                field,
+            );
             let k = if is_upper { kt } else { kb };
             if count > 0 {
                 out[k].offsets = sparse_offsets(field);
@@ -357,11 +339,74 @@ pub(super) fn close_lids(
     done
 }
 
+/// One lid's margin row as a change spreads from it: its neutral points, its vertices, the
+/// other lid's (never changed), the vertices kept, the eye's corners, and which lid.
+pub(super) struct Row<'a> {
+    pub(super) line: &'a [Vec3],
+    pub(super) own: &'a HashSet<u32>,
+    pub(super) across: &'a HashSet<u32>,
+    pub(super) fixed: &'a HashSet<u32>,
+    pub(super) corners: (Vec3, Vec3),
+    pub(super) is_upper: bool,
+}
+
+/// The vertical motion in `field` of the lid point `fp` (a feature point id) on `target`.
+pub(super) fn lid_point_motion(target: &CloneSurface, fp: &str, field: &[Vec3]) -> Option<f32> {
+    fp.parse::<FeaturePointId>()
+        .ok()
+        .and_then(|id| target.fp_vertices.get(&id))
+        .map(|&v| field[v as usize].y)
+}
+
+/// Adds the vertical change `ch` (per vertex of `row`, at the table's border) to `field`:
+/// in full on the row, fading out by a Wendland bump within `reach` of it over the row's
+/// side of the corner line, never closing a vertex past its lid point's motion `point`
+/// (step 6). Returns how many vertices changed.
+pub(super) fn spread(
+    target: &CloneSurface,
+    row: Row,
+    ch: &[f32],
+    point: Option<f32>,
+    reach: f32,
+    field: &mut [Vec3],
+) -> usize {
+    let (o, i) = row.corners;
+    let side = |p: Vec3| {
+        let t = along(row.corners, p).clamp(0.0, 1.0);
+        p.y - (o.y + t * (i.y - o.y))
+    };
+    let mut count = 0;
+    for (v, p) in target.positions.iter().enumerate() {
+        let v32 = v as u32;
+        let on = row.own.contains(&v32);
+        if (!on && (side(*p) > 0.0) != row.is_upper)
+            || row.fixed.contains(&v32)
+            || row.across.contains(&v32)
+        {
+            continue;
+        }
+        let (a, t, dist) = nearest_on(row.line, *p);
+        let w = if on { 1.0 } else { bump(dist / reach) };
+        if w <= 0.0 {
+            continue;
+        }
+        let b = (a + 1).min(ch.len() - 1);
+        let c = (1.0 - t) * ch[a] + t * ch[b];
+        let y = field[v].y;
+        let to = no_further(y, y + w * c, point, row.is_upper);
+        if to != y {
+            field[v].y = to;
+            count += 1;
+        }
+    }
+    count
+}
+
 /// A vertex's vertical motion `y` changed to `to`, held back where the change closes the
 /// slit (down for the upper lid, up for the lower) past its lid point's motion `point`
 /// (step 6): nothing is taken back of a motion already past it, and a change that opens is
 /// kept.
-fn no_further(y: f32, to: f32, point: Option<f32>, is_upper: bool) -> f32 {
+pub(super) fn no_further(y: f32, to: f32, point: Option<f32>, is_upper: bool) -> f32 {
     let Some(point) = point else {
         return to;
     };

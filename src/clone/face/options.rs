@@ -66,9 +66,9 @@ pub struct CloneOptions {
     /// Default on.
     pub smooth_shares: bool,
     /// Run `lid_close` (module docs): the slit closes band by band where the source's does,
-    /// the change faded out over the margins' middles and capped past the closing value; and
-    /// `eyeball`: no lid vertex passes into an eyeball part on its way to any border. Default
-    /// on.
+    /// the change faded out over the margins' middles and capped past the closing value;
+    /// `lid_seam`: there the lids meet along one smooth line; and `eyeball`: no lid vertex
+    /// passes into an eyeball part on its way to any border. Default on.
     pub lid_close: bool,
 }
 
