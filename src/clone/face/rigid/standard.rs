@@ -40,13 +40,15 @@
 
 use std::collections::BTreeMap;
 
+use rayon::prelude::*;
+
 use glam::{Affine3A, DMat3, DQuat, DVec3, Vec3};
 use serde::Serialize;
 
 use super::centres::{eyeball_centre, install_center};
 use super::hierarchy::{encloses, lowest_enclosing};
 use crate::clone::face::eyeball::eye_white_points;
-use crate::clone::face::split::split_view;
+use crate::clone::face::split::{split_view, SplitView};
 use crate::clone::face::{identify_parts, FaceParts, Part};
 use crate::face::{FaceFrames, FaceModel};
 use crate::fat::{FaceDefMesh, FaceDefTable, FaceDefTransform, TableKey, TransformField};
@@ -110,6 +112,16 @@ pub fn is_standard_rotation(key: TableKey) -> bool {
 /// has the parts; may install centres on the transforms it drives (the neutral pose does not
 /// move).
 pub fn add_standard_rotations(face: &mut FaceModel) -> StandardRotations {
+    add_standard_rotations_cut(face, None)
+}
+
+/// [`add_standard_rotations`] with the face's cut already known (`cut`: what `split_view`
+/// gave for it, `None` inside: nothing to cut), as the clone has it: cutting again costs
+/// about as much as the clone's whole `parts` step.
+pub(in crate::clone::face) fn add_standard_rotations_cut(
+    face: &mut FaceModel,
+    cut: Option<Option<&SplitView>>,
+) -> StandardRotations {
     let mut out = StandardRotations::default();
     let missing = |f: &FaceModel, n: u8| {
         FapId::new(n).is_some_and(|id| f.fat.table(TableKey::LowLevel(id)).is_none())
@@ -129,7 +141,7 @@ pub fn add_standard_rotations(face: &mut FaceModel) -> StandardRotations {
     };
     let es0 = f64::from(pl.distance(pr));
     if !eyes.is_empty() {
-        add_eye_tables(face, &eyes, &mut out);
+        add_eye_tables(face, &eyes, cut, &mut out);
     }
     if !head.is_empty() {
         add_head_tables(face, &head, (pl, pr), es0, &mut out);
@@ -148,7 +160,11 @@ struct Turn {
 impl Turn {
     /// Displacement of face-frame point `p` turned by `angle` radians.
     fn displacement(&self, p: DVec3, angle: f64) -> DVec3 {
-        let q = DQuat::from_axis_angle(self.axis, angle);
+        self.displacement_by(p, DQuat::from_axis_angle(self.axis, angle))
+    }
+
+    /// Displacement of `p` turned by `q` (a turn about [`Turn::axis`]).
+    fn displacement_by(&self, p: DVec3, q: DQuat) -> DVec3 {
         self.centre + q * (p - self.centre) - p
     }
 }
@@ -187,6 +203,12 @@ fn baked_entry(
     let n = borders.len() - 1;
     let mut coord_index = Vec::with_capacity(vertices.len());
     let mut displacements = Vec::with_capacity(vertices.len() * n);
+    // Most vertices turn by the whole angle: their turns at the borders are shared.
+    let whole: Vec<DQuat> = borders
+        .iter()
+        .map(|&b| DQuat::from_axis_angle(turn.axis, b * AU))
+        .collect();
+    let mut at = Vec::with_capacity(borders.len());
     for &v in vertices {
         let Some(x) = local.get(v as usize) else {
             continue;
@@ -196,10 +218,19 @@ fn baked_entry(
         if w <= 0.0 {
             continue;
         }
-        let at = |b: f64| back * turn.displacement(p, w * b * AU);
+        at.clear();
+        if w == 1.0 {
+            at.extend(whole.iter().map(|&q| back * turn.displacement_by(p, q)));
+        } else {
+            at.extend(
+                borders
+                    .iter()
+                    .map(|&b| back * turn.displacement(p, w * b * AU)),
+            );
+        }
         coord_index.push(v);
         for j in 0..n {
-            let rate = (at(borders[j + 1]) - at(borders[j])) / (borders[j + 1] - borders[j]);
+            let rate = (at[j + 1] - at[j]) / (borders[j + 1] - borders[j]);
             displacements.push(rate.as_vec3());
         }
     }
@@ -216,13 +247,19 @@ fn baked_entry(
 type PartView = (FaceModel, FaceParts, BTreeMap<usize, (usize, Vec<u32>)>);
 
 /// The part view of `face` (its FAT set aside so a one-mesh head it deforms can be cut).
-fn part_view(face: &mut FaceModel) -> PartView {
-    let fat = std::mem::take(&mut face.fat);
-    let view = split_view(face);
-    face.fat = fat;
-    let (vface, split) = match view {
-        Some(v) => (v.face, v.parts),
-        None => (face.clone(), Vec::new()),
+fn part_view(face: &mut FaceModel, cut: Option<Option<&SplitView>>) -> PartView {
+    let (vface, split) = match cut {
+        Some(Some(v)) => (v.face.clone(), v.parts.clone()),
+        Some(None) => (face.clone(), Vec::new()),
+        None => {
+            let fat = std::mem::take(&mut face.fat);
+            let view = split_view(face);
+            face.fat = fat;
+            match view {
+                Some(v) => (v.face, v.parts),
+                None => (face.clone(), Vec::new()),
+            }
+        }
     };
     let mut parts = identify_parts(&vface);
     let mut map = BTreeMap::new();
@@ -270,8 +307,13 @@ fn local_axis(face: &FaceModel, frames: &FaceFrames, t: usize, world_axis: DVec3
 }
 
 /// Adds the eyeball tables `faps` (module docs).
-fn add_eye_tables(face: &mut FaceModel, faps: &[u8], out: &mut StandardRotations) {
-    let (vface, parts, map) = part_view(face);
+fn add_eye_tables(
+    face: &mut FaceModel,
+    faps: &[u8],
+    cut: Option<Option<&SplitView>>,
+    out: &mut StandardRotations,
+) {
+    let (vface, parts, map) = part_view(face, cut);
     let vframes = vface.frames();
     for (eye, left) in [(Part::LeftEye, true), (Part::RightEye, false)] {
         let Some(meshes) = parts.parts.get(&eye) else {
@@ -468,35 +510,38 @@ fn add_head_tables(
         .fold(0.0, f64::max);
     let borders = rotation_borders(HEAD_RANGE, radius, HEAD_TOLERANCE * size);
     out.intervals[1] = borders.len() - 1;
-    for f in &keys {
-        let Some(axis) = f.info().rotation_axis() else {
-            continue;
-        };
-        let turn = Turn {
-            centre: c,
-            axis: axis.as_dvec3(),
-        };
-        let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
-        for &m in &all {
-            let mesh = &face.meshes[m];
-            let vs: Vec<u32> = (0..mesh.mesh.positions.len() as u32).collect();
-            let entry = baked_entry(
-                &mesh.name,
-                &vs,
-                &mesh.mesh.positions,
-                frames.meshes[m],
-                &turn,
-                |p| neck_weight(p.y, top, bottom),
-                &borders,
-            );
-            if !entry.coord_index.is_empty() {
-                table.meshes.push(entry);
+    // The head's tables cover every vertex: one FAP per core.
+    let tables: Vec<FaceDefTable> = keys
+        .par_iter()
+        .filter_map(|f| {
+            let axis = f.info().rotation_axis()?;
+            let turn = Turn {
+                centre: c,
+                axis: axis.as_dvec3(),
+            };
+            let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
+            for &m in &all {
+                let mesh = &face.meshes[m];
+                let vs: Vec<u32> = (0..mesh.mesh.positions.len() as u32).collect();
+                let entry = baked_entry(
+                    &mesh.name,
+                    &vs,
+                    &mesh.mesh.positions,
+                    frames.meshes[m],
+                    &turn,
+                    |p| neck_weight(p.y, top, bottom),
+                    &borders,
+                );
+                if !entry.coord_index.is_empty() {
+                    table.meshes.push(entry);
+                }
             }
-        }
-        if !table.meshes.is_empty() {
-            face.fat.tables.push(table);
-            out.added.push(TableKey::LowLevel(*f));
-        }
+            (!table.meshes.is_empty()).then_some(table)
+        })
+        .collect();
+    for table in tables {
+        out.added.push(table.key);
+        face.fat.tables.push(table);
     }
 }
 
