@@ -562,7 +562,9 @@ fn eyeballs_turn_rigidly_for_their_own_faps_only() {
                         continue;
                     }
                     let most = max_len(&d, range.clone()) / eye_size;
-                    if own {
+                    // A head turn (48–50) carries both eyes with it, rigidly.
+                    let head = matches!(fap, 48..=50);
+                    if own || head {
                         let r = rigid_residual(&rest, &moved) / eye_size;
                         worst_rigid = worst_rigid.max(r);
                         assert!(
