@@ -848,7 +848,9 @@ fn check_parts(parts: &FaceParts, side: &str) -> Result<()> {
     Ok(())
 }
 
-/// One warning naming the meshes (`others`) of neither skin nor a part that stay rigid.
+/// One warning naming the meshes (`others`) of neither skin nor a part: a source's are not
+/// cloned, a target's get no FAT motion (a Ready Player Me body or outfit stays on its spine
+/// joints, not on the head).
 fn warn_others(face: &FaceModel, others: &[usize], side: &str, warnings: &mut Vec<Diagnostic>) {
     if others.is_empty() {
         return;
@@ -857,8 +859,13 @@ fn warn_others(face: &FaceModel, others: &[usize], side: &str, warnings: &mut Ve
         .iter()
         .map(|&m| face.meshes[m].name.as_str())
         .collect();
+    let fate = if side == "source" {
+        "their motion is not cloned"
+    } else {
+        "they get no FAT motion (they move only with their own nodes or joints)"
+    };
     warnings.push(Diagnostic::warning(format!(
-        "{side} meshes {} are neither skin nor a part; they stay rigid with the head",
+        "{side} meshes {} are neither skin nor a part; {fate}",
         names.join(", ")
     )));
 }
