@@ -250,14 +250,7 @@ pub(super) fn close_lids(
         );
         // Kept: the corners (on both margins) and the FAPs' own feature points; the change
         // fades out over the margins' middles (step 3).
-        let upper_set: HashSet<u32> = upper.1.iter().copied().collect();
-        let lower_set: HashSet<u32> = lower.1.iter().copied().collect();
-        let fixed: HashSet<u32> = [up, low]
-            .iter()
-            .filter_map(|s| s.parse::<FeaturePointId>().ok())
-            .filter_map(|id| target.fp_vertices.get(&id).copied())
-            .chain(upper_set.intersection(&lower_set).copied())
-            .collect();
+        let sets = RowSets::of(target, upper.1, lower.1, [up, low]);
         // Per margin vertex, the change of its height at the closing value.
         let change = |own: &[(f32, f32)],
                       other: &[(f32, f32)],
@@ -300,54 +293,115 @@ pub(super) fn close_lids(
         let cu = change(&pu, &pl, &fu, &fl, true);
         let cl = change(&pl, &pu, &fl, &fu, false);
         let reach = REACH * tm.es();
-        for ((line, verts), own, across, ch, share, field, is_upper) in [
-            (upper, &upper_set, &lower_set, cu, st, &mut dt, true),
-            (lower, &lower_set, &upper_set, cl, sb, &mut db, false),
+        for ((line, verts), ch, share, field, is_upper) in [
+            (upper, cu, st, &mut dt, true),
+            (lower, cl, sb, &mut db, false),
         ] {
             let ch: Vec<f32> = verts
                 .iter()
                 .zip(ch)
-                .map(|(v, c)| if fixed.contains(v) { 0.0 } else { c / share })
+                .map(|(v, c)| {
+                    if sets.fixed.contains(v) {
+                        0.0
+                    } else {
+                        c / share
+                    }
+                })
                 .collect();
             if !ch.iter().all(|c| c.is_finite()) || share <= 0.0 {
                 continue;
             }
-            // The lid point's vertical motion at the border (step 6).
-            let point = lid_point_motion(target, if is_upper { up } else { low }, field);
-            let count = spread(
-                target,
-                Row {
-                    line,
-                    own,
-                    across,
-                    fixed: &fixed,
-                    corners,
-                    is_upper,
-                },
-                &ch,
-                point,
-                reach,
-                field,
-            );
-            let k = if is_upper { kt } else { kb };
-            if count > 0 {
-                out[k].offsets = sparse_offsets(field);
-                done.insert(format!("{}@{}", out[k].key.name(), out[k].value), count);
-            }
+            let row = sets.row(line, corners, [up, low], is_upper);
+            let count = spread(target, row, &ch, reach, field);
+            store_changed(out, if is_upper { kt } else { kb }, field, count, &mut done);
         }
     }
     done
 }
 
+/// The vertices of an eye's two margin rows, and those a change keeps: the lid FAPs' own
+/// feature points and the corners both rows share (step 3).
+pub(super) struct RowSets {
+    pub(super) upper: HashSet<u32>,
+    pub(super) lower: HashSet<u32>,
+    pub(super) fixed: HashSet<u32>,
+}
+
+impl RowSets {
+    /// The sets of the rows `upper` and `lower` on `target`, whose lid points are `points`
+    /// (the upper and lower lid FAPs' feature point ids).
+    pub(super) fn of(
+        target: &CloneSurface,
+        upper: &[u32],
+        lower: &[u32],
+        points: [&str; 2],
+    ) -> Self {
+        let upper: HashSet<u32> = upper.iter().copied().collect();
+        let lower: HashSet<u32> = lower.iter().copied().collect();
+        let fixed = points
+            .iter()
+            .filter_map(|s| s.parse::<FeaturePointId>().ok())
+            .filter_map(|id| target.fp_vertices.get(&id).copied())
+            .chain(upper.intersection(&lower).copied())
+            .collect();
+        RowSets {
+            upper,
+            lower,
+            fixed,
+        }
+    }
+
+    /// The upper (`is_upper`) or lower row with neutral points `line`, for [`spread`].
+    pub(super) fn row<'a>(
+        &'a self,
+        line: &'a [Vec3],
+        corners: (Vec3, Vec3),
+        points: [&'a str; 2],
+        is_upper: bool,
+    ) -> Row<'a> {
+        let (own, across, lid_point) = if is_upper {
+            (&self.upper, &self.lower, points[0])
+        } else {
+            (&self.lower, &self.upper, points[1])
+        };
+        Row {
+            line,
+            own,
+            across,
+            fixed: &self.fixed,
+            corners,
+            lid_point,
+            is_upper,
+        }
+    }
+}
+
 /// One lid's margin row as a change spreads from it: its neutral points, its vertices, the
-/// other lid's (never changed), the vertices kept, the eye's corners, and which lid.
+/// other lid's (never changed), the vertices kept, the eye's corners, its lid point (a
+/// feature point id) and which lid.
 pub(super) struct Row<'a> {
     pub(super) line: &'a [Vec3],
     pub(super) own: &'a HashSet<u32>,
     pub(super) across: &'a HashSet<u32>,
     pub(super) fixed: &'a HashSet<u32>,
     pub(super) corners: (Vec3, Vec3),
+    pub(super) lid_point: &'a str,
     pub(super) is_upper: bool,
+}
+
+/// Stores `field` as the offsets of motion `k` of `out` when `count` vertices of it changed,
+/// noting the count in `done` under `name@value`.
+pub(super) fn store_changed(
+    out: &mut [SurfaceMotion],
+    k: usize,
+    field: &[Vec3],
+    count: usize,
+    done: &mut BTreeMap<String, usize>,
+) {
+    if count > 0 {
+        out[k].offsets = sparse_offsets(field);
+        done.insert(format!("{}@{}", out[k].key.name(), out[k].value), count);
+    }
 }
 
 /// The vertical motion in `field` of the lid point `fp` (a feature point id) on `target`.
@@ -360,16 +414,16 @@ pub(super) fn lid_point_motion(target: &CloneSurface, fp: &str, field: &[Vec3]) 
 
 /// Adds the vertical change `ch` (per vertex of `row`, at the table's border) to `field`:
 /// in full on the row, fading out by a Wendland bump within `reach` of it over the row's
-/// side of the corner line, never closing a vertex past its lid point's motion `point`
-/// (step 6). Returns how many vertices changed.
+/// side of the corner line, never closing a vertex past the motion its lid point has in
+/// `field` before the change (step 6). Returns how many vertices changed.
 pub(super) fn spread(
     target: &CloneSurface,
     row: Row,
     ch: &[f32],
-    point: Option<f32>,
     reach: f32,
     field: &mut [Vec3],
 ) -> usize {
+    let point = lid_point_motion(target, row.lid_point, field);
     let (o, i) = row.corners;
     let side = |p: Vec3| {
         let t = along(row.corners, p).clamp(0.0, 1.0);

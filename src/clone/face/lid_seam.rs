@@ -27,15 +27,15 @@
 //!    the bottom one the lower), spread into its lid by `lid_close`'s bump, never closing a
 //!    vertex past its lid point.
 
-use std::collections::{BTreeMap, HashSet};
+use std::collections::BTreeMap;
 
 use glam::Vec3;
 
 use super::lid_close::{
-    first_motion, height, lid_point_motion, posed, source_close, spread, Row, EYES, REACH,
+    first_motion, height, posed, source_close, spread, store_changed, RowSets, EYES, REACH,
 };
 use super::lid_margin::LidMargins;
-use super::smooth::{dense_field, sparse_offsets};
+use super::smooth::dense_field;
 use crate::clone::{CloneSurface, SurfaceMotion};
 use crate::spec::FeaturePointId;
 
@@ -224,18 +224,11 @@ pub(super) fn seam_lids(
         if dc.iter().chain(&dw).all(|x| x.abs() <= ROUNDING * irisd) {
             continue;
         }
-        let upper_set: HashSet<u32> = upper.1.iter().copied().collect();
-        let lower_set: HashSet<u32> = lower.1.iter().copied().collect();
-        let fixed: HashSet<u32> = [up, low]
-            .iter()
-            .filter_map(|s| s.parse::<FeaturePointId>().ok())
-            .filter_map(|id| target.fp_vertices.get(&id).copied())
-            .chain(upper_set.intersection(&lower_set).copied())
-            .collect();
+        let sets = RowSets::of(target, upper.1, lower.1, [up, low]);
         let reach = REACH * tm.es();
-        for ((line, verts), posed_row, own, across, share, field, is_upper) in [
-            (upper, &pu, &upper_set, &lower_set, st, &mut dt, true),
-            (lower, &pl, &lower_set, &upper_set, sb, &mut db, false),
+        for ((line, verts), posed_row, share, field, is_upper) in [
+            (upper, &pu, st, &mut dt, true),
+            (lower, &pl, sb, &mut db, false),
         ] {
             if share <= 0.0 {
                 continue;
@@ -245,7 +238,7 @@ pub(super) fn seam_lids(
                 .iter()
                 .zip(posed_row)
                 .map(|(v, &(t, _))| {
-                    if fixed.contains(v) {
+                    if sets.fixed.contains(v) {
                         return 0.0;
                     }
                     let w = on_grid(&dw, t);
@@ -261,27 +254,9 @@ pub(super) fn seam_lids(
             if !ch.iter().all(|c| c.is_finite()) || ch.iter().all(|c| *c == 0.0) {
                 continue;
             }
-            let point = lid_point_motion(target, if is_upper { up } else { low }, field);
-            let count = spread(
-                target,
-                Row {
-                    line,
-                    own,
-                    across,
-                    fixed: &fixed,
-                    corners,
-                    is_upper,
-                },
-                &ch,
-                point,
-                reach,
-                field,
-            );
-            let k = if is_upper { kt } else { kb };
-            if count > 0 {
-                out[k].offsets = sparse_offsets(field);
-                done.insert(format!("{}@{}", out[k].key.name(), out[k].value), count);
-            }
+            let row = sets.row(line, corners, [up, low], is_upper);
+            let count = spread(target, row, &ch, reach, field);
+            store_changed(out, if is_upper { kt } else { kb }, field, count, &mut done);
         }
     }
     done
