@@ -306,6 +306,35 @@ fn local_axis(face: &FaceModel, frames: &FaceFrames, t: usize, world_axis: DVec3
     (m.inverse() * world_axis).normalize_or_zero().as_vec3()
 }
 
+/// Rotation tables for `keys` on transform `t`, turning about `centre` (face frame; installed
+/// as the transform's centre unless a table already rotates it).
+fn add_transform_tables(
+    face: &mut FaceModel,
+    t: usize,
+    centre: Vec3,
+    keys: &[FapId],
+    out: &mut StandardRotations,
+) {
+    let name = face.transforms[t].name.clone();
+    if !rotated(face, &name) {
+        install_center(face, t, centre);
+    }
+    let frames = face.frames();
+    for f in keys {
+        let Some(axis) = f.info().rotation_axis() else {
+            continue;
+        };
+        let local = local_axis(face, &frames, t, axis.as_dvec3());
+        let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
+        table
+            .transforms
+            .push(FaceDefTransform::rotation(name.clone(), local, AU as f32));
+        face.fat.tables.push(table);
+        out.added.push(TableKey::LowLevel(*f));
+    }
+    out.transforms.push(name);
+}
+
 /// Adds the eyeball tables `faps` (module docs).
 fn add_eye_tables(
     face: &mut FaceModel,
@@ -345,24 +374,7 @@ fn add_eye_tables(
             .filter(|f| (f.number() % 2 == 1) == left)
             .collect();
         if let Some(t) = own_tf {
-            let name = face.transforms[t].name.clone();
-            if !rotated(face, &name) {
-                install_center(face, t, centre);
-            }
-            let frames = face.frames();
-            for f in &keys {
-                let Some(axis) = f.info().rotation_axis() else {
-                    continue;
-                };
-                let local = local_axis(face, &frames, t, axis.as_dvec3());
-                let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
-                table
-                    .transforms
-                    .push(FaceDefTransform::rotation(name.clone(), local, AU as f32));
-                face.fat.tables.push(table);
-                out.added.push(TableKey::LowLevel(*f));
-            }
-            out.transforms.push(name);
+            add_transform_tables(face, t, centre, &keys, out);
             continue;
         }
         // Per-vertex: every face mesh holding the eye's vertices.
@@ -467,24 +479,7 @@ fn add_head_tables(
     let keys: Vec<FapId> = faps.iter().filter_map(|&n| FapId::new(n)).collect();
     out.pivot = Some((pivot.to_array(), source));
     if let Some(t) = lowest_enclosing(face, &all) {
-        let name = face.transforms[t].name.clone();
-        if !rotated(face, &name) {
-            install_center(face, t, pivot);
-        }
-        let frames = face.frames();
-        for f in &keys {
-            let Some(axis) = f.info().rotation_axis() else {
-                continue;
-            };
-            let local = local_axis(face, &frames, t, axis.as_dvec3());
-            let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
-            table
-                .transforms
-                .push(FaceDefTransform::rotation(name.clone(), local, AU as f32));
-            face.fat.tables.push(table);
-            out.added.push(TableKey::LowLevel(*f));
-        }
-        out.transforms.push(name);
+        add_transform_tables(face, t, pivot, &keys, out);
         return;
     }
     let frames = face.frames();
