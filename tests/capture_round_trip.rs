@@ -33,6 +33,16 @@ fn pearson(a: &[f64], b: &[f64]) -> f64 {
     }
 }
 
+/// How series `got` follows `want`: their correlation and the largest difference.
+fn compare(want: &[f64], got: &[f64]) -> (f64, f64) {
+    let worst = want
+        .iter()
+        .zip(got)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    (pearson(want, got), worst)
+}
+
 /// The moving shapes and their weight at frame `i` of 90.
 const SHAPES: [&str; 5] = [
     "jawOpen",
@@ -157,12 +167,7 @@ fn check_rotations(back: &str) -> fbakit::rig::weights_csv::WeightCsv {
             continue;
         }
         let want: Vec<f64> = (0..90).map(|i| rotation(r, i)).collect();
-        let corr = pearson(&want, &got);
-        let worst = want
-            .iter()
-            .zip(&got)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let (corr, worst) = compare(&want, &got);
         eprintln!(
             "{:<14} r = {corr:.6}, worst |Δ| {worst:.2e} rad",
             rot.column
@@ -190,12 +195,7 @@ fn live_link_round_trip_on_a_face_with_a_fat() {
             .unwrap();
         let got: Vec<f64> = w.rows.iter().map(|r| f64::from(r.weights[c])).collect();
         let want: Vec<f64> = (0..90).map(|i| shape_weight(k, i)).collect();
-        let corr = pearson(&want, &got);
-        let worst = want
-            .iter()
-            .zip(&got)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let (corr, worst) = compare(&want, &got);
         eprintln!("bruno {name:<16} r = {corr:.4}, worst |Δw| {worst:.4}");
         assert!(corr >= 0.95, "{name} r = {corr}");
         assert!(worst < 0.05, "{name}: {worst}");

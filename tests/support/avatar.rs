@@ -40,6 +40,20 @@ pub struct Prim {
     pub joints: Vec<[(u8, f32); 2]>,
 }
 
+impl Prim {
+    /// A primitive named `name` with nothing in it yet.
+    pub fn empty(name: &'static str) -> Prim {
+        Prim {
+            name,
+            positions: vec![],
+            normals: vec![],
+            uvs: vec![],
+            triangles: vec![],
+            joints: vec![],
+        }
+    }
+}
+
 /// The avatar: JSON and its binary buffer.
 pub struct Avatar {
     pub json: Value,
@@ -182,14 +196,7 @@ pub fn eye_layer(
     tilt: glam::Quat,
     share: f32,
 ) -> Prim {
-    let mut layer = Prim {
-        name,
-        positions: vec![],
-        normals: vec![],
-        uvs: vec![],
-        triangles: vec![],
-        joints: vec![],
-    };
+    let mut layer = Prim::empty(name);
     for (left, slot) in [(false, 5u8), (true, 4u8)] {
         let (p, n, uv, t) = sphere(Vec3::ZERO, radius, 2, 8, half_angle);
         let base = layer.positions.len() as u16;
@@ -342,14 +349,7 @@ fn teeth_row(y0: f32, y1: f32) -> (Vec<Vec3>, Vec<Vec2>, Vec<[u16; 3]>) {
 /// the lower row (14..28, jaw joint).
 pub fn teeth_prim() -> Prim {
     let (head, jaw) = (2u8, 3u8);
-    let mut prim = Prim {
-        name: "teeth",
-        positions: vec![],
-        normals: vec![],
-        uvs: vec![],
-        triangles: vec![],
-        joints: vec![],
-    };
+    let mut prim = Prim::empty("teeth");
     let rows = [
         (LIP_Y + TEETH_GAP, LIP_Y + TEETH_GAP + TEETH_HEIGHT, head),
         (LIP_Y - TEETH_GAP - TEETH_HEIGHT, LIP_Y - TEETH_GAP, jaw),
@@ -471,14 +471,7 @@ pub fn body_prims() -> Vec<Prim> {
         triangles: t,
         joints: mouth_joints,
     };
-    let mut eyes = Prim {
-        name: "eyes",
-        positions: vec![],
-        normals: vec![],
-        uvs: vec![],
-        triangles: vec![],
-        joints: vec![],
-    };
+    let mut eyes = Prim::empty("eyes");
     for left in [false, true] {
         let (p, n, uv, t) = eyeball(left);
         let base = eyes.positions.len() as u16;
@@ -490,14 +483,7 @@ pub fn body_prims() -> Vec<Prim> {
         eyes.normals.extend(n);
         eyes.uvs.extend(uv);
     }
-    let mut lashes = Prim {
-        name: "lashes",
-        positions: vec![],
-        normals: vec![],
-        uvs: vec![],
-        triangles: vec![],
-        joints: vec![],
-    };
+    let mut lashes = Prim::empty("lashes");
     for x in [-3.2f32, 3.2] {
         let base = lashes.positions.len() as u16;
         for k in 0..4 {

@@ -131,17 +131,6 @@ fn joint_worlds() -> Vec<Mat4> {
     worlds
 }
 
-fn prim(name: &'static str) -> Prim {
-    Prim {
-        name,
-        positions: vec![],
-        normals: vec![],
-        uvs: vec![],
-        triangles: vec![],
-        joints: vec![],
-    }
-}
-
 /// A UV sphere about `centre` of radius `r` with `grid` = (rings, segments, cap: radians from
 /// the pole where it is cut), turned by `orient` (the unturned pole points along +z), skinned
 /// wholly to `slot`.
@@ -155,7 +144,7 @@ fn sphere_prim(
 ) -> Prim {
     let (rings, segs, cap) = grid;
     let (p, n, uv, t) = avatar::sphere(Vec3::ZERO, r, rings, segs, cap);
-    let mut out = prim(name);
+    let mut out = Prim::empty(name);
     out.positions = p.iter().map(|&x| centre + orient * x).collect();
     out.normals = n.iter().map(|&x| orient * x).collect();
     out.uvs = uv;
@@ -232,7 +221,7 @@ fn tube(
     slots: impl Fn(f32) -> [(u8, f32); 2],
 ) -> Prim {
     let segs = 24;
-    let mut p = prim(name);
+    let mut p = Prim::empty(name);
     for i in 0..=rings {
         let y = y0 + (y1 - y0) * i as f32 / rings as f32;
         for j in 0..=segs {
