@@ -1,7 +1,7 @@
 //! Cloning onto a target file keeps every node of it fbakit does not read, also when the
-//! clone must add transforms: a face without a head transform (a `head` root is added, and
-//! eye transforms under it) whose tongue shares the jaw's transform with the lower teeth (a
-//! tongue transform is added under the jaw).
+//! clone must add transforms: a face without a head transform (none is added: the head turns
+//! become per-vertex tables; eye transforms are added as roots) whose tongue shares the jaw's
+//! transform with the lower teeth (a tongue transform is added under the jaw).
 
 mod support;
 
@@ -101,17 +101,20 @@ fn cloning_keeps_unknown_nodes_when_it_adds_transforms() {
     // Reads back with the new transforms around the old content, in the same places.
     let (cloned, _) = fbakit::face::read_with(&out, &Default::default()).unwrap();
     let names: Vec<&str> = cloned.transforms.iter().map(|t| t.name.as_str()).collect();
-    for t in ["head", "jaw_tf", "tongue_tf"] {
+    for t in ["jaw_tf", "tongue_tf"] {
         assert!(names.contains(&t), "{t} missing from {names:?}");
     }
+    assert!(
+        !names.contains(&"head"),
+        "a head transform was added: {names:?}"
+    );
     let parent = |t: &str| {
         let i = cloned.transform_index(t).unwrap();
         cloned.transforms[i]
             .parent
             .map(|p| cloned.transforms[p].name.as_str())
     };
-    assert_eq!(parent("head"), None);
-    assert_eq!(parent("jaw_tf"), Some("head"));
+    assert_eq!(parent("jaw_tf"), None);
     assert_eq!(parent("tongue_tf"), Some("jaw_tf"));
     let tongue = cloned.mesh_index("tongue").unwrap();
     assert_eq!(
@@ -119,6 +122,23 @@ fn cloning_keeps_unknown_nodes_when_it_adds_transforms() {
         cloned.transform_index("tongue_tf")
     );
     assert!(!cloned.fat.tables.is_empty());
+    // alma's head transform turns become per-vertex turns of the whole face.
+    let head_turns: Vec<_> = cloned
+        .fat
+        .tables
+        .iter()
+        .filter(|t| {
+            matches!(t.key, fbakit::fat::TableKey::LowLevel(f) if (48..=50).contains(&f.number()))
+        })
+        .collect();
+    assert_eq!(head_turns.len(), 3);
+    for t in head_turns {
+        assert!(
+            t.transforms.is_empty() && !t.meshes.is_empty(),
+            "{:?}",
+            t.key
+        );
+    }
     let flat = flat_bruno();
     let (frames, flat_frames) = (cloned.frames(), flat.frames());
     for (m, mesh) in flat.meshes.iter().enumerate() {

@@ -138,9 +138,15 @@ fn ict_left_eyeball_turns_alone() {
 /// `head_yaw` turns the face rigidly about a point behind it; the neck's base stays.
 #[test]
 fn ict_head_yaw_turns_the_face_not_the_neck_base() {
-    let face = ict();
+    assert_head_yaw_keeps_the_neck_base(&ict());
+}
+
+/// `head_yaw` at 0.3 rad turns `face`'s pupils' line by that angle about +y, keeps the
+/// distances between its face points within 0.5 % (the skull turns rigidly), turns the nose
+/// to the face's left and leaves the neck's base (the lowest 2 % of its height) still.
+fn assert_head_yaw_keeps_the_neck_base(face: &FaceModel) {
     let neutral = face.neutral_world_positions();
-    let pose = posed(&face, 49, 30_000.0);
+    let pose = posed(face, 49, 30_000.0);
     let fps = [
         FeaturePointId::FP_3_5,
         FeaturePointId::FP_3_6,
@@ -153,14 +159,12 @@ fn ict_head_yaw_turns_the_face_not_the_neck_base() {
         let (m, v) = face.fp_vertex(id).expect("feature point on the face");
         w[m][v as usize].as_dvec3()
     };
-    // The pupils' line turns by the angle about +y.
     let (a0, a1) = (
         at(&neutral, fps[0]) - at(&neutral, fps[1]),
         at(&pose, fps[0]) - at(&pose, fps[1]),
     );
     let turn = (a0.z.atan2(a0.x)) - (a1.z.atan2(a1.x));
     assert!((turn - 0.3).abs() < 0.01, "pupils turned {turn} rad");
-    // Rigid: distances between face points kept within 0.5 %.
     for i in 0..fps.len() {
         for j in i + 1..fps.len() {
             let d0 = at(&neutral, fps[i]).distance(at(&neutral, fps[j]));
@@ -173,9 +177,7 @@ fn ict_head_yaw_turns_the_face_not_the_neck_base() {
             );
         }
     }
-    // The nose turns to the face's left.
     assert!(at(&pose, fps[5]).x > at(&neutral, fps[5]).x);
-    // The neck's base (the lowest 2 % of the head's height) does not move.
     let all: Vec<Vec3> = neutral.iter().flatten().copied().collect();
     let lo = all.iter().map(|p| p.y).fold(f32::MAX, f32::min);
     let hi = all.iter().map(|p| p.y).fold(f32::MIN, f32::max);
@@ -189,6 +191,43 @@ fn ict_head_yaw_turns_the_face_not_the_neck_base() {
         }
     }
     assert!(base > 0);
+}
+
+/// alma turns her head with a `head` transform; a one-mesh head has none, and the clone
+/// creates none (a root around the user's face would change their asset and turn the neck's
+/// base with the skull): the head turns are re-made per vertex, faded down the neck, with no
+/// warning that they were dropped.
+#[test]
+fn clone_alma_onto_a_one_mesh_head_turns_it_per_vertex() {
+    let work = tempfile::tempdir().expect("temp dir");
+    let Some((_, target)) = support::ict_full_head::ict_full_head(work.path()) else {
+        return;
+    };
+    let alma = fbakit::face::read("alma").expect("alma");
+    assert!(
+        alma.fat
+            .table(key(49))
+            .is_some_and(|t| !t.transforms.is_empty()),
+        "alma turns her head by a transform"
+    );
+    let out = clone_face(&alma, &target, &CloneOptions::default()).expect("clone");
+    let face = out.face;
+    assert!(
+        face.transforms.is_empty(),
+        "no transform added: {:?}",
+        face.transforms
+    );
+    assert_eq!(out.report.rigid.head_transform, None);
+    for w in &out.report.warnings {
+        for bad in ["created transforms", "no counterpart", "are not cloned"] {
+            assert!(!w.message.contains(bad), "{}", w.message);
+        }
+    }
+    for n in [48, 49, 50] {
+        let t = face.fat.table(key(n)).unwrap_or_else(|| panic!("FAP {n}"));
+        assert!(t.transforms.is_empty() && !t.meshes.is_empty(), "FAP {n}");
+    }
+    assert_head_yaw_keeps_the_neck_base(&face);
 }
 
 /// A clone from `ict` turns its target's eyes: per-vertex on a one-mesh OBJ head.

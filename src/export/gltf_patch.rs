@@ -196,6 +196,44 @@ pub fn patch_face(
     // A face fbakit generated and read back: its transforms are nodes of the document (their
     // motion is animated there, not baked) and its lengths may be in other units.
     let unit = gltf_fat::face_unit(&source.json);
+    // A head node of the user's (named, or found by its usual names and carrying the nose
+    // tip) turns the head: the head rotations (48–50) are left to it, not baked into morph
+    // targets (never a rotation and a morph for one motion). A face without a nose tip or
+    // chin cannot be checked: the node is taken.
+    let head = head_node(source, nodes).filter(|&n| {
+        [FeaturePointId::FP_9_3, FeaturePointId::FP_2_1]
+            .into_iter()
+            .find(|&id| face.feature_points.position(id).is_some())
+            .is_none_or(|nose| {
+                node_takes(
+                    NodeCheck {
+                        source,
+                        face,
+                        node: n,
+                        role: "head",
+                        fp: nose,
+                        named: nodes.head.is_some(),
+                        motion: "the head rotations",
+                        option: "--head-node",
+                    },
+                    &mut warnings,
+                )
+            })
+    });
+    // Head turns given per vertex (a clone onto a face without a head transform gets the
+    // standard's rotations that way) become one turn of that node about its origin, as a
+    // head transform's would: the user's rig bends the neck, and the turn is not also a morph.
+    let turned;
+    let face = match head.filter(|_| head_transform(face).is_none()) {
+        Some(n) => match head_turns_on_node(face, source, n, unit) {
+            Some(f) => {
+                turned = f;
+                &turned
+            }
+            None => face,
+        },
+        None => face,
+    };
     let by_name = gltf_fat::transform_nodes(&source.json);
     let mut transform_nodes: Vec<Option<usize>> = face
         .transforms
@@ -229,30 +267,6 @@ pub fn patch_face(
         parted = without_parts(face, &parts);
         &parted
     };
-    // A head node of the user's (named, or found by its usual names and carrying the nose
-    // tip) turns the head: the head rotations (48–50) are left to it, not baked into morph
-    // targets (never a rotation and a morph for one motion). A face without a nose tip or
-    // chin cannot be checked: the node is taken.
-    let head = head_node(source, nodes).filter(|&n| {
-        [FeaturePointId::FP_9_3, FeaturePointId::FP_2_1]
-            .into_iter()
-            .find(|&id| face.feature_points.position(id).is_some())
-            .is_none_or(|nose| {
-                node_takes(
-                    NodeCheck {
-                        source,
-                        face,
-                        node: n,
-                        role: "head",
-                        fp: nose,
-                        named: nodes.head.is_some(),
-                        motion: "the head rotations",
-                        option: "--head-node",
-                    },
-                    &mut warnings,
-                )
-            })
-    });
     // The transform the head rotations turn (the cloner's `head`) is shown by that node:
     // recorded as a user node like the eyes, so the written file reads back with the head's
     // motion, and animated there. A transform on a node of fbakit's own keeps it.
@@ -621,6 +635,63 @@ fn without_head_rotations(face: &FaceModel, transform_nodes: &[Option<usize>]) -
         .tables
         .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
     out
+}
+
+/// `face` with its per-vertex head rotation tables (48–50) turned into rotations of a new
+/// root transform above every mesh, centred on node `node`'s rest origin (face frame: the
+/// file's world / `unit`), which the caller maps onto that node; `None` when no head table is
+/// given per vertex alone.
+fn head_turns_on_node(
+    face: &FaceModel,
+    source: &GltfSource,
+    node: usize,
+    unit: f32,
+) -> Option<FaceModel> {
+    let per_vertex = |t: &crate::fat::FaceDefTable| {
+        matches!(t.key, TableKey::LowLevel(f) if HEAD_FAPS.contains(&f.number()))
+            && t.transforms.is_empty()
+            && !t.meshes.is_empty()
+    };
+    if !face.fat.tables.iter().any(per_vertex) || unit <= 0.0 {
+        return None;
+    }
+    let origin = UserNode::new(&source.json, node)?.world_origin() / unit;
+    let mut out = face.clone();
+    let mut name = "head".to_string();
+    let mut k = 1;
+    while out.transform_index(&name).is_some() || out.mesh_index(&name).is_some() {
+        k += 1;
+        name = format!("head_{k}");
+    }
+    // A root above everything, first (parents come before children).
+    for t in &mut out.transforms {
+        t.parent = Some(t.parent.map_or(0, |p| p + 1));
+    }
+    for m in &mut out.meshes {
+        m.transform = Some(m.transform.map_or(0, |t| t + 1));
+    }
+    out.transforms.insert(
+        0,
+        crate::face::FaceTransform::new(name.clone(), None, origin),
+    );
+    for table in out.fat.tables.iter_mut().filter(|t| per_vertex(t)) {
+        let TableKey::LowLevel(f) = table.key else {
+            continue;
+        };
+        let Some(axis) = f.info().rotation_axis() else {
+            continue;
+        };
+        table.meshes.clear();
+        // One AU (1e-5 rad) per FAP unit, the standard's angle.
+        table
+            .transforms
+            .push(crate::fat::FaceDefTransform::rotation(
+                name.clone(),
+                axis,
+                1e-5,
+            ));
+    }
+    Some(out)
 }
 
 /// The one transform the head rotation tables (48–50) turn, if they turn exactly one.

@@ -292,6 +292,11 @@ impl UserNode {
         (r.normalize(), t)
     }
 
+    /// The node's origin in the file's world frame at rest.
+    pub fn world_origin(&self) -> Vec3 {
+        self.world.w_axis.truncate()
+    }
+
     /// The rest translation.
     pub fn rest_translation(&self) -> Vec3 {
         self.rest_translation

@@ -1070,3 +1070,44 @@ pub fn fp_csv(
     std::fs::write(&path, body).unwrap();
     path
 }
+
+/// `face diff` of a clone onto an avatar without a head transform (`cloned`, whose head turns
+/// are per-vertex tables: the clone creates no transform) and the file written from it
+/// (`back`, whose head turns are one rotation each of a root above every mesh, shown by the
+/// avatar's head node). Checks that shape of the head tables, then compares the rest.
+pub fn same_fat_head_on_node(
+    cloned: &fbakit::face::FaceModel,
+    back: &fbakit::face::FaceModel,
+) -> fbakit::snapshot::FaceDiff {
+    use fbakit::fat::TableKey;
+    let is_head =
+        |k: TableKey| matches!(k, TableKey::LowLevel(f) if (48..=50).contains(&f.number()));
+    let (mut cloned, mut back) = (cloned.clone(), back.clone());
+    for f in 48u8..=50 {
+        let key = TableKey::LowLevel(fbakit::spec::FapId::new(f).unwrap());
+        let c = cloned.fat.table(key).expect("the clone turns the head");
+        assert!(c.transforms.is_empty() && !c.meshes.is_empty(), "FAP {f}");
+        let b = back.fat.table(key).expect("the file turns the head");
+        assert!(b.meshes.is_empty(), "FAP {f} is also a morph");
+        assert_eq!(b.transforms.len(), 1, "FAP {f}");
+        let t = back.transform_index(&b.transforms[0].transform).unwrap();
+        assert!(back.transforms[t].parent.is_none(), "the head is a root");
+    }
+    cloned.fat.tables.retain(|t| !is_head(t.key));
+    back.fat.tables.retain(|t| !is_head(t.key));
+    // The root above everything that the file's head node shows, its rest the identity.
+    let head = back
+        .transforms
+        .iter()
+        .position(|t| t.parent.is_none() && cloned.transform_index(&t.name).is_none())
+        .expect("a head transform in the file");
+    back.transforms.remove(head);
+    let shift = |i: usize| if i > head { i - 1 } else { i };
+    for x in &mut back.transforms {
+        x.parent = x.parent.filter(|&p| p != head).map(shift);
+    }
+    for m in &mut back.meshes {
+        m.transform = m.transform.filter(|&p| p != head).map(shift);
+    }
+    fbakit::snapshot::diff(&cloned, &back, &fbakit::snapshot::DiffOptions::default())
+}

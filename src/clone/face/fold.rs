@@ -9,8 +9,8 @@
 //! size at every FAP value the table covers. A cut mesh goes back under a transform above
 //! every piece's (both eye whites of one primitive: not the left eye's transform, which an
 //! iris mesh of its own keeps). The face returned has exactly the target's
-//! meshes, vertices and polygons; its transforms are the target's plus those that still hold
-//! a mesh (a created root `head`).
+//! meshes, vertices and polygons; its transforms are the target's plus those created for
+//! whole part meshes that still hold one (never a head: step 7 creates none).
 
 use std::collections::{BTreeSet, HashMap};
 

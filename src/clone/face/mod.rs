@@ -152,8 +152,10 @@
 //! 7. **`rigid`** — transforms ([`RigidReport`]): the target's part transforms are the lowest
 //!    transforms enclosing each part's meshes; the head's encloses all face meshes. A part
 //!    sharing its lowest transform with other meshes (a tongue under the jaw with the lower
-//!    teeth is fine for the teeth, not for the tongue) gets a new transform, child of that one;
-//!    a face without transforms gets a root `head`. Centres: eyes at their eyeball centre
+//!    teeth is fine for the teeth, not for the tongue) gets a new transform, child of that one
+//!    (a root without one). No head transform is ever created: a root wrapped around the
+//!    user's face would change their asset and turn the neck's base with the skull, so a
+//!    source's head turns onto a face without one are re-made in step 10. Centres: eyes at their eyeball centre
 //!    (least-squares sphere fit of the eye's largest piece, the eye white, not the caps in
 //!    front of it; bounding-box centre if that piece is no sphere), head at 7.1;
 //!    a transform the source rotates that has no centre (zero) gets the source's centre mapped
@@ -206,9 +208,10 @@
 //!     centre and about 7.1 (derived where missing), on the target's eye and head transforms
 //!     where it has them, else as per-vertex tables (the head's faded down the neck). A
 //!     source's own eye and head turns given as vertex motion (a rig's) are re-made this way
-//!     too, about the target's centres; given as transform rotations they map in step 7. The
-//!     target's `head` transform is created in step 7 only when the source's head motion
-//!     drives it.
+//!     too, about the target's centres; given as transform rotations they map in step 7 —
+//!     except head turns onto a target without a head transform, which are re-made here as
+//!     per-vertex tables (their tables from step 8 give way). A source turn the target gets no
+//!     table for (no pupils, no eye part) is named in a warning.
 //!
 //! Rotations from the FAT are taken as composed after the neutral rotation (`R₀·ΔR`), so their
 //! axes live in the transform's own rotated frame.
@@ -339,6 +342,14 @@ pub fn clone_face(
         }
         .into());
     }
+    // The source's eye and head turns, to say which the clone could not re-make.
+    let source_turns: Vec<TableKey> = source
+        .fat
+        .tables
+        .iter()
+        .map(|t| t.key)
+        .filter(|&k| standard::is_standard_rotation(k))
+        .collect();
     // Eye and head turns a source moves as vertex motion (a rig's, the bundled `ict`'s) are
     // rotations by definition: the target gets them about its own centres (`standard`) rather
     // than through the skin's surface method, which cannot carry a rigid turn of its parts.
@@ -583,12 +594,43 @@ pub fn clone_face(
     let clock = Instant::now();
     // The target's cut from step 1, unless `fit` took the whole mesh and nothing was cut.
     let cut = (!whole).then_some(view.as_ref());
+    if rigid.remakes_head_turns() {
+        // The source turns its head transform and the target has none: what the head
+        // tables hold now (the skin's share of the turn, if any) gives way to the whole turn.
+        face.fat
+            .tables
+            .retain(|t| !matches!(t.key, TableKey::LowLevel(f) if (48..=50).contains(&f.number())));
+    }
     report.standard_rotations = standard::add_standard_rotations_cut(&mut face, cut);
+    warn_lost_turns(&source_turns, &face, &mut report);
     report.timings.push("turns", clock.elapsed().as_secs_f64());
     report.tables = face.fat.tables.len();
     report.source_parts = sparts;
     report.target_parts = tparts;
     Ok(CloneOutcome { face, report })
+}
+
+/// Warns about the source's eye and head turns (`source_turns`) that the clone `face` has no
+/// table for, with the standard step's reasons (no pupils, no eye part).
+fn warn_lost_turns(source_turns: &[TableKey], face: &FaceModel, report: &mut CloneReport) {
+    let lost: Vec<String> = source_turns
+        .iter()
+        .filter(|&&k| face.fat.table(k).is_none())
+        .map(|k| k.name())
+        .collect();
+    if lost.is_empty() {
+        return;
+    }
+    let why = &report.standard_rotations.skipped;
+    report.warnings.push(Diagnostic::warning(format!(
+        "the source's turns {} are not cloned ({})",
+        lost.join(", "),
+        if why.is_empty() {
+            "the target has no part for them".to_string()
+        } else {
+            why.join("; ")
+        }
+    )));
 }
 
 /// Steps 5 and 6: the surface method on the motions that move the skin, then (RBF) the FAPU

@@ -14,7 +14,7 @@ use crate::face::FaceModel;
 pub struct RigidReport {
     /// Target transform used for each part (by name).
     pub part_transforms: BTreeMap<Part, String>,
-    /// Target head transform.
+    /// Target head transform (the lowest one enclosing every face mesh; none is created).
     pub head_transform: Option<String>,
     /// Transforms fbakit created.
     pub created_transforms: Vec<String>,

@@ -144,7 +144,13 @@ impl RigidPlan {
                     continue;
                 };
                 let Some(&(role, tt)) = self.map.get(&st) else {
-                    dropped_tf.insert(x.transform.clone());
+                    // Head turns onto a face without a head transform are re-made by the
+                    // standard step (10), not lost.
+                    if !(Some(st) == self.standard_head
+                        && super::standard::is_standard_rotation(table.key))
+                    {
+                        dropped_tf.insert(x.transform.clone());
+                    }
                     continue;
                 };
                 out.transforms

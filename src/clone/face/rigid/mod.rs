@@ -1,5 +1,5 @@
-//! Rigid parts by transforms (module docs of [`super`], step 7): the target's part and head
-//! transforms are found or created, their centres installed, and source transforms mapped to
+//! Rigid parts by transforms (module docs of [`super`], step 7): the target's head transform
+//! is found (never created), its part transforms found or created, their centres installed, and source transforms mapped to
 //! them by role ([`RigidPlan`]); [`entries`] then writes the FAT's transform entries.
 
 mod centres;
@@ -34,6 +34,9 @@ pub(super) struct RigidPlan {
     map: HashMap<usize, (Role, usize)>,
     /// Target tongue transform (for rigid tongue motion).
     tongue: Option<usize>,
+    /// The source's head transform when it drives head motion the target has no head
+    /// transform for: its head turns (48–50) are re-made by the standard step instead.
+    standard_head: Option<usize>,
 }
 
 /// What the source FAT drives: transforms it moves or rotates, and the parts that therefore
@@ -97,8 +100,8 @@ fn tongue_mesh_names<'a>(source: &'a FaceModel, sparts: &FaceParts) -> HashSet<&
 }
 
 impl RigidPlan {
-    /// Prepares the target `face` for rigid motion: head and part transforms (created where
-    /// missing), their centres, and the map from source transforms. Fills `report.rigid` and
+    /// Prepares the target `face` for rigid motion: its head transform (if any) and part
+    /// transforms (created where missing), their centres, and the map from source transforms. Fills `report.rigid` and
     /// warns about created transforms and parts only one face has.
     pub(super) fn install(
         source: &FaceModel,
@@ -111,15 +114,22 @@ impl RigidPlan {
         let (sroles, shead) = roles(source, sparts);
         let drive = SourceDrive::of(source, sparts, &sroles);
         let mut created = Vec::new();
-        // A head transform is created only for the source's head motion to drive: the
-        // standard's head turns (`standard`) bake into a face without one.
+        // The head is the target's own transform enclosing every face mesh, never a new one:
+        // a root wrapped around a user's face would change their asset, and it would turn the
+        // neck's base with the skull. Without one, the source's head turns are re-made as the
+        // standard's per-vertex rotations, faded down the neck (step 10).
+        let head = lowest_enclosing(face, &tparts.face_meshes());
         let head_driven =
             shead.is_some_and(|h| drive.driven.contains(source.transforms[h].name.as_str()));
-        let head = if head_driven {
-            Some(head_transform(face, tparts, &mut created))
-        } else {
-            lowest_enclosing(face, &tparts.face_meshes())
-        };
+        let standard_head = shead.filter(|&h| {
+            head.is_none()
+                && source.fat.tables.iter().any(|t| {
+                    standard::is_standard_rotation(t.key)
+                        && t.transforms
+                            .iter()
+                            .any(|x| x.transform == source.transforms[h].name)
+                })
+        });
         let part_tf = part_transforms(face, tparts, head, &drive.needed, &mut created);
         if !created.is_empty() {
             // The kept scene stays: its writer inserts the new transforms where their
@@ -164,27 +174,15 @@ impl RigidPlan {
         Ok(RigidPlan {
             map,
             tongue: part_tf.get(&Part::Tongue).copied(),
+            standard_head,
         })
     }
-}
 
-/// The head transform: the lowest transform enclosing every face mesh, or a new root `head`
-/// above everything (its name goes to `created`).
-fn head_transform(face: &mut FaceModel, tparts: &FaceParts, created: &mut Vec<String>) -> usize {
-    if let Some(h) = lowest_enclosing(face, &tparts.face_meshes()) {
-        return h;
+    /// Whether the source's head turns (48–50) drive a head transform the target does not
+    /// have: the clone then re-makes them as the standard's rotations (step 10).
+    pub(super) fn remakes_head_turns(&self) -> bool {
+        self.standard_head.is_some()
     }
-    let name = unique_name(face, "head");
-    for t in &mut face.transforms {
-        t.parent = Some(t.parent.map_or(0, |p| p + 1));
-    }
-    for m in &mut face.meshes {
-        m.transform = Some(m.transform.map_or(0, |t| t + 1));
-    }
-    face.transforms
-        .insert(0, FaceTransform::new(name.clone(), None, Vec3::ZERO));
-    created.push(name);
-    0
 }
 
 /// The transform of each target part: its lowest enclosing transform when that holds only
