@@ -581,8 +581,9 @@ pub fn clone_face(
         .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
     // Eye and head turns the source does not give (module docs, step 10).
     let clock = Instant::now();
-    // The target's cut from step 1, unless `fit` took the whole mesh and nothing was cut.
-    let cut = (!whole).then_some(view.as_ref());
+    // The target's cut from step 1 with its parts, unless `fit` took the whole mesh and
+    // nothing was cut.
+    let cut = (!whole).then_some(view.as_ref().map(|v| (v, &tparts)));
     report.standard_rotations = standard::add_standard_rotations_cut(&mut face, cut);
     report.timings.push("turns", clock.elapsed().as_secs_f64());
     report.tables = face.fat.tables.len();
