@@ -67,6 +67,27 @@
 //! interior, face pieces) side by side — `fit:sides` stayed at 9.1 ms.
 //! `ict_to_its_dense_remesh`, same conditions, two runs each: medians 1.407 / 1.553 →
 //! 1.389 / 1.510 s.
+//!
+//! Helper `speed9`: `lid_close` and `lid_seam` spread each row's change only over the
+//! vertices inside the row's box grown by the bump's reach (1 % and a rounding margin more:
+//! outside it the weight is exactly zero), instead of measuring every skin vertex's distance
+//! to the row; the `turns` step borrows the clone's cut view and target parts instead of
+//! cloning the view face and sorting its meshes into parts again; `fold`'s cut band finds an
+//! entry's rows through a table over the mesh instead of two hash maps and a vector per row.
+//! Same output bit for bit (hash of the whole cloned face's `Debug` text `b30de834699e5e7f`
+//! at main's `71c1bb7`, before and after each change). Measured on the shared machine only
+//! (load 4–6, three sessions), old and new binaries alternated: a probe of the same clone
+//! (5 clones a run, two pairs at load 5.6), step medians lid_close 10.2 → 0.7, lid_seam
+//! 10.2 → 0.7, fold 37.7 / 37.9 → 16.9 / 18.0, turns 22.0 / 21.6 → 9.0 / 9.7 ms, totals
+//! 789 / 749 → 732 / 711 ms; whole process (setup and 3 clones, six alternated pairs, load
+//! 5.5) CPU 1.909 → 1.823 s, wall 2.891 → 2.763 s (pair ratio median 0.948), peak memory
+//! 135.5 → 134.0 MB. This bench (`-- fit`), three alternated pairs at load 6.0–6.2: medians
+//! 745.4 / 747.8 / 777.0 → 712.6 / 551.7 / 718.0 ms; peak memory 117–122 → 112–115 MB.
+//! Expected on a quiet machine: ~30 ms less (lids ~6.1 → ~0.7 ms each, turns ~11 → ~5,
+//! fold ~20 → ~12), not measured quietly, so the 0.3 s target is not shown. Not
+//! attempted: `fit:register`'s factorisations (the largest lever left) each wait for the
+//! searches before them and the searches for them, so only work outside the registration
+//! could use the idle core.
 
 use std::path::Path;
 use std::sync::OnceLock;

@@ -417,15 +417,22 @@ impl CutBand {
         if n == 0 {
             return entry;
         }
-        let slot: HashMap<u32, usize> = entry
+        // Each vertex's row in the entry (the last, if listed twice), `NONE` if unlisted: a
+        // table over the mesh, not a hash map (one per table, tens of thousands of rows).
+        const NONE: u32 = u32::MAX;
+        let size = entry
             .coord_index
             .iter()
-            .enumerate()
-            .map(|(k, &v)| (v, k))
-            .collect();
-        let rate = |v: u32, j: usize| {
-            slot.get(&v)
-                .map_or(Vec3::ZERO, |&k| entry.displacements[k * n + j])
+            .map(|&v| v as usize + 1)
+            .chain(self.band.iter().map(|&(v, _)| v as usize + 1))
+            .fold(self.local.len(), usize::max);
+        let mut slot = vec![NONE; size];
+        for (k, &v) in entry.coord_index.iter().enumerate() {
+            slot[v as usize] = k as u32;
+        }
+        let rate = |v: u32, j: usize| match slot[v as usize] {
+            NONE => Vec3::ZERO,
+            k => entry.displacements[k as usize * n + j],
         };
         // Per interval, each side's motion as an affine map (lower, upper).
         let maps: Vec<[Option<AffineFit>; 2]> = (0..n)
@@ -435,35 +442,39 @@ impl CutBand {
                 })
             })
             .collect();
-        // Vertices of the band the entry did not list join it.
-        let mut rows: Vec<(u32, Vec<Vec3>)> = entry
+        // Rows (vertex, its rates' place in `rates`): the entry's, then vertices of the band
+        // the entry did not list.
+        let mut rows: Vec<(u32, usize)> = entry
             .coord_index
             .iter()
             .enumerate()
-            .map(|(k, &v)| (v, entry.displacements[k * n..(k + 1) * n].to_vec()))
+            .map(|(k, &v)| (v, k))
             .collect();
-        let mut at: HashMap<u32, usize> = slot.clone();
+        let mut rates_of: Vec<Vec3> = entry.displacements[..rows.len() * n].to_vec();
+        let mut at = slot.clone();
+        let mut rates: Vec<Vec3> = Vec::with_capacity(n);
         for &(v, share) in &self.band {
             let p = self.local[v as usize];
-            let rates: Vec<Vec3> = maps
-                .iter()
-                .enumerate()
-                .map(|(j, [lower, upper])| {
-                    let side = |f: &Option<AffineFit>| f.as_ref().map_or(rate(v, j), |f| f.at(p));
-                    let (l, u) = (side(lower), side(upper));
-                    u + share * (l - u)
-                })
-                .collect();
+            rates.clear();
+            rates.extend(maps.iter().enumerate().map(|(j, [lower, upper])| {
+                let side = |f: &Option<AffineFit>| f.as_ref().map_or(rate(v, j), |f| f.at(p));
+                let (l, u) = (side(lower), side(upper));
+                u + share * (l - u)
+            }));
             if !rates.iter().all(|r| r.is_finite()) {
                 continue;
             }
-            match at.get(&v) {
-                Some(&r) => rows[r].1 = rates,
-                None => {
+            match at[v as usize] {
+                NONE => {
                     if rates.iter().any(|r| *r != Vec3::ZERO) {
-                        at.insert(v, rows.len());
-                        rows.push((v, rates));
+                        at[v as usize] = rows.len() as u32;
+                        rows.push((v, rates_of.len() / n));
+                        rates_of.extend_from_slice(&rates);
                     }
+                }
+                r => {
+                    let k = rows[r as usize].1;
+                    rates_of[k * n..(k + 1) * n].copy_from_slice(&rates);
                 }
             }
         }
@@ -472,7 +483,10 @@ impl CutBand {
             mesh: entry.mesh,
             interval_borders: entry.interval_borders,
             coord_index: rows.iter().map(|r| r.0).collect(),
-            displacements: rows.into_iter().flat_map(|r| r.1).collect(),
+            displacements: rows
+                .iter()
+                .flat_map(|&(_, k)| rates_of[k * n..(k + 1) * n].iter().copied())
+                .collect(),
         }
     }
 }

@@ -429,8 +429,12 @@ pub(super) fn spread(
         let t = along(row.corners, p).clamp(0.0, 1.0);
         p.y - (o.y + t * (i.y - o.y))
     };
+    let near = reach_box(target, &row, reach);
     let mut count = 0;
     for (v, p) in target.positions.iter().enumerate() {
+        if near.is_some_and(|(lo, hi)| p.cmplt(lo).any() || p.cmpgt(hi).any()) {
+            continue;
+        }
         let v32 = v as u32;
         let on = row.own.contains(&v32);
         if (!on && (side(*p) > 0.0) != row.is_upper)
@@ -454,6 +458,32 @@ pub(super) fn spread(
         }
     }
     count
+}
+
+/// The box [`spread`] reaches: around the row's neutral points and its own vertices, grown
+/// by `reach` and a margin for rounding (1 % of it, and 1e-5 of the box's largest
+/// coordinate). A vertex outside it is none of the row's and lies further than `reach` from
+/// the row, where the bump is zero: skipping it changes nothing. `None` (no box: visit
+/// every vertex) when `reach` is not positive or the box not finite.
+fn reach_box(target: &CloneSurface, row: &Row, reach: f32) -> Option<(Vec3, Vec3)> {
+    if !(reach > 0.0 && reach.is_finite()) {
+        return None;
+    }
+    let own = row
+        .own
+        .iter()
+        .filter_map(|&v| target.positions.get(v as usize));
+    let (lo, hi) = row
+        .line
+        .iter()
+        .chain(own)
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    let scale = lo.abs().max(hi.abs()).max_element();
+    let grow = Vec3::splat(1.01 * reach + 1e-5 * scale);
+    let (lo, hi) = (lo - grow, hi + grow);
+    (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
 }
 
 /// A vertex's vertical motion `y` changed to `to`, held back where the change closes the

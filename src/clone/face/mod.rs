@@ -592,8 +592,9 @@ pub fn clone_face(
         .retain(|t| !t.meshes.is_empty() || !t.transforms.is_empty());
     // Eye and head turns the source does not give (module docs, step 10).
     let clock = Instant::now();
-    // The target's cut from step 1, unless `fit` took the whole mesh and nothing was cut.
-    let cut = (!whole).then_some(view.as_ref());
+    // The target's cut from step 1 with its parts, unless `fit` took the whole mesh and
+    // nothing was cut.
+    let cut = (!whole).then_some(view.as_ref().map(|v| (v, &tparts)));
     if rigid.remakes_head_turns() {
         // The source turns its head transform and the target has none: what the head
         // tables hold now (the skin's share of the turn, if any) gives way to the whole turn.

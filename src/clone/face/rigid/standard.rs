@@ -38,6 +38,7 @@
 //!
 //! Tables the FAT has are never replaced; eye tables need both pupils, head tables the pupils.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use rayon::prelude::*;
@@ -48,7 +49,7 @@ use serde::Serialize;
 use super::centres::{eyeball_centre, install_center};
 use super::hierarchy::{encloses, lowest_enclosing};
 use crate::clone::face::eyeball::eye_white_points;
-use crate::clone::face::split::{split_view, SplitView};
+use crate::clone::face::split::{split_view, SplitPart, SplitView};
 use crate::clone::face::{identify_parts, FaceParts, Part};
 use crate::face::{FaceFrames, FaceModel};
 use crate::fat::{FaceDefMesh, FaceDefTable, FaceDefTransform, TableKey, TransformField};
@@ -116,11 +117,12 @@ pub fn add_standard_rotations(face: &mut FaceModel) -> StandardRotations {
 }
 
 /// [`add_standard_rotations`] with the face's cut already known (`cut`: what `split_view`
-/// gave for it, `None` inside: nothing to cut), as the clone has it: cutting again costs
-/// about as much as the clone's whole `parts` step.
+/// gave for it with the parts of its view face, cut parts included, `None` inside: nothing
+/// to cut), as the clone has it: cutting again costs about as much as the clone's whole
+/// `parts` step, and sorting the view's meshes into parts again half of this step.
 pub(in crate::clone::face) fn add_standard_rotations_cut(
     face: &mut FaceModel,
-    cut: Option<Option<&SplitView>>,
+    cut: Option<Option<(&SplitView, &FaceParts)>>,
 ) -> StandardRotations {
     let mut out = StandardRotations::default();
     let missing = |f: &FaceModel, n: u8| {
@@ -243,37 +245,43 @@ fn baked_entry(
 }
 
 /// The face cut into parts as the clone sees it, with each view mesh's vertices in the
-/// face's own meshes: `(view face, parts, view mesh → (face mesh, its vertex per view vertex))`.
-type PartView = (FaceModel, FaceParts, BTreeMap<usize, (usize, Vec<u32>)>);
+/// face's own meshes: `(view face, parts, view mesh → (face mesh, its vertex per view vertex))`
+/// (the view face and its parts borrowed from the clone's cut when it handed them).
+type PartView<'a> = (
+    Cow<'a, FaceModel>,
+    Cow<'a, FaceParts>,
+    BTreeMap<usize, (usize, Vec<u32>)>,
+);
 
 /// The part view of `face` (its FAT set aside so a one-mesh head it deforms can be cut).
-fn part_view(face: &mut FaceModel, cut: Option<Option<&SplitView>>) -> PartView {
-    let (vface, split) = match cut {
-        Some(Some(v)) => (v.face.clone(), v.parts.clone()),
-        Some(None) => (face.clone(), Vec::new()),
+fn part_view<'a>(
+    face: &mut FaceModel,
+    cut: Option<Option<(&'a SplitView, &'a FaceParts)>>,
+) -> PartView<'a> {
+    let (vface, split, known) = match cut {
+        Some(Some((v, parts))) => (
+            Cow::Borrowed(&v.face),
+            Cow::Borrowed(v.parts.as_slice()),
+            Some(parts),
+        ),
+        Some(None) => (Cow::Owned(face.clone()), Cow::Owned(Vec::new()), None),
         None => {
             let fat = std::mem::take(&mut face.fat);
             let view = split_view(face);
             face.fat = fat;
             match view {
-                Some(v) => (v.face, v.parts),
-                None => (face.clone(), Vec::new()),
+                Some(v) => (Cow::Owned(v.face), Cow::Owned(v.parts), None),
+                None => (Cow::Owned(face.clone()), Cow::Owned(Vec::new()), None),
             }
         }
     };
-    let mut parts = identify_parts(&vface);
-    let mut map = BTreeMap::new();
-    for (vi, m) in vface.meshes.iter().enumerate() {
-        if let Some(s) = split.iter().find(|s| s.mesh == m.name) {
-            if let Some(fi) = face.mesh_index(&s.from) {
-                map.insert(vi, (fi, s.source_vertices.clone()));
-            }
-        } else if let Some(fi) = face.mesh_index(&m.name) {
-            map.insert(vi, (fi, (0..m.mesh.positions.len() as u32).collect()));
-        }
+    let map = view_map(face, &vface, &split);
+    if let Some(parts) = known {
+        return (vface, Cow::Borrowed(parts), map);
     }
+    let mut parts = identify_parts(&vface);
     // Cut parts are parts whatever the feature-point sort made of them (as in cloning).
-    for s in &split {
+    for s in split.iter() {
         if let Some(mi) = vface.mesh_index(&s.mesh) {
             parts.skin.retain(|&m| m != mi);
             parts.other.retain(|&m| m != mi);
@@ -284,7 +292,27 @@ fn part_view(face: &mut FaceModel, cut: Option<Option<&SplitView>>) -> PartView 
         }
     }
     parts.parts.retain(|_, l| !l.is_empty());
-    (vface, parts, map)
+    (vface, Cow::Owned(parts), map)
+}
+
+/// Each mesh of the view face `vface` (cut from `face` by `split`) in the face's own
+/// meshes: view mesh → (face mesh, its vertex per view vertex).
+fn view_map(
+    face: &FaceModel,
+    vface: &FaceModel,
+    split: &[SplitPart],
+) -> BTreeMap<usize, (usize, Vec<u32>)> {
+    let mut map = BTreeMap::new();
+    for (vi, m) in vface.meshes.iter().enumerate() {
+        if let Some(s) = split.iter().find(|s| s.mesh == m.name) {
+            if let Some(fi) = face.mesh_index(&s.from) {
+                map.insert(vi, (fi, s.source_vertices.clone()));
+            }
+        } else if let Some(fi) = face.mesh_index(&m.name) {
+            map.insert(vi, (fi, (0..m.mesh.positions.len() as u32).collect()));
+        }
+    }
+    map
 }
 
 /// Whether a table rotates transform `name`.
@@ -339,7 +367,7 @@ fn add_transform_tables(
 fn add_eye_tables(
     face: &mut FaceModel,
     faps: &[u8],
-    cut: Option<Option<&SplitView>>,
+    cut: Option<Option<(&SplitView, &FaceParts)>>,
     out: &mut StandardRotations,
 ) {
     let (vface, parts, map) = part_view(face, cut);
