@@ -250,7 +250,7 @@ impl GltfPatch {
         if let Some(anim) = &self.animation {
             add_animation(&mut b, anim);
         }
-        super::reclaim::drop_released(&mut b.json, &mut b.bin, &b.released);
+        super::reclaim::drop_released(&mut b.json, &mut b.bin, &b.released, &file, &mut warnings);
         if let Some(buffers) = b.json.get_mut("buffers") {
             if let Some(first) = buffers.get_mut(0) {
                 first["byteLength"] = json!(b.bin.len());
