@@ -444,7 +444,7 @@ fn a_bin_that_would_replace_an_input_file_is_refused() {
     // Through the library: `clone.gltf` over itself would replace its `clone.bin` (refused,
     // nothing written); `other.gltf` over itself writes `other.bin` and leaves `clone.bin`.
     let face = fbakit::face::read(dir.join("clone.gltf")).unwrap();
-    let e = fbakit::export::write_face(&dir.join("clone.gltf"), &face).unwrap_err();
+    let e = fbakit::export::write_face(dir.join("clone.gltf"), &face).unwrap_err();
     assert!(e.is_input_error(), "{e}");
     assert!(e.to_string().contains("clone.bin"), "{e}");
     assert!(before == snapshot(&dir), "files changed");
