@@ -30,17 +30,18 @@ struct Layout {
     input: PathBuf,
     /// The texture's bytes.
     png: Vec<u8>,
-    /// `clone alma models/avatar.gltf -o cloned/clone.gltf` (another folder).
+    /// `clone alma models/avatar.gltf -o results/cloned/clone.gltf` (another folder, one
+    /// deeper).
     cloned: PathBuf,
     /// `clone alma models/avatar.gltf -o models/clone.gltf` (the input's folder).
     cloned_here: PathBuf,
-    /// `play models/clone.gltf lowlevel.fap -o out/play.gltf`.
+    /// `play models/clone.gltf lowlevel.fap -o results/out/play.gltf`.
     played: PathBuf,
-    /// `face export models/clone.gltf -o out/export.gltf` (the image already there, same
-    /// bytes).
+    /// `face export models/clone.gltf -o results/out/export.gltf` (the image already there,
+    /// same bytes).
     exported: PathBuf,
-    /// `face export models/clone.gltf -o foreign/face.gltf`, a foreign `skin base.png` in
-    /// `foreign/`.
+    /// `face export models/clone.gltf -o results/foreign/face.gltf`, a foreign
+    /// `skin base.png` in `results/foreign/`.
     foreign: PathBuf,
     /// The stderr of each run, by output.
     stderr: Vec<(PathBuf, String)>,
@@ -99,14 +100,17 @@ fn layout() -> &'static Layout {
         let alma = fbakit::face::read("alma").unwrap();
         let fp = avatar::fp_csv(&alma, &dir, "");
         let mut stderr = Vec::new();
-        let cloned = dir.join("cloned/clone.gltf");
-        std::fs::create_dir_all(dir.join("cloned")).unwrap();
+        // Outputs one folder deeper than the input, so that an image URI carried over
+        // unchanged (`../textures/…`) would name a file that is not there.
+        let res = dir.join("results");
+        let cloned = res.join("cloned/clone.gltf");
+        std::fs::create_dir_all(res.join("cloned")).unwrap();
         stderr.push((cloned.clone(), clone_to(&input, &fp, &cloned)));
         let cloned_here = dir.join("models/clone.gltf");
         stderr.push((cloned_here.clone(), clone_to(&input, &fp, &cloned_here)));
 
-        std::fs::create_dir_all(dir.join("out")).unwrap();
-        let played = dir.join("out/play.gltf");
+        std::fs::create_dir_all(res.join("out")).unwrap();
+        let played = res.join("out/play.gltf");
         let lowlevel = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/lowlevel.fap");
         stderr.push((
             played.clone(),
@@ -120,14 +124,14 @@ fn layout() -> &'static Layout {
                 played.as_os_str(),
             ]),
         ));
-        let exported = dir.join("out/export.gltf");
+        let exported = res.join("out/export.gltf");
         let o = export_to(&cloned_here, &exported);
         assert!(o.status.success(), "{}", text(&o.stderr));
         stderr.push((exported.clone(), text(&o.stderr)));
 
-        std::fs::create_dir_all(dir.join("foreign")).unwrap();
-        std::fs::write(dir.join("foreign").join(IMAGE), b"the user's own file").unwrap();
-        let foreign = dir.join("foreign/face.gltf");
+        std::fs::create_dir_all(res.join("foreign")).unwrap();
+        std::fs::write(res.join("foreign").join(IMAGE), b"the user's own file").unwrap();
+        let foreign = res.join("foreign/face.gltf");
         let o = export_to(&cloned_here, &foreign);
         assert!(o.status.success(), "{}", text(&o.stderr));
         stderr.push((foreign.clone(), text(&o.stderr)));
@@ -210,7 +214,7 @@ fn outputs_get_their_own_bin_and_images_that_resolve() {
     }
     assert!(!l.dir.join("models").join(IMAGE).exists());
     assert_eq!(
-        std::fs::read(l.dir.join("foreign").join(IMAGE)).unwrap(),
+        std::fs::read(l.foreign.with_file_name(IMAGE)).unwrap(),
         b"the user's own file"
     );
     // The input is untouched by the clone written beside it.
@@ -420,7 +424,7 @@ fn a_bin_that_would_replace_an_input_file_is_refused() {
     for f in ["clone.gltf", "clone.bin"] {
         std::fs::copy(l.cloned.with_file_name(f), dir.join(f)).unwrap();
     }
-    std::fs::copy(l.cloned.with_file_name(IMAGE), dir.join(IMAGE)).unwrap();
+    std::fs::write(dir.join(IMAGE), &l.png).unwrap();
     // `other.gltf` is the clone under another name, its buffer still `clone.bin`.
     std::fs::copy(dir.join("clone.gltf"), dir.join("other.gltf")).unwrap();
     let before = snapshot(&dir);
@@ -469,8 +473,8 @@ fn an_unknown_extension_keeps_every_accessor_and_says_so() {
     let dir = l.dir.join("unknown");
     std::fs::create_dir_all(&dir).unwrap();
     let mut json = json_of(&l.cloned);
-    json["buffers"][0]["uri"] = "../cloned/clone.bin".into();
-    json["images"][0]["uri"] = "../cloned/skin%20base.png".into();
+    json["buffers"][0]["uri"] = "../results/cloned/clone.bin".into();
+    json["images"][0]["uri"] = "../results/cloned/skin%20base.png".into();
     let plain = dir.join("plain.gltf");
     std::fs::write(&plain, serde_json::to_vec(&json).unwrap()).unwrap();
     json["extensionsUsed"] = serde_json::json!(["EXT_fbakit_test"]);
@@ -508,4 +512,28 @@ fn an_unknown_extension_keeps_every_accessor_and_says_so() {
         json_of(&dir.join("ext-out.gltf"))["nodes"][0]["extensions"],
         json["nodes"][0]["extensions"]
     );
+}
+
+/// An image whose file is missing: the output keeps its URI and `face export` warns, naming
+/// the file it looked for.
+#[test]
+fn a_missing_image_is_named_and_its_uri_kept() {
+    let l = layout();
+    let dir = l.dir.join("missing");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut json = json_of(&l.cloned);
+    json["buffers"][0]["uri"] = "../results/cloned/clone.bin".into();
+    json["images"][0]["uri"] = "gone%20away.png".into();
+    let input = dir.join("face.gltf");
+    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    let out = l.dir.join("results/missing-out.gltf");
+    let o = export_to(&input, &out);
+    let stderr = text(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    let named = dir.join("gone away.png");
+    assert!(
+        stderr.contains(&named.display().to_string()) && stderr.contains("does not exist"),
+        "{stderr}"
+    );
+    assert_eq!(json_of(&out)["images"][0]["uri"], "gone%20away.png");
 }
