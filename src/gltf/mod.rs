@@ -77,6 +77,7 @@ pub mod container;
 pub mod decode;
 mod document;
 mod error;
+mod images;
 pub mod json;
 mod layout;
 mod normals;

@@ -19,8 +19,9 @@
 //! `min`/`max`; new buffer views carry no `target`.
 //!
 //! [`PatchedGltf::write`] writes `.glb` (one `BIN` chunk), or `.gltf` with the buffer as
-//! `<stem>.bin` beside it; images the document references by relative URI are copied next to
-//! the output when it is written to another folder.
+//! `<stem>.bin` beside it; images the document references by relative URI are carried to the
+//! output's folder when it is another, their URIs rewritten (`images`). A `<stem>.bin` that
+//! would replace one of the input's own files is refused before anything is written.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -28,6 +29,7 @@ use std::path::{Path, PathBuf};
 use glam::{Quat, Vec3};
 use serde_json::{json, Map, Value};
 
+use super::images::{self, uri_escape};
 use super::source::GltfSource;
 use super::GltfError;
 use crate::error::{Diagnostic, Result};
@@ -36,8 +38,6 @@ use crate::error::{Diagnostic, Result};
 const FLOAT: u32 = 5126;
 /// `componentType` UNSIGNED_INT.
 const UNSIGNED_INT: u32 = 5125;
-/// Largest image copied beside an output: 1 GiB.
-const MAX_IMAGE_BYTES: u64 = 1 << 30;
 
 /// The morph targets added to one glTF mesh.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -104,6 +104,9 @@ pub struct PatchedGltf {
     pub bin: Vec<u8>,
     /// The folder relative image URIs were resolved against.
     pub source_dir: PathBuf,
+    /// The input's own files: the document, its external buffers and images (none of them
+    /// may be replaced by the output's `.bin`).
+    pub inputs: Vec<PathBuf>,
     /// What could not be kept exactly.
     pub warnings: Vec<Diagnostic>,
 }
@@ -247,19 +250,32 @@ impl GltfPatch {
         if let Some(anim) = &self.animation {
             add_animation(&mut b, anim);
         }
-        super::reclaim::drop_released(&mut b.json, &mut b.bin, &b.released);
+        super::reclaim::drop_released(&mut b.json, &mut b.bin, &b.released, &file, &mut warnings);
         if let Some(buffers) = b.json.get_mut("buffers") {
             if let Some(first) = buffers.get_mut(0) {
                 first["byteLength"] = json!(b.bin.len());
             }
         }
+        let source_dir = source
+            .path
+            .parent()
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        warnings.extend(images::missing(&b.json, &source_dir, &file));
+        let mut inputs = vec![source.path.clone()];
+        inputs.extend(
+            source.json["buffers"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(|buf| images::relative_file(buf["uri"].as_str()?))
+                .map(|rel| source_dir.join(rel)),
+        );
+        inputs.extend(images::files(&b.json, &source_dir));
         Ok(PatchedGltf {
             json: b.json,
             bin: b.bin,
-            source_dir: source
-                .path
-                .parent()
-                .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+            source_dir,
+            inputs,
             warnings,
         })
     }
@@ -593,7 +609,12 @@ fn add_animation(b: &mut Builder, anim: &PatchAnimation) {
 
 impl PatchedGltf {
     /// Writes `.glb` or `.gltf` (+ `<stem>.bin`) as `path`'s extension says, atomically per
-    /// file, and copies relatively referenced images beside it.
+    /// file, with the images the document names by relative URI carried beside it (see
+    /// `images`). Refused before anything is written (exit code 2) when the `.bin`, or the
+    /// output itself, would replace one of the input's buffers or images: the input is read
+    /// whole, but a `.gltf` and its `.bin` are two files, and a write stopped between them
+    /// would leave the input's `.gltf` pointing into a rewritten buffer. The output may
+    /// replace the input document itself (it is replaced last, atomically).
     pub fn write(&self, path: &Path) -> Result<()> {
         use crate::format::OutputFormat;
         let format = OutputFormat::resolve(
@@ -601,130 +622,103 @@ impl PatchedGltf {
             &[OutputFormat::Glb, OutputFormat::Gltf],
             "glTF output",
         )?;
-        self.copy_images(path)?;
-        if format == OutputFormat::Glb {
-            crate::io::write_atomic(path, &self.to_glb()?)
-        } else {
+        let out_dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let file_name = path.file_name().map_or_else(
+            || std::ffi::OsString::from("model"),
+            std::ffi::OsStr::to_os_string,
+        );
+        let bin_name = (format == OutputFormat::Gltf).then(|| {
             let stem = path
                 .file_stem()
                 .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
-            let bin_name = format!("{stem}.bin");
-            let mut json = self.json.clone();
-            if let Some(first) = json["buffers"].get_mut(0) {
-                first["uri"] = json!(uri_escape(&bin_name));
+            format!("{stem}.bin")
+        });
+        let document = self.inputs.first();
+        let own_files = self.inputs.iter().skip(1);
+        if let Some(input) = own_files.clone().find(|i| same_file(path, i)) {
+            return Err(crate::error::Error::Usage(format!(
+                "{}: is {}, a file {} reads; choose another output name",
+                path.display(),
+                input.display(),
+                document.map_or_else(String::new, |d| d.display().to_string())
+            )));
+        }
+        if let Some(bin) = &bin_name {
+            let bin_path = out_dir.join(bin);
+            if let Some(input) = own_files.clone().find(|i| same_file(&bin_path, i)) {
+                return Err(crate::error::Error::Usage(format!(
+                    "{}: writing {} there would replace {}, which {} reads; choose another \
+                     output name",
+                    bin_path.display(),
+                    path.display(),
+                    input.display(),
+                    document.map_or_else(String::new, |d| d.display().to_string())
+                )));
             }
-            crate::io::write_atomic(&path.with_file_name(&bin_name), &self.bin)?;
-            let mut text = serde_json::to_string_pretty(&json)
-                .map_err(|e| GltfError::Serialize(e.to_string()))?;
-            text.push('\n');
-            crate::io::write_atomic(path, text.as_bytes())
+        }
+        let mut reserved = vec![out_dir.join(&file_name)];
+        reserved.extend(bin_name.iter().map(|b| out_dir.join(b)));
+        let placement = images::place(&self.json, &self.source_dir, out_dir, &reserved)?;
+        let mut json = self.json.clone();
+        placement.set_uris(&mut json);
+        placement.copy()?;
+        match bin_name {
+            None => crate::io::write_atomic(path, &glb_bytes(&json, &self.bin)?),
+            Some(bin_name) => {
+                if let Some(first) = json["buffers"].get_mut(0) {
+                    first["uri"] = json!(uri_escape(&bin_name));
+                }
+                crate::io::write_atomic(&out_dir.join(&bin_name), &self.bin)?;
+                let mut text = serde_json::to_string_pretty(&json)
+                    .map_err(|e| GltfError::Serialize(e.to_string()))?;
+                text.push('\n');
+                crate::io::write_atomic(path, text.as_bytes())
+            }
         }
     }
 
     /// The document as `.glb` bytes.
     pub fn to_glb(&self) -> Result<Vec<u8>> {
-        let mut json =
-            serde_json::to_vec(&self.json).map_err(|e| GltfError::Serialize(e.to_string()))?;
-        json.resize(json.len().next_multiple_of(4), b' ');
-        let bin_len = self.bin.len().next_multiple_of(4);
-        let total = 12 + 8 + json.len() + if self.bin.is_empty() { 0 } else { 8 + bin_len };
-        let total = u32::try_from(total).map_err(|_| GltfError::AssetTooLarge)?;
-        let mut out = Vec::with_capacity(total as usize);
-        for w in [
-            super::container::GLB_MAGIC,
-            super::container::GLB_VERSION,
-            total,
-            json.len() as u32,
-            super::container::CHUNK_JSON,
-        ] {
-            out.extend_from_slice(&w.to_le_bytes());
-        }
-        out.extend_from_slice(&json);
-        if !self.bin.is_empty() {
-            out.extend_from_slice(&(bin_len as u32).to_le_bytes());
-            out.extend_from_slice(&super::container::CHUNK_BIN.to_le_bytes());
-            out.extend_from_slice(&self.bin);
-            out.resize(total as usize, 0);
-        }
-        Ok(out)
-    }
-
-    /// Copies images referenced by relative URIs from the source folder to the output's
-    /// folder when the two differ (an existing file of the same name is left alone).
-    fn copy_images(&self, path: &Path) -> Result<()> {
-        let out_dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let same = match (out_dir.canonicalize(), self.source_dir.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        };
-        if same {
-            return Ok(());
-        }
-        for img in self.json["images"].as_array().into_iter().flatten() {
-            let Some(uri) = img["uri"].as_str() else {
-                continue;
-            };
-            if uri.starts_with("data:") || uri.contains("://") || uri.starts_with('/') {
-                continue;
-            }
-            let rel = uri_unescape(uri);
-            if rel.split(['/', '\\']).any(|c| c == "..") {
-                continue;
-            }
-            let from = self.source_dir.join(&rel);
-            let to = out_dir.join(&rel);
-            if to.exists() || !from.is_file() {
-                continue;
-            }
-            if let Some(dir) = to.parent() {
-                std::fs::create_dir_all(dir).map_err(|e| crate::error::Error::io(dir, e))?;
-            }
-            let bytes = crate::io::read_bounded(&from, MAX_IMAGE_BYTES)?;
-            crate::io::write_atomic(&to, &bytes)?;
-        }
-        Ok(())
+        glb_bytes(&self.json, &self.bin)
     }
 }
 
-/// A file name as a relative URI (`%`, spaces and other reserved bytes escaped).
-fn uri_escape(name: &str) -> String {
-    let mut out = String::with_capacity(name.len());
-    for b in name.bytes() {
-        if b.is_ascii_alphanumeric() || b"-_.~".contains(&b) {
-            out.push(b as char);
-        } else {
-            out.push_str(&format!("%{b:02X}"));
-        }
+/// Whether `a` and `b` are one existing file (after resolving links).
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
     }
-    out
 }
 
-/// `%XX` decoding (malformed escapes kept as they are).
-fn uri_unescape(s: &str) -> String {
-    let b = s.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        let hex = (b[i] == b'%')
-            .then(|| b.get(i + 1..i + 3))
-            .flatten()
-            .and_then(|h| std::str::from_utf8(h).ok())
-            .and_then(|h| u8::from_str_radix(h, 16).ok());
-        match hex {
-            Some(v) => {
-                out.push(v);
-                i += 3;
-            }
-            None => {
-                out.push(b[i]);
-                i += 1;
-            }
-        }
+/// `json` and `bin` as `.glb` bytes.
+fn glb_bytes(json: &Value, bin: &[u8]) -> Result<Vec<u8>> {
+    let mut json = serde_json::to_vec(json).map_err(|e| GltfError::Serialize(e.to_string()))?;
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let bin_len = bin.len().next_multiple_of(4);
+    let total = 12 + 8 + json.len() + if bin.is_empty() { 0 } else { 8 + bin_len };
+    let total = u32::try_from(total).map_err(|_| GltfError::AssetTooLarge)?;
+    let mut out = Vec::with_capacity(total as usize);
+    for w in [
+        super::container::GLB_MAGIC,
+        super::container::GLB_VERSION,
+        total,
+        json.len() as u32,
+        super::container::CHUNK_JSON,
+    ] {
+        out.extend_from_slice(&w.to_le_bytes());
     }
-    String::from_utf8_lossy(&out).into_owned()
+    out.extend_from_slice(&json);
+    if !bin.is_empty() {
+        out.extend_from_slice(&(bin_len as u32).to_le_bytes());
+        out.extend_from_slice(&super::container::CHUNK_BIN.to_le_bytes());
+        out.extend_from_slice(bin);
+        out.resize(total as usize, 0);
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

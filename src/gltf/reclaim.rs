@@ -6,8 +6,87 @@
 //! validator, and a file that grows with every write. Only accessors the patch released and
 //! nothing references any more are dropped; references are renumbered where glTF (and the
 //! extensions that point at accessors or views) keeps them.
+//!
+//! An extension fbakit does not know may hold accessor or view indices it cannot renumber:
+//! when the document uses one, nothing is dropped (the file keeps the unused data, and a
+//! warning names the extensions), since a wrong index would break the user's file.
+
+use std::collections::BTreeSet;
 
 use serde_json::Value;
+
+use crate::error::Diagnostic;
+
+/// Extensions whose accessor and buffer view indices the walks below renumber.
+const WALKED: &[&str] = &["EXT_mesh_gpu_instancing", "KHR_draco_mesh_compression"];
+
+/// Extensions whose JSON holds no accessor or buffer view index (only factors, texture,
+/// image, node, mesh or material indices, morph target slots, which dropping accessors does
+/// not move), so they never stop the cleanup.
+const HOLD_NO_ACCESSORS: &[&str] = &[
+    "KHR_animation_pointer",
+    "KHR_lights_punctual",
+    "KHR_materials_anisotropy",
+    "KHR_materials_clearcoat",
+    "KHR_materials_diffuse_transmission",
+    "KHR_materials_dispersion",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_iridescence",
+    "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_sheen",
+    "KHR_materials_specular",
+    "KHR_materials_transmission",
+    "KHR_materials_unlit",
+    "KHR_materials_variants",
+    "KHR_materials_volume",
+    "KHR_mesh_quantization",
+    "KHR_texture_basisu",
+    "KHR_texture_transform",
+    "KHR_xmp_json_ld",
+    "EXT_texture_avif",
+    "EXT_texture_webp",
+    "VRM",
+    "VRMC_materials_mtoon",
+    "VRMC_node_constraint",
+    "VRMC_springBone",
+    "VRMC_vrm",
+];
+
+/// The extensions `json` uses that fbakit cannot renumber references in: named in
+/// `extensionsUsed` or as a key of an `extensions` object anywhere (extras, the user's own
+/// data, are not looked into).
+fn unknown_extensions(json: &Value) -> BTreeSet<String> {
+    fn walk(v: &Value, out: &mut BTreeSet<String>) {
+        match v {
+            Value::Object(o) => {
+                for (k, child) in o {
+                    match k.as_str() {
+                        "extras" => {}
+                        "extensions" => {
+                            if let Some(e) = child.as_object() {
+                                out.extend(e.keys().cloned());
+                            }
+                            walk(child, out);
+                        }
+                        _ => walk(child, out),
+                    }
+                }
+            }
+            Value::Array(a) => a.iter().for_each(|c| walk(c, out)),
+            _ => {}
+        }
+    }
+    let mut names: BTreeSet<String> = json["extensionsUsed"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|n| n.as_str().map(str::to_string))
+        .collect();
+    walk(json, &mut names);
+    names.retain(|n| !WALKED.contains(&n.as_str()) && !HOLD_NO_ACCESSORS.contains(&n.as_str()));
+    names
+}
 
 /// A walk over one kind of reference (accessor or buffer view indices) of a document.
 type Visit = fn(&mut Value, &mut dyn FnMut(&mut Value));
@@ -147,15 +226,34 @@ fn view_refs(json: &mut Value, f: &mut dyn FnMut(&mut Value)) {
 
 /// Drops the accessors `released` that nothing references any more, then the buffer views
 /// only they used, then those views' bytes in `bin` (buffer 0; the views after them move down,
-/// keeping their 4-byte alignment).
-pub(super) fn drop_released(json: &mut Value, bin: &mut Vec<u8>, released: &[usize]) {
+/// keeping their 4-byte alignment). In a document using an extension fbakit cannot renumber,
+/// keeps them all and says so in `warnings` (`file` names the document).
+pub(super) fn drop_released(
+    json: &mut Value,
+    bin: &mut Vec<u8>,
+    released: &[usize],
+    file: &str,
+    warnings: &mut Vec<Diagnostic>,
+) {
     let n_acc = json["accessors"].as_array().map_or(0, Vec::len);
     let refs = counts(json, n_acc, accessor_refs);
     let mut drop_acc = vec![false; n_acc];
     for &a in released.iter().filter(|&&a| a < n_acc && refs[a] == 0) {
         drop_acc[a] = true;
     }
-    if !drop_acc.contains(&true) {
+    let unused = drop_acc.iter().filter(|&&d| d).count();
+    if unused == 0 {
+        return;
+    }
+    let unknown = unknown_extensions(json);
+    if !unknown.is_empty() {
+        let names: Vec<&str> = unknown.iter().map(String::as_str).collect();
+        warnings.push(Diagnostic::warning(format!(
+            "{file}: kept {unused} unused accessors (fbakit's replaced morph targets) because \
+             the document uses {}, whose references fbakit cannot renumber; the file is \
+             larger than it needs to be",
+            names.join(", ")
+        )));
         return;
     }
     // The views the dropped accessors used.
@@ -262,7 +360,7 @@ mod tests {
         });
         let mut bin: Vec<u8> = (0..20).collect();
         // Accessor 1 (released, referenced by nothing) goes; 0 and 2 are used and stay.
-        drop_released(&mut json, &mut bin, &[1]);
+        drop_released(&mut json, &mut bin, &[1], "d.gltf", &mut Vec::new());
         assert_eq!(json["accessors"].as_array().unwrap().len(), 2);
         assert_eq!(
             json["meshes"][0]["primitives"][0]["attributes"]["POSITION"],
@@ -285,6 +383,51 @@ mod tests {
     }
 
     #[test]
+    fn an_unknown_extension_keeps_everything_and_says_so() {
+        let doc = |ext: Value| {
+            json!({
+                "extensionsUsed": ["KHR_materials_specular"],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 1}, "extensions": ext}]}],
+                "accessors": [{"count": 1, "bufferView": 0}, {"count": 1, "bufferView": 1}],
+                "bufferViews": [
+                    {"buffer": 0, "byteOffset": 0, "byteLength": 4},
+                    {"buffer": 0, "byteOffset": 4, "byteLength": 4}
+                ],
+                "materials": [{"extensions": {"KHR_materials_specular": {"specularFactor": 0.5}}}],
+                "extras": {"extensions": {"MY_NOTE": {}}}
+            })
+        };
+        // Known ones (and an `extensions` key inside extras) do not stop the cleanup.
+        let mut json = doc(json!({}));
+        let mut bin = vec![0u8; 8];
+        let mut warnings = Vec::new();
+        drop_released(&mut json, &mut bin, &[0], "d.gltf", &mut warnings);
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(json["accessors"].as_array().unwrap().len(), 1);
+        assert_eq!(bin.len(), 4);
+        // An unknown one on a primitive, or only listed as used: nothing dropped, a warning.
+        for mut json in [doc(json!({"EXT_foo": {"accessor": 0}})), {
+            let mut j = doc(json!({}));
+            j["extensionsUsed"] = json!(["EXT_foo"]);
+            j
+        }] {
+            let before = json.clone();
+            let mut bin = vec![0u8; 8];
+            let mut warnings = Vec::new();
+            drop_released(&mut json, &mut bin, &[0], "d.gltf", &mut warnings);
+            assert_eq!(json, before);
+            assert_eq!(bin.len(), 8);
+            assert_eq!(warnings.len(), 1);
+            let w = &warnings[0].message;
+            assert!(
+                w.contains("d.gltf: kept 1 unused accessors") && w.contains("EXT_foo"),
+                "{w}"
+            );
+            assert!(!w.contains("KHR_materials_specular"), "{w}");
+        }
+    }
+
+    #[test]
     fn a_released_accessor_still_referenced_stays() {
         let mut json = json!({
             "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": 0}]}]}],
@@ -293,7 +436,7 @@ mod tests {
         });
         let before = json.clone();
         let mut bin = vec![0u8; 4];
-        drop_released(&mut json, &mut bin, &[0]);
+        drop_released(&mut json, &mut bin, &[0], "d.gltf", &mut Vec::new());
         assert_eq!(json, before);
         assert_eq!(bin.len(), 4);
     }

@@ -32,13 +32,22 @@ if (!validator) {
 
 try {
   for (const file of process.argv.slice(2)) {
+    const dir = path.dirname(path.resolve(file));
     const report = await validator.validateBytes(new Uint8Array(readFileSync(file)), {
       uri: path.basename(file),
       // Every issue counted: patched avatars carry hundreds of hints, which must not hide a
       // warning behind the cut.
       maxIssues: 0,
-      // Sidecar files are not used by fbakit; refuse any external reference.
-      externalResourceFunction: (uri) => Promise.reject(`external resource ${uri} not allowed`),
+      // A `.gltf`'s buffers and images are read beside it, as a loader would (a file that is
+      // not there is the validator's IO_ERROR).
+      externalResourceFunction: (uri) =>
+        new Promise((resolve, reject) => {
+          try {
+            resolve(new Uint8Array(readFileSync(path.resolve(dir, decodeURIComponent(uri)))));
+          } catch (e) {
+            reject(`${uri}: ${e.message}`);
+          }
+        }),
     });
     const issues = report.issues;
     console.log(
