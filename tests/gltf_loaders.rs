@@ -18,31 +18,7 @@ use std::path::PathBuf;
 
 use serde_json::Value;
 use support::avatar;
-use support::loader_outputs::{gltf_outputs, json_of, scene_nodes};
-use support::node_check::run_node_check;
-
-/// three.js's view of each file, or `None` (with a note) when a tool is missing.
-fn load_in_three(files: &[&PathBuf]) -> Option<Vec<Value>> {
-    let text = run_node_check(
-        "gltf-loaders-check.mjs",
-        files,
-        &[
-            ("THREE_DIR", "target/gltf-loaders"),
-            ("VIEWER_BROWSER_DIR", "target/viewer-browser"),
-        ],
-        "GLTF_LOADERS_REQUIRED",
-        "three.js loader",
-    )?;
-    let reports: Vec<Value> = text
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(reports.len(), files.len());
-    for r in &reports {
-        eprintln!("{}", summary(r));
-    }
-    Some(reports)
-}
+use support::loader_outputs::{assert_clean, gltf_outputs, json_of, load_in_three_js, scene_nodes};
 
 /// One line per file: what three.js made of it (shown with `--nocapture` or on failure).
 fn summary(r: &Value) -> String {
@@ -89,20 +65,6 @@ fn strings(v: &Value) -> Vec<String> {
         .iter()
         .map(|s| s.as_str().unwrap_or_else(|| panic!("{s}")).to_string())
         .collect()
-}
-
-/// No load error, nothing on the console, no request but the file's own.
-fn assert_clean(r: &Value) {
-    let file = &r["file"];
-    assert!(r.get("loadError").is_none(), "{file}: {}", r["loadError"]);
-    for k in [
-        "consoleErrors",
-        "consoleWarnings",
-        "pageErrors",
-        "foreignRequests",
-    ] {
-        assert_eq!(r[k], Value::Array(vec![]), "{file}: {k}");
-    }
 }
 
 /// three.js's nodes are the document's scene nodes, by index and name.
@@ -250,6 +212,15 @@ fn assert_avatar(r: &Value, input: &Value, output: &Value, played: bool) -> Vec<
         assert_eq!(clips, 1, "{file}");
     }
     names
+}
+
+/// three.js's view of each file, each summarised on stderr.
+fn load_in_three(files: &[&PathBuf]) -> Option<Vec<Value>> {
+    let reports = load_in_three_js(files)?;
+    for r in &reports {
+        eprintln!("{}", summary(r));
+    }
+    Some(reports)
 }
 
 #[test]

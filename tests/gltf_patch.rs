@@ -405,21 +405,7 @@ fn validator_finds_no_new_issue() {
     else {
         return;
     };
-    // Errors and warnings (severities 0 and 1) by code.
-    let issues = |r: &Value| {
-        let mut codes: Vec<String> = r["messages"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(|m| {
-                let mut words = m.as_str()?.split_whitespace();
-                let severity: u8 = words.next()?.parse().ok()?;
-                (severity <= 1).then(|| words.next().unwrap_or("").to_string())
-            })
-            .collect();
-        codes.sort();
-        codes
-    };
+    let issues = support::validator::issue_codes;
     if std::env::var_os("FBAKIT_SHOW_VALIDATOR").is_some() {
         for r in &reports {
             eprintln!("{r}");
@@ -531,16 +517,7 @@ fn target_names_that_do_not_match_are_refused() {
     let input = dir.path().join("bad.glb");
     std::fs::write(&input, a.to_glb()).unwrap();
     let out = dir.path().join("out.glb");
-    let run = command()
-        .args([
-            "face".as_ref(),
-            "export".as_ref(),
-            input.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ])
-        .output()
-        .unwrap();
+    let run = support::cli::face_export(&input, &out);
     assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
     let err = text(&run.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
@@ -723,20 +700,7 @@ fn the_jaw_joint_takes_the_jaw_faps_over_from_the_morphs() {
     let Some(reports) = support::validator::validate(&[input.clone(), out.clone()]) else {
         return;
     };
-    let issues = |r: &Value| {
-        let mut codes: Vec<String> = r["messages"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(|m| {
-                let mut words = m.as_str()?.split_whitespace();
-                let severity: u8 = words.next()?.parse().ok()?;
-                (severity <= 1).then(|| words.next().unwrap_or("").to_string())
-            })
-            .collect();
-        codes.sort();
-        codes
-    };
+    let issues = support::validator::issue_codes;
     assert_eq!(issues(&reports[0]), issues(&reports[1]), "{}", reports[1]);
 }
 
@@ -823,16 +787,7 @@ fn float_joints_are_refused() {
     let input = dir.path().join("float-joints.glb");
     std::fs::write(&input, a.to_glb()).unwrap();
     let out = dir.path().join("out.glb");
-    let run = command()
-        .args([
-            "face".as_ref(),
-            "export".as_ref(),
-            input.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ])
-        .output()
-        .unwrap();
+    let run = support::cli::face_export(&input, &out);
     assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
     let err = text(&run.stderr);
     assert!(

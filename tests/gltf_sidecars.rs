@@ -16,9 +16,8 @@ use std::sync::OnceLock;
 
 use serde_json::Value;
 use support::avatar;
-use support::cli::{command, text};
-use support::loader_outputs::json_of;
-use support::node_check::run_node_check;
+use support::cli::{clone_alma_to, face_export, run_ok, text};
+use support::loader_outputs::{assert_clean, json_of, load_in_three_js};
 
 /// The image's name in the user's texture folder (a space, so URIs are escaped).
 const IMAGE: &str = "skin base.png";
@@ -43,40 +42,10 @@ struct Layout {
     /// `face export models/clone.gltf -o results/foreign/face.gltf`, a foreign
     /// `skin base.png` in `results/foreign/`.
     foreign: PathBuf,
+    /// `clone alma models/avatar.gltf -o results/glb/clone.glb`: one self-contained file.
+    glb: PathBuf,
     /// The stderr of each run, by output.
     stderr: Vec<(PathBuf, String)>,
-}
-
-fn run(args: &[&std::ffi::OsStr]) -> String {
-    let out = command().args(args).output().unwrap();
-    let stderr = text(&out.stderr);
-    assert!(out.status.success(), "fbakit {args:?}: {stderr}");
-    stderr
-}
-
-fn clone_to(input: &Path, fp: &Path, out: &Path) -> String {
-    run(&[
-        "clone".as_ref(),
-        "alma".as_ref(),
-        input.as_os_str(),
-        "--fp-target".as_ref(),
-        fp.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-    ])
-}
-
-fn export_to(input: &Path, out: &Path) -> std::process::Output {
-    command()
-        .args([
-            "face".as_ref(),
-            "export".as_ref(),
-            input.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ])
-        .output()
-        .unwrap()
 }
 
 fn layout() -> &'static Layout {
@@ -105,16 +74,19 @@ fn layout() -> &'static Layout {
         let res = dir.join("results");
         let cloned = res.join("cloned/clone.gltf");
         std::fs::create_dir_all(res.join("cloned")).unwrap();
-        stderr.push((cloned.clone(), clone_to(&input, &fp, &cloned)));
+        stderr.push((cloned.clone(), clone_alma_to(&input, &fp, &cloned)));
         let cloned_here = dir.join("models/clone.gltf");
-        stderr.push((cloned_here.clone(), clone_to(&input, &fp, &cloned_here)));
+        stderr.push((
+            cloned_here.clone(),
+            clone_alma_to(&input, &fp, &cloned_here),
+        ));
 
         std::fs::create_dir_all(res.join("out")).unwrap();
         let played = res.join("out/play.gltf");
         let lowlevel = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/lowlevel.fap");
         stderr.push((
             played.clone(),
-            run(&[
+            run_ok(&[
                 "play".as_ref(),
                 cloned_here.as_os_str(),
                 lowlevel.as_os_str(),
@@ -125,20 +97,24 @@ fn layout() -> &'static Layout {
             ]),
         ));
         let exported = res.join("out/export.gltf");
-        let o = export_to(&cloned_here, &exported);
+        let o = face_export(&cloned_here, &exported);
         assert!(o.status.success(), "{}", text(&o.stderr));
         stderr.push((exported.clone(), text(&o.stderr)));
 
         std::fs::create_dir_all(res.join("foreign")).unwrap();
         std::fs::write(res.join("foreign").join(IMAGE), b"the user's own file").unwrap();
         let foreign = res.join("foreign/face.gltf");
-        let o = export_to(&cloned_here, &foreign);
+        let o = face_export(&cloned_here, &foreign);
         assert!(o.status.success(), "{}", text(&o.stderr));
         stderr.push((foreign.clone(), text(&o.stderr)));
+        std::fs::create_dir_all(res.join("glb")).unwrap();
+        let glb = res.join("glb/clone.glb");
+        stderr.push((glb.clone(), clone_alma_to(&input, &fp, &glb)));
         Layout {
             dir,
             input,
             png,
+            glb,
             cloned,
             cloned_here,
             played,
@@ -231,21 +207,45 @@ fn outputs_get_their_own_bin_and_images_that_resolve() {
     }
 }
 
-/// Errors and warnings (severities 0 and 1) of a validator report, by code.
-fn issue_codes(r: &Value) -> Vec<String> {
-    let mut codes: Vec<String> = r["messages"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|m| {
-            let mut words = m.as_str()?.split_whitespace();
-            let severity: u8 = words.next()?.parse().ok()?;
-            (severity <= 1).then(|| words.next().unwrap_or("").to_string())
-        })
+/// A `.glb` written from the `.gltf` is one file: the texture embedded in its binary chunk
+/// (was: copied beside it under the old URI scheme), nothing else written beside it.
+#[test]
+fn a_glb_output_embeds_the_texture() {
+    let l = layout();
+    let bytes = std::fs::read(&l.glb).unwrap();
+    let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+    let json: Value = serde_json::from_slice(chunks.json).unwrap();
+    let bin = chunks.bin.unwrap();
+    let buffers = json["buffers"].as_array().unwrap();
+    assert_eq!(buffers.len(), 1);
+    assert!(buffers[0].get("uri").is_none(), "{}", buffers[0]);
+    // The chunk is padded to 4 bytes; the buffer is what the views use.
+    let length = buffers[0]["byteLength"].as_u64().unwrap() as usize;
+    assert!(
+        length <= bin.len() && bin.len() - length < 4,
+        "{length} of {}",
+        bin.len()
+    );
+    let image = &json["images"][0];
+    assert!(image.get("uri").is_none(), "{image}");
+    assert_eq!(image["mimeType"], "image/png");
+    let view = &json["bufferViews"][image["bufferView"].as_u64().unwrap() as usize];
+    let at = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let len = view["byteLength"].as_u64().unwrap() as usize;
+    assert_eq!(bin[at..at + len], l.png[..]);
+    let beside: Vec<_> = std::fs::read_dir(l.glb.parent().unwrap())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
         .collect();
-    codes.sort();
-    codes.dedup();
-    codes
+    assert_eq!(beside, [std::ffi::OsString::from("clone.glb")]);
+    // Read back, it is the clone written as `.gltf`.
+    let a = fbakit::face::read(&l.glb).unwrap();
+    let b = fbakit::face::read(&l.cloned).unwrap();
+    assert_eq!(a.meshes.len(), b.meshes.len());
+    for (x, y) in a.meshes.iter().zip(&b.meshes) {
+        assert_eq!(x.mesh.positions, y.mesh.positions, "{}", x.name);
+    }
+    assert_eq!(a.fat.tables.len(), b.fat.tables.len());
 }
 
 /// The Khronos validator, reading each document's `.bin` and images beside it, finds no error
@@ -261,11 +261,12 @@ fn validator_finds_no_new_issue_with_the_files_beside() {
         l.played.clone(),
         l.exported.clone(),
         l.foreign.clone(),
+        l.glb.clone(),
     ];
     let Some(reports) = support::validator::validate(&files) else {
         return;
     };
-    let base = issue_codes(&reports[0]);
+    let base = support::validator::issue_codes(&reports[0]);
     eprintln!(
         "validator on the input: {base:?} ({} infos)",
         reports[0]["infos"]
@@ -276,7 +277,7 @@ fn validator_finds_no_new_issue_with_the_files_beside() {
         reports[0]["messages"]
     );
     for (file, r) in files.iter().zip(&reports).skip(1) {
-        let got = issue_codes(r);
+        let got = support::validator::issue_codes(r);
         eprintln!(
             "validator on {}: {got:?} ({} infos)",
             file.display(),
@@ -298,35 +299,13 @@ fn validator_finds_no_new_issue_with_the_files_beside() {
 fn outputs_load_in_three_js_with_their_texture() {
     let l = layout();
     // The input's folder's clone climbs to `../textures/`, above what the check serves.
-    let files = [&l.cloned, &l.played, &l.exported, &l.foreign];
-    let Some(out) = run_node_check(
-        "gltf-loaders-check.mjs",
-        files,
-        &[
-            ("THREE_DIR", "target/gltf-loaders"),
-            ("VIEWER_BROWSER_DIR", "target/viewer-browser"),
-        ],
-        "GLTF_LOADERS_REQUIRED",
-        "three.js loader",
-    ) else {
+    let files = [&l.cloned, &l.played, &l.exported, &l.foreign, &l.glb];
+    let Some(reports) = load_in_three_js(&files) else {
         return;
     };
-    let reports: Vec<Value> = out
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(reports.len(), files.len());
     for r in &reports {
         let file = &r["file"];
-        assert!(r.get("loadError").is_none(), "{file}: {}", r["loadError"]);
-        for k in [
-            "consoleErrors",
-            "consoleWarnings",
-            "pageErrors",
-            "foreignRequests",
-        ] {
-            assert_eq!(r[k], Value::Array(vec![]), "{file}: {k}");
-        }
+        assert_clean(r);
         let textured: Vec<&Value> = r["meshes"]
             .as_array()
             .unwrap()
@@ -428,7 +407,7 @@ fn a_bin_that_would_replace_an_input_file_is_refused() {
     // `other.gltf` is the clone under another name, its buffer still `clone.bin`.
     std::fs::copy(dir.join("clone.gltf"), dir.join("other.gltf")).unwrap();
     let before = snapshot(&dir);
-    let o = export_to(&dir.join("other.gltf"), &dir.join("clone.gltf"));
+    let o = face_export(&dir.join("other.gltf"), &dir.join("clone.gltf"));
     let stderr = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
@@ -441,7 +420,7 @@ fn a_bin_that_would_replace_an_input_file_is_refused() {
     assert!(before == snapshot(&dir), "files changed");
 
     // Writing over the input document itself: refused by the CLI.
-    let o = export_to(&dir.join("clone.gltf"), &dir.join("clone.gltf"));
+    let o = face_export(&dir.join("clone.gltf"), &dir.join("clone.gltf"));
     assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
     assert!(before == snapshot(&dir), "files changed");
 
@@ -483,14 +462,14 @@ fn an_unknown_extension_keeps_every_accessor_and_says_so() {
     std::fs::write(&ext, serde_json::to_vec(&json).unwrap()).unwrap();
     let accessors = |p: &Path| json_of(p)["accessors"].as_array().unwrap().len();
 
-    let o = export_to(&plain, &dir.join("plain-out.gltf"));
+    let o = face_export(&plain, &dir.join("plain-out.gltf"));
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(
         !text(&o.stderr).contains("unused accessors"),
         "{}",
         text(&o.stderr)
     );
-    let o = export_to(&ext, &dir.join("ext-out.gltf"));
+    let o = face_export(&ext, &dir.join("ext-out.gltf"));
     let stderr = text(&o.stderr);
     assert!(o.status.success(), "{stderr}");
     let (n_in, n_plain, n_ext) = (
@@ -527,7 +506,7 @@ fn a_missing_image_is_named_and_its_uri_kept() {
     let input = dir.join("face.gltf");
     std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
     let out = l.dir.join("results/missing-out.gltf");
-    let o = export_to(&input, &out);
+    let o = face_export(&input, &out);
     let stderr = text(&o.stderr);
     assert!(o.status.success(), "{stderr}");
     let named = dir.join("gone away.png");

@@ -20,6 +20,7 @@ use fbakit::spec::FapId;
 use fbakit::spec::FeaturePointId;
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
+use support::cli::{clone_alma_to, face_export, play_to};
 use support::rpm_avatar::{self, HEAD, LEFT_EYE, LOWER_TEETH, RIGHT_EYE, TONGUE, UPPER_TEETH};
 
 /// The avatar, its feature points and its clone from alma (CLI), written once.
@@ -39,7 +40,7 @@ fn fixture() -> &'static Fixture {
         let alma = fbakit::face::read("alma").unwrap();
         let fp = rpm_avatar::fp_csv(&alma, &dir);
         let out = dir.join("out.glb");
-        clone_to(&input, &fp, &out);
+        clone_alma_to(&input, &fp, &out);
         Fixture {
             dir,
             input,
@@ -47,25 +48,6 @@ fn fixture() -> &'static Fixture {
             out,
         }
     })
-}
-
-fn run(args: &[&std::ffi::OsStr]) -> String {
-    let o = support::cli::command().args(args).output().unwrap();
-    let stderr = support::cli::text(&o.stderr);
-    assert!(o.status.success(), "fbakit {args:?}: {stderr}");
-    stderr
-}
-
-fn clone_to(input: &Path, fp: &Path, out: &Path) -> String {
-    run(&[
-        "clone".as_ref(),
-        "alma".as_ref(),
-        input.as_os_str(),
-        "--fp-target".as_ref(),
-        fp.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-    ])
 }
 
 /// The JSON and BIN chunks of a glb (the JSON twice, so call sites read like a document and
@@ -482,13 +464,7 @@ fn play_turns_the_head_and_eye_joints_and_weights_head_and_teeth() {
     let f = fixture();
     let turns = write_turns(&f.dir);
     let played = f.dir.join("turns.glb");
-    run(&[
-        "play".as_ref(),
-        f.out.as_os_str(),
-        turns.as_os_str(),
-        "-o".as_ref(),
-        played.as_os_str(),
-    ]);
+    play_to(&f.out, &turns, &played);
     let (pj, pr, pb) = glb(&played);
     let play = pj["animations"]
         .as_array()
@@ -573,13 +549,7 @@ fn play_turns_the_head_and_eye_joints_and_weights_head_and_teeth() {
         worst * 100.0
     );
     let speech = f.dir.join("speech.glb");
-    run(&[
-        "play".as_ref(),
-        f.out.as_os_str(),
-        "samples/speech.fap".as_ref(),
-        "-o".as_ref(),
-        speech.as_os_str(),
-    ]);
+    play_to(&f.out, Path::new("samples/speech.fap"), &speech);
 }
 
 /// Counts of the validator's errors, warnings and unused objects in one file.
@@ -603,21 +573,10 @@ fn issues(r: &Value) -> (u64, u64, usize) {
 fn validator_finds_nothing_new_and_rewriting_does_not_grow_the_file() {
     let f = fixture();
     let played = f.dir.join("speech-v.glb");
-    run(&[
-        "play".as_ref(),
-        f.out.as_os_str(),
-        "samples/speech.fap".as_ref(),
-        "-o".as_ref(),
-        played.as_os_str(),
-    ]);
+    play_to(&f.out, Path::new("samples/speech.fap"), &played);
     let again = f.dir.join("again.glb");
-    run(&[
-        "face".as_ref(),
-        "export".as_ref(),
-        f.out.as_os_str(),
-        "-o".as_ref(),
-        again.as_os_str(),
-    ]);
+    let o = face_export(&f.out, &again);
+    assert!(o.status.success(), "{}", support::cli::text(&o.stderr));
     let (out_len, again_len) = (
         std::fs::metadata(&f.out).unwrap().len(),
         std::fs::metadata(&again).unwrap().len(),
@@ -658,7 +617,7 @@ fn gltf_transform_rewrites_still_clone() {
         let rewritten = f.dir.join(format!("rpm-{command}.glb"));
         support::gltf_transform::run(&program, command, &f.input, &rewritten, args);
         let out = f.dir.join(format!("out-{command}.glb"));
-        clone_to(&rewritten, &f.fp, &out);
+        clone_alma_to(&rewritten, &f.fp, &out);
         let (oj, _, _) = glb(&out);
         let counts = |j: &Value| -> Vec<Value> {
             j["meshes"]
@@ -726,22 +685,10 @@ fn blender_mesh<'a>(r: &'a Value, name: &str) -> &'a Value {
 fn clone_and_play_import_in_blender_with_fbakits_shape_keys() {
     let f = fixture();
     let played = f.dir.join("speech-b.glb");
-    run(&[
-        "play".as_ref(),
-        f.out.as_os_str(),
-        "samples/speech.fap".as_ref(),
-        "-o".as_ref(),
-        played.as_os_str(),
-    ]);
+    play_to(&f.out, Path::new("samples/speech.fap"), &played);
     let turns = write_turns(&f.dir);
     let turned = f.dir.join("turns-b.glb");
-    run(&[
-        "play".as_ref(),
-        f.out.as_os_str(),
-        turns.as_os_str(),
-        "-o".as_ref(),
-        turned.as_os_str(),
-    ]);
+    play_to(&f.out, &turns, &turned);
     let files = [&f.input, &f.out, &played, &turned];
     let Some(r) = support::blender::import_in_blender(&files) else {
         return;

@@ -7,7 +7,8 @@
 //! document's folder, else (a `..` path) flattened into the output folder — and the image's
 //! `uri` is rewritten to the written file. A file already at the destination is used only when
 //! it is byte-identical to the image; otherwise the copy takes a free name (`skin_2.png`, …),
-//! so a user's own file is never overwritten nor mistaken for the texture. Data URIs, URLs,
+//! so a user's own file is never overwritten nor mistaken for the texture. Written as `.glb`,
+//! the images are embedded instead ([`embed`]): a binary glTF is one file. Data URIs, URLs,
 //! absolute paths and images in buffer views are left alone.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -227,6 +228,83 @@ impl Placement {
     }
 }
 
+/// The media type of an image file, from its first bytes (a file's name can lie), else from
+/// its extension; `None` for a type glTF does not name.
+fn media_type(bytes: &[u8], path: &Path) -> Option<&'static str> {
+    if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        return Some("image/png");
+    }
+    if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
+        return Some("image/jpeg");
+    }
+    if bytes.len() >= 12 && &bytes[..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
+        return Some("image/webp");
+    }
+    if bytes.starts_with(b"\xABKTX 20\xBB\r\n\x1a\n") {
+        return Some("image/ktx2");
+    }
+    let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
+    match ext.as_str() {
+        "png" => Some("image/png"),
+        "jpg" | "jpeg" => Some("image/jpeg"),
+        "webp" => Some("image/webp"),
+        "ktx2" => Some("image/ktx2"),
+        _ => None,
+    }
+}
+
+/// Moves the images `json` names by relative file URI (read from `source_dir`) into `bin`, for
+/// a `.glb`: a binary glTF is one self-contained file, as users converting a `.gltf` expect.
+/// Each file becomes one buffer view (4-byte aligned, in buffer 0, whose `byteLength` follows)
+/// and each image naming it gets `bufferView` and `mimeType` instead of its `uri`. A missing
+/// file, or one of a type glTF does not name, keeps its URI (and is carried beside the output
+/// by [`place`] as before). Returns how many images were embedded.
+pub(super) fn embed(json: &mut Value, bin: &mut Vec<u8>, source_dir: &Path) -> Result<usize> {
+    let mut views: BTreeMap<PathBuf, (usize, &'static str)> = BTreeMap::new();
+    let mut embedded = 0;
+    for (i, _, rel) in relative_images(json) {
+        let from = source_dir.join(&rel);
+        if !from.is_file() {
+            continue;
+        }
+        let (view, mime) = match views.get(&from) {
+            Some(&v) => v,
+            None => {
+                let bytes = crate::io::read_bounded(&from, MAX_IMAGE_BYTES)?;
+                let Some(mime) = media_type(&bytes, &from) else {
+                    continue;
+                };
+                bin.resize(bin.len().next_multiple_of(4), 0);
+                let offset = bin.len();
+                bin.extend_from_slice(&bytes);
+                if !json["bufferViews"].is_array() {
+                    json["bufferViews"] = Value::Array(Vec::new());
+                }
+                let list = json["bufferViews"].as_array_mut().expect("made an array");
+                list.push(serde_json::json!({
+                    "buffer": 0, "byteOffset": offset, "byteLength": bytes.len()
+                }));
+                let v = (list.len() - 1, mime);
+                views.insert(from, v);
+                v
+            }
+        };
+        if let Some(img) = json["images"].get_mut(i).and_then(Value::as_object_mut) {
+            img.remove("uri");
+            img.insert("bufferView".into(), view.into());
+            img.insert("mimeType".into(), mime.into());
+            embedded += 1;
+        }
+    }
+    if embedded > 0 {
+        if !json["buffers"].is_array() || json["buffers"].as_array().is_some_and(Vec::is_empty) {
+            json["buffers"] = serde_json::json!([{}]);
+        }
+        json["buffers"][0]["byteLength"] = bin.len().into();
+    }
+    Ok(embedded)
+}
+
 /// A relative path as a URI: each component escaped, joined by `/`.
 fn path_uri(path: &Path) -> String {
     path.components()
@@ -355,5 +433,56 @@ mod tests {
         // Into the input's own folder: nothing moves.
         let plan = place(&json, &src, &src, &[]).unwrap();
         assert!(plan.copies.is_empty() && plan.uris.is_empty());
+    }
+
+    #[test]
+    fn a_glb_embeds_the_images_it_can_and_keeps_the_uris_of_the_rest() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = b"\x89PNG\r\n\x1a\n-png-bytes";
+        std::fs::create_dir_all(dir.path().join("tex")).unwrap();
+        std::fs::write(dir.path().join("tex/skin a.png"), png).unwrap();
+        // A JPEG named `.png`: the bytes decide.
+        std::fs::write(dir.path().join("eye.png"), [0xFF, 0xD8, 0xFF, 0xE0, 1]).unwrap();
+        std::fs::write(dir.path().join("notes.txt"), b"not an image").unwrap();
+        let mut json = doc(&[
+            "tex/skin%20a.png",
+            "eye.png",
+            "tex/skin%20a.png",
+            "gone.png",
+            "notes.txt",
+            "data:image/png;base64,AAAA",
+        ]);
+        json["buffers"] = json!([{"byteLength": 3}]);
+        json["bufferViews"] = json!([{"buffer": 0, "byteLength": 3}]);
+        let mut bin = vec![1, 2, 3];
+        let n = embed(&mut json, &mut bin, dir.path()).unwrap();
+        assert_eq!(n, 3);
+        let img = &json["images"];
+        assert_eq!(img[0], json!({"bufferView": 1, "mimeType": "image/png"}));
+        assert_eq!(img[1], json!({"bufferView": 2, "mimeType": "image/jpeg"}));
+        // The same file twice: one view.
+        assert_eq!(img[2], img[0]);
+        for (k, uri) in [
+            (3, "gone.png"),
+            (4, "notes.txt"),
+            (5, "data:image/png;base64,AAAA"),
+        ] {
+            assert_eq!(img[k], json!({ "uri": uri }), "image {k}");
+        }
+        let view = |k: usize| {
+            let v = &json["bufferViews"][k];
+            let at = v["byteOffset"].as_u64().unwrap() as usize;
+            assert_eq!(at % 4, 0, "view {k} unaligned");
+            bin[at..at + v["byteLength"].as_u64().unwrap() as usize].to_vec()
+        };
+        assert_eq!(view(1), png);
+        assert_eq!(view(2), [0xFF, 0xD8, 0xFF, 0xE0, 1]);
+        assert_eq!(bin[..3], [1, 2, 3]);
+        assert_eq!(json["buffers"][0]["byteLength"], bin.len());
+        // No buffer yet: one is made for the images.
+        let mut bare = doc(&["eye.png"]);
+        let mut bin = Vec::new();
+        assert_eq!(embed(&mut bare, &mut bin, dir.path()).unwrap(), 1);
+        assert_eq!(bare["buffers"], json!([{"byteLength": 5}]));
     }
 }

@@ -609,8 +609,8 @@ fn add_animation(b: &mut Builder, anim: &PatchAnimation) {
 
 impl PatchedGltf {
     /// Writes `.glb` or `.gltf` (+ `<stem>.bin`) as `path`'s extension says, atomically per
-    /// file, with the images the document names by relative URI carried beside it (see
-    /// `images`). Refused before anything is written (exit code 2) when the `.bin`, or the
+    /// file, with the images the document names by relative URI embedded in a `.glb`, carried
+    /// beside a `.gltf` (see `images`). Refused before anything is written (exit code 2) when the `.bin`, or the
     /// output itself, would replace one of the input's buffers or images: the input is read
     /// whole, but a `.gltf` and its `.bin` are two files, and a write stopped between them
     /// would leave the input's `.gltf` pointing into a rewritten buffer. The output may
@@ -661,12 +661,17 @@ impl PatchedGltf {
         }
         let mut reserved = vec![out_dir.join(&file_name)];
         reserved.extend(bin_name.iter().map(|b| out_dir.join(b)));
-        let placement = images::place(&self.json, &self.source_dir, out_dir, &reserved)?;
         let mut json = self.json.clone();
+        let mut glb_bin = Vec::new();
+        if bin_name.is_none() {
+            glb_bin.clone_from(&self.bin);
+            images::embed(&mut json, &mut glb_bin, &self.source_dir)?;
+        }
+        let placement = images::place(&json, &self.source_dir, out_dir, &reserved)?;
         placement.set_uris(&mut json);
         placement.copy()?;
         match bin_name {
-            None => crate::io::write_atomic(path, &glb_bytes(&json, &self.bin)?),
+            None => crate::io::write_atomic(path, &glb_bytes(&json, &glb_bin)?),
             Some(bin_name) => {
                 if let Some(first) = json["buffers"].get_mut(0) {
                     first["uri"] = json!(uri_escape(&bin_name));
@@ -680,9 +685,12 @@ impl PatchedGltf {
         }
     }
 
-    /// The document as `.glb` bytes.
+    /// The document as `.glb` bytes, one self-contained file: the images it names by
+    /// relative URI (found beside the input) embedded.
     pub fn to_glb(&self) -> Result<Vec<u8>> {
-        glb_bytes(&self.json, &self.bin)
+        let (mut json, mut bin) = (self.json.clone(), self.bin.clone());
+        images::embed(&mut json, &mut bin, &self.source_dir)?;
+        glb_bytes(&json, &bin)
     }
 }
 

@@ -33,3 +33,54 @@ pub fn command() -> Command {
     c.current_dir(env!("CARGO_MANIFEST_DIR"));
     c
 }
+
+/// Runs `fbakit ARGS` (paths as they are), fails the test with its stderr unless it
+/// succeeded, and returns that stderr (the warnings).
+pub fn run_ok(args: &[&std::ffi::OsStr]) -> String {
+    let out = command().args(args).output().expect("run fbakit");
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "fbakit {args:?}: {stderr}");
+    stderr
+}
+
+/// `fbakit clone alma INPUT --fp-target FP -o OUT`, which must succeed; its stderr.
+pub fn clone_alma_to(
+    input: &std::path::Path,
+    fp: &std::path::Path,
+    out: &std::path::Path,
+) -> String {
+    run_ok(&[
+        "clone".as_ref(),
+        "alma".as_ref(),
+        input.as_os_str(),
+        "--fp-target".as_ref(),
+        fp.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ])
+}
+
+/// `fbakit play FACE STREAM -o OUT`, which must succeed; its stderr.
+pub fn play_to(face: &std::path::Path, stream: &std::path::Path, out: &std::path::Path) -> String {
+    run_ok(&[
+        "play".as_ref(),
+        face.as_os_str(),
+        stream.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ])
+}
+
+/// `fbakit face export INPUT -o OUT`, as it ended (for tests of refusals too).
+pub fn face_export(input: &std::path::Path, out: &std::path::Path) -> Output {
+    command()
+        .args([
+            "face".as_ref(),
+            "export".as_ref(),
+            input.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
+        .output()
+        .expect("run fbakit")
+}

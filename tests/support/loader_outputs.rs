@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use super::avatar;
-use super::cli::{command, text};
+use super::cli::{clone_alma_to, run_ok as run};
 
 /// The written files.
 pub struct GltfOutputs {
@@ -32,16 +32,6 @@ pub struct GltfOutputs {
     pub rig_glb: PathBuf,
     /// `face from-rig ict-head.glb --fp ict-head-fp.csv -o from-rig.glb`.
     pub from_rig_glb: PathBuf,
-}
-
-fn run(args: &[&std::ffi::OsStr]) {
-    let out = command().args(args).output().unwrap();
-    assert!(
-        out.status.success(),
-        "fbakit {:?}: {}",
-        args,
-        text(&out.stderr)
-    );
 }
 
 fn sample(name: &str) -> PathBuf {
@@ -77,15 +67,7 @@ pub fn gltf_outputs(dir: &Path) -> GltfOutputs {
         (&o.input_glb, &o.clone_glb, &o.play_glb),
         (&o.input_gltf, &o.clone_gltf, &o.play_gltf),
     ] {
-        run(&[
-            "clone".as_ref(),
-            "alma".as_ref(),
-            input.as_os_str(),
-            "--fp-target".as_ref(),
-            fp.as_os_str(),
-            "-o".as_ref(),
-            cloned.as_os_str(),
-        ]);
+        clone_alma_to(input, &fp, cloned);
         // The avatar's `Jaw` carries the mouth, not the chin: named, it still takes the jaw
         // FAPs (found by its name alone it would not).
         run(&[
@@ -149,15 +131,7 @@ pub fn obj_outputs(dir: &Path) -> ObjOutputs {
     let fp = dir.join("head-fp.csv");
     std::fs::write(&fp, csv).unwrap();
     let set = dir.join("set/");
-    run(&[
-        "clone".as_ref(),
-        "alma".as_ref(),
-        target.as_os_str(),
-        "--fp-target".as_ref(),
-        fp.as_os_str(),
-        "-o".as_ref(),
-        set.as_os_str(),
-    ]);
+    clone_alma_to(&target, &fp, &set);
     ObjOutputs { target, set }
 }
 
@@ -200,5 +174,42 @@ pub fn json_of(path: &Path) -> serde_json::Value {
         serde_json::from_slice(chunks.json).unwrap()
     } else {
         serde_json::from_slice(&bytes).unwrap()
+    }
+}
+
+/// three.js's view of each file (`GLTFLoader` in headless Chromium, by
+/// `tests/support/gltf-loaders-check.mjs`, files served beside each document), one JSON report
+/// per file, or `None` (with a note) when a tool is missing and CI did not require it.
+pub fn load_in_three_js<P: AsRef<Path>>(files: &[P]) -> Option<Vec<serde_json::Value>> {
+    let text = super::node_check::run_node_check(
+        "gltf-loaders-check.mjs",
+        files.iter().map(|f| f.as_ref()),
+        &[
+            ("THREE_DIR", "target/gltf-loaders"),
+            ("VIEWER_BROWSER_DIR", "target/viewer-browser"),
+        ],
+        "GLTF_LOADERS_REQUIRED",
+        "three.js loader",
+    )?;
+    let reports: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(reports.len(), files.len());
+    Some(reports)
+}
+
+/// A three.js report with no load error, nothing on the console, no request but the file's
+/// own.
+pub fn assert_clean(r: &serde_json::Value) {
+    let file = &r["file"];
+    assert!(r.get("loadError").is_none(), "{file}: {}", r["loadError"]);
+    for k in [
+        "consoleErrors",
+        "consoleWarnings",
+        "pageErrors",
+        "foreignRequests",
+    ] {
+        assert_eq!(r[k], serde_json::Value::Array(vec![]), "{file}: {k}");
     }
 }

@@ -35,3 +35,20 @@ pub fn validate(files: &[PathBuf]) -> Option<Vec<serde_json::Value>> {
     assert_eq!(reports.len(), files.len());
     Some(reports)
 }
+
+/// The codes of a report's errors and warnings (severities 0 and 1; infos and hints left
+/// out), sorted, one entry per message.
+pub fn issue_codes(r: &serde_json::Value) -> Vec<String> {
+    let mut codes: Vec<String> = r["messages"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|m| {
+            let mut words = m.as_str()?.split_whitespace();
+            let severity: u8 = words.next()?.parse().ok()?;
+            (severity <= 1).then(|| words.next().unwrap_or("").to_string())
+        })
+        .collect();
+    codes.sort();
+    codes
+}
