@@ -349,6 +349,7 @@ fn outputs_import_in_blender_with_their_texture() {
         &l.played,
         &l.exported,
         &l.foreign,
+        &l.glb,
     ];
     let Some(reports) = support::blender::import_in_blender(&files) else {
         return;
