@@ -50,6 +50,13 @@
 //! A clone whose closed lids meet over the eye and lie in front of it (a self-clone of a
 //! source whose own blink covers its eye) is not changed.
 //!
+//! Measured, alma → ICT (per eye, at alma's closing value 512; ICT's own blink at its own
+//! closing value in brackets): eye vertices seen through the closed lids 69 / 70 → 0 (0),
+//! gaps along the closed line −0.041…0.060 → −0.072…0.026 IRISD0 (−0.177…0.032),
+//! roughness 0.172 → 0.117 (0.083), at 1024 0.345 → 0.234 (0.172); `close_t` at 512 turns
+//! 101° → 113° (ICT's own 97°); the blink's depth into the eye white 0.161 → 0.163 radii
+//! (0.109); about 5 ms.
+//!
 //! Off by default ([`CloneOptions::lid_cover`]): a cartoon's own blink may leave its eye
 //! showing (alma's shows 59 of her 338 eye vertices), and the step forces a cover on any
 //! target, so self-clones of such faces change.
