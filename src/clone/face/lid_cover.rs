@@ -37,10 +37,11 @@
 //! 5. Each lid vertex `k` comes forward by `max_j need_j · bump(|k − j| / (`[`SPREAD`]` r))`
 //!    over the needing vertices `j` of its own lid (rest places; `lid_close`'s Wendland
 //!    bump: each vertex at least its own need, the push smooth into the lid), at most
-//!    [`MAX_PUSH`] `r`, along the eyeball's normal at its posed place turned level
-//!    (`n = (p.x − c.x, 0, p.z − c.z)`, normalised; straight forward where that faces
-//!    sideways), stretched so its z part is the amount: no height changes, so step 2's
-//!    closed line stays closed and the lid points keep their FAPs' vertical motion.
+//!    [`MAX_PUSH`] `r`, straight forward (+z: in front of the cornea, where the lids close,
+//!    the eyeball's normal; its level turn towards the corners shifted the margins sideways
+//!    and made the lids cross 0.03 IRISD0 deeper at alma's closing value): no height
+//!    changes, so step 2's closed line stays closed and the lid points keep their FAPs'
+//!    vertical motion.
 //! 6. The push is added to the top FAP's motion at its first border (upper lid) or the
 //!    bottom FAP's (lower lid), times `b / x`: the FAT interpolates its first interval
 //!    linearly, so at values short of closing (the eye open) the lids move only by that
@@ -52,9 +53,9 @@
 //!
 //! Measured, alma → ICT (per eye, at alma's closing value 512; ICT's own blink at its own
 //! closing value in brackets): eye vertices seen through the closed lids 69 / 70 → 0 (0),
-//! gaps along the closed line −0.041…0.060 → −0.072…0.026 IRISD0 (−0.177…0.032),
+//! gaps along the closed line −0.041…0.060 → −0.041…0.021 IRISD0 (−0.177…0.032),
 //! roughness 0.172 → 0.117 (0.083), at 1024 0.345 → 0.234 (0.172); `close_t` at 512 turns
-//! 101° → 113° (ICT's own 97°); the blink's depth into the eye white 0.161 → 0.163 radii
+//! 101° → 119° (ICT's own 97°); the blink's depth into the eye white 0.161 → 0.163 radii
 //! (0.109); about 5 ms.
 //!
 //! Off by default ([`CloneOptions::lid_cover`]): a cartoon's own blink may leave its eye
@@ -254,12 +255,12 @@ fn lid_vertices(
         .collect()
 }
 
-/// Steps 3–5 for one eye: the lid vertices `lids` of the eye with centre `c`, radius `r` and
+/// Steps 4–6 for one eye: the lid vertices `lids` of the eye with eye-white radius `r` and
 /// front `front`, the top and bottom FAPs' first-border fields `fields` (dense, changed in
 /// place) with their borders `borders`, at the values `values` (closing, then full). Returns
 /// how many vertices of each field changed.
 fn cover(
-    (c, r): (Vec3, f32),
+    r: f32,
     front: &EyeFront,
     lids: &[LidVertex],
     fields: [&mut Vec<Vec3>; 2],
@@ -273,7 +274,7 @@ fn cover(
         let posed = |l: &LidVertex, dt: &[Vec3], db: &[Vec3]| {
             l.rest + st * dt[l.v as usize] + sb * db[l.v as usize]
         };
-        // Step 3: what each lid vertex seen through needs.
+        // Step 4: what each lid vertex seen through needs.
         let needs: Vec<(usize, f32)> = lids
             .iter()
             .enumerate()
@@ -286,8 +287,8 @@ fn cover(
         if needs.is_empty() {
             continue;
         }
-        // Step 4: spread over each lid, level along the eyeball's normal; step 5: through
-        // the lid's FAP at its border.
+        // Step 5: spread over each lid, straight forward; step 6: through the lid's FAP at
+        // its border.
         let reach = SPREAD * r;
         let pushes: Vec<(usize, Vec3)> = lids
             .iter()
@@ -302,11 +303,8 @@ fn cover(
                 if amount <= 0.0 {
                     return None;
                 }
-                let p = posed(l, dt, db);
-                let n = Vec3::new(p.x - c.x, 0.0, p.z - c.z).normalize_or_zero();
-                let n = if n.z >= 0.5 { n } else { Vec3::Z };
                 let scale = if l.upper { 1.0 / st } else { 1.0 / sb };
-                Some((k, n * (amount / n.z * scale)))
+                Some((k, Vec3::Z * (amount * scale)))
             })
             .collect();
         for (k, d) in pushes {
@@ -349,7 +347,7 @@ fn closing(
         .collect();
     // Each vertex at least its own closing, its neighbours along the slit a bump of it: a
     // single vertex closing alone creased the lid (alma → ICT's `close_t` at 512 turned
-    // 139° against 101° without the step, 113° so).
+    // 139° against 101° without the step, 113° with the spread).
     own.iter()
         .map(|&(t, _)| {
             let close = need
@@ -450,7 +448,14 @@ pub(super) fn cover_lids(
         } else {
             vec![sc.value]
         };
-        let [ct, cb] = cover(sphere, front, &lids, [&mut dt, &mut db], [vt, vb], &values);
+        let [ct, cb] = cover(
+            sphere.1,
+            front,
+            &lids,
+            [&mut dt, &mut db],
+            [vt, vb],
+            &values,
+        );
         store_changed(out, kt, &dt, ct.max(counts[0]), &mut done);
         store_changed(out, kb, &db, cb.max(counts[1]), &mut done);
     }
@@ -524,7 +529,7 @@ mod tests {
         let (t0, b0) = (dt.clone(), db.clone());
         let r = 1.0;
         let changed = cover(
-            (Vec3::ZERO, r),
+            r,
             &f,
             &lids,
             [&mut dt, &mut db],
@@ -584,7 +589,7 @@ mod tests {
         let mut db = vec![Vec3::new(0.0, 0.6, 0.0); 8];
         let (t0, b0) = (dt.clone(), db.clone());
         let changed = cover(
-            (Vec3::ZERO, 1.0),
+            1.0,
             &f,
             &lids,
             [&mut dt, &mut db],

@@ -141,8 +141,8 @@
 //!    the eye) that the eyeball shows through from the front (its triangles' largest z over
 //!    the vertex lies in front of it) need to come to 0.02 eye-white radii in front of it:
 //!    each lid comes forward by the largest of those needs spread by a Wendland bump over
-//!    half a radius, level along the eyeball's normal (no height change), through its lid's
-//!    FAP at its first border. A target whose closed lids cover its eye is not changed.
+//!    half a radius, straight forward (no height change), through its lid's FAP at its
+//!    first border. A target whose closed lids cover its eye is not changed.
 //!    Alma's blink on ICT's head: eye vertices seen through the closed lids 69 / 70 per eye
 //!    → 0 (ICT's own blink 0); off by default because a cartoon's own blink may leave its
 //!    eye showing (alma's own: 59 of 338), and the step would change its self-clone.
