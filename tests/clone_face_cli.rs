@@ -137,3 +137,44 @@ fn eval_ground_truth_clones_and_measures() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// `--lid-cover` (alma's blink onto the real ICT head, whose corneas showed through the
+/// closed lids): the eyelid tables (FAPs 19–22) change, a table away from the eyes
+/// (`open_jaw`) is the same to the bit.
+#[test]
+fn lid_cover_changes_the_lids_and_only_them() {
+    let Ok(ict) = fbakit::face::read("ict") else {
+        eprintln!("note: bundled face ict not readable; skipped");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("ict.wrl");
+    write_face_file(&target, &fbakit::export::picture::strip_fat(&ict)).unwrap();
+    let clone = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let o = fbakit()
+            .args(["clone", "alma", target.to_str().unwrap(), "-o"])
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        fbakit::face::vrml::read_face_file(&out).unwrap().0
+    };
+    let (plain, covered) = (
+        clone("plain.wrl", &[]),
+        clone("covered.wrl", &["--lid-cover"]),
+    );
+    let table = |face: &fbakit::face::FaceModel, fap: u8| {
+        let key = fbakit::fat::TableKey::LowLevel(fbakit::spec::FapId::new(fap).unwrap());
+        face.fat.table(key).cloned()
+    };
+    for fap in 19..=22 {
+        let (a, b) = (table(&plain, fap), table(&covered, fap));
+        assert!(a.is_some() && b.is_some(), "FAP {fap}");
+        assert_ne!(a, b, "FAP {fap} is the same with --lid-cover");
+    }
+    let (a, b) = (table(&plain, 3), table(&covered, 3));
+    assert!(a.is_some());
+    assert_eq!(a, b, "open_jaw changed with --lid-cover");
+}

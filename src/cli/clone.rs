@@ -39,6 +39,12 @@ pub struct CloneArgs {
     /// the feature points disagree a lot).
     #[arg(long)]
     pub no_align: bool,
+    /// Where the source's blink closes its eyes, bring the target's closed lids forward until
+    /// they cover its eyeballs from the front (a real head under a cartoon's blink, whose
+    /// closed lids lie behind its protruding eyes). Off by default: it changes a self-clone
+    /// of a face whose own blink leaves its eyes showing.
+    #[arg(long)]
+    pub lid_cover: bool,
     /// Feature points of an OBJ source.
     #[arg(long, value_name = "FILE")]
     pub fp_source: Option<PathBuf>,
@@ -314,6 +320,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         method: args.method.into(),
         rbf_fapu_rescale: !args.rbf_paper,
         align: !args.no_align,
+        lid_cover: args.lid_cover,
         ..CloneOptions::default()
     };
     let outcome = clone_face(&source, &target, &opts).with_context(|| {
