@@ -53,8 +53,48 @@ use crate::spec::{FapId, FeaturePointId};
 pub(super) const REACH: f32 = 0.2;
 
 /// One eye: left or not, top and bottom lid FAPs, upper and lower lid points.
-pub(super) const EYES: [(bool, u8, u8, &str, &str); 2] =
-    [(true, 19, 21, "3.1", "3.3"), (false, 20, 22, "3.2", "3.4")];
+pub(super) type Eye = (bool, u8, u8, &'static str, &'static str);
+
+/// The two eyes.
+pub(super) const EYES: [Eye; 2] = [(true, 19, 21, "3.1", "3.3"), (false, 20, 22, "3.2", "3.4")];
+
+/// What every lid step starts from for one eye whose source blink closes it: the source's
+/// closing, the target's top and bottom lid motions at their first borders (index, border),
+/// and the target's corners and margins (upper, lower).
+pub(super) struct EyeClosing<'a> {
+    pub(super) source: SourceClose,
+    pub(super) top: (usize, f64),
+    pub(super) bottom: (usize, f64),
+    pub(super) corners: (Vec3, Vec3),
+    pub(super) upper: (&'a [Vec3], &'a [u32]),
+    pub(super) lower: (&'a [Vec3], &'a [u32]),
+}
+
+/// [`EyeClosing`] for each of [`EYES`] a step has something to do for: the source's blink
+/// closes that eye, both lid FAPs move the target and its margins were found. (Only indices
+/// and borders of `out` are kept, which the steps' changes to offsets leave as they are.)
+pub(super) fn eye_closings<'a>(
+    source: &CloneSurface,
+    motions: &[SurfaceMotion],
+    source_margins: &LidMargins,
+    target_margins: &'a LidMargins,
+    out: &[SurfaceMotion],
+) -> Vec<(Eye, EyeClosing<'a>)> {
+    EYES.into_iter()
+        .filter_map(|eye| {
+            let (left, top, bottom, ..) = eye;
+            let c = EyeClosing {
+                source: source_close(source, motions, source_margins, eye)?,
+                top: first_motion(out, top)?,
+                bottom: first_motion(out, bottom)?,
+                corners: target_margins.corners(left)?,
+                upper: target_margins.lid(left, true)?,
+                lower: target_margins.lid(left, false)?,
+            };
+            Some((eye, c))
+        })
+        .collect()
+}
 
 /// Index of the motion of FAP `fap` at its smallest positive border, with that border.
 pub(super) fn first_motion(motions: &[SurfaceMotion], fap: u8) -> Option<(usize, f64)> {
@@ -214,20 +254,10 @@ pub(super) fn close_lids(
     let [tm, sm] = margins;
     let n = target.positions.len();
     let irisd = target.fapu.distances.irisd0 as f32;
-    for eye in EYES {
-        let (left, top, bottom, up, low) = eye;
-        let Some(sc) = source_close(source, motions, sm, eye) else {
-            continue;
-        };
-        let (Some((kt, vt)), Some((kb, vb))) = (first_motion(out, top), first_motion(out, bottom))
-        else {
-            continue;
-        };
-        let (Some(corners), Some(upper), Some(lower)) =
-            (tm.corners(left), tm.lid(left, true), tm.lid(left, false))
-        else {
-            continue;
-        };
+    for (eye, c) in eye_closings(source, motions, sm, tm, out) {
+        let (left, _, _, up, low) = eye;
+        let (sc, (kt, vt), (kb, vb)) = (c.source, c.top, c.bottom);
+        let (corners, upper, lower) = (c.corners, c.upper, c.lower);
         // Where both tables are still in their first interval the change grows linearly with
         // the FAP value; at `far` it is capped (step 4).
         let far = vt.min(vb);

@@ -69,9 +69,7 @@ use std::collections::{BTreeMap, HashSet};
 use glam::Vec3;
 
 use super::align::Similarity;
-use super::lid_close::{
-    along, first_motion, height, posed, source_close, spread, store_changed, RowSets, EYES, REACH,
-};
+use super::lid_close::{along, eye_closings, height, posed, spread, store_changed, RowSets, REACH};
 use super::lid_margin::LidMargins;
 use super::parts::{FaceParts, Part};
 use super::rescale::bump;
@@ -378,26 +376,16 @@ pub(super) fn cover_lids(
     let mut done = BTreeMap::new();
     let [tm, sm] = margins;
     let n = target.positions.len();
-    for eye in EYES {
-        let (left, top, bottom, ..) = eye;
+    for (eye, c) in eye_closings(source, motions, sm, tm, out) {
+        let (left, ..) = eye;
         let Some(front) = fronts.iter().find(|f| f.left == left) else {
             continue;
         };
         let Some(&(_, ball)) = tm.balls().iter().find(|b| b.0 == left) else {
             continue;
         };
-        let Some(sc) = source_close(source, motions, sm, eye) else {
-            continue;
-        };
-        let (Some((kt, vt)), Some((kb, vb))) = (first_motion(out, top), first_motion(out, bottom))
-        else {
-            continue;
-        };
-        let (Some(corners), Some(upper), Some(lower)) =
-            (tm.corners(left), tm.lid(left, true), tm.lid(left, false))
-        else {
-            continue;
-        };
+        let (sc, (kt, vt), (kb, vb)) = (c.source, c.top, c.bottom);
+        let (corners, upper, lower) = (c.corners, c.upper, c.lower);
         let rows: [HashSet<u32>; 2] = [upper.1, lower.1].map(|r| r.iter().copied().collect());
         let sphere = ball.sphere();
         let lids = lid_vertices(target, sphere, front, [&rows[0], &rows[1]], corners);

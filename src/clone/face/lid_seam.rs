@@ -31,9 +31,7 @@ use std::collections::BTreeMap;
 
 use glam::Vec3;
 
-use super::lid_close::{
-    first_motion, height, posed, source_close, spread, store_changed, RowSets, EYES, REACH,
-};
+use super::lid_close::{eye_closings, height, posed, spread, store_changed, RowSets, REACH};
 use super::lid_margin::LidMargins;
 use super::smooth::dense_field;
 use crate::clone::{CloneSurface, SurfaceMotion};
@@ -170,21 +168,11 @@ pub(super) fn seam_lids(
     let [tm, sm] = margins;
     let n = target.positions.len();
     let irisd = target.fapu.distances.irisd0 as f32;
-    for eye in EYES {
-        let (left, top, bottom, up, low) = eye;
-        let Some(sc) = source_close(source, motions, sm, eye) else {
-            continue;
-        };
-        let (Some((kt, vt)), Some((kb, vb))) = (first_motion(out, top), first_motion(out, bottom))
-        else {
-            continue;
-        };
-        let (Some(corners), Some(scorners), Some(upper), Some(lower)) = (
-            tm.corners(left),
-            sm.corners(left),
-            tm.lid(left, true),
-            tm.lid(left, false),
-        ) else {
+    for (eye, c) in eye_closings(source, motions, sm, tm, out) {
+        let (left, _, _, up, low) = eye;
+        let (sc, (kt, vt), (kb, vb)) = (c.source, c.top, c.bottom);
+        let (corners, upper, lower) = (c.corners, c.upper, c.lower);
+        let Some(scorners) = sm.corners(left) else {
             continue;
         };
         let (Some(tp), Some(stp)) = (
