@@ -75,10 +75,11 @@ pub struct CloneOptions {
     /// they cover it from the front. Alma's blink on ICT's head left 69 / 70 eye
     /// vertices per eye seen through the closed lids, none with this on. Default off: the
     /// step forces a cover on any target, but a cartoon's own blink may leave its eye showing
-    /// (alma's shows 59 of her 338 eye vertices), so self-clones change (an earlier version of the
-    /// step measured alma → alma's lid FAPs 34.5 % off, bruno → bruno's 39.5 %), and no rule on the target's
-    /// resting geometry was found that tells a cartoon target from a real one. Turn it on
-    /// for a real head whose closed lids must cover its eyes.
+    /// (alma's shows 59 of her 338 eye vertices), so self-clones change (alma → alma's lid
+    /// FAPs 4.6 % upper / 3.7 % lower off the truth, bruno → bruno's 4.6 % / 3.4 %; median
+    /// 0.000 % for both; off: 0.00 %), and no rule on the target's resting geometry was found
+    /// that tells a cartoon target from a real one. Turn it on for a real head whose closed
+    /// lids must cover its eyes.
     pub lid_cover: bool,
 }
 
