@@ -549,6 +549,42 @@ fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
     );
 }
 
+/// What the reader noticed is said by the commands users run, once and with the file named
+/// once: `clone` onto a file without a scene warns (it said nothing), `face info` lists it
+/// without `warning: FILE:` twice.
+#[test]
+fn reader_warnings_are_said_once_by_clone_and_face_info() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = avatar::build();
+    let o = a.json.as_object_mut().unwrap();
+    o.remove("scene");
+    o.remove("scenes");
+    let input = dir.path().join("noscene.glb");
+    std::fs::write(&input, a.to_glb()).unwrap();
+    let alma = fbakit::face::read("alma").unwrap();
+    let fp = avatar::fp_csv(&alma, dir.path(), "");
+    let stderr = support::cli::clone_alma_to(&input, &fp, &dir.path().join("out.glb"));
+    let said: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("the file has no scene"))
+        .collect();
+    assert_eq!(said.len(), 1, "{stderr}");
+    assert_eq!(said[0].matches("noscene.glb").count(), 1, "{}", said[0]);
+    assert!(said[0].starts_with("warning: "), "{}", said[0]);
+    let o = command()
+        .args(["face".as_ref(), "info".as_ref(), input.as_os_str()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    let line = out
+        .lines()
+        .find(|l| l.contains("the file has no scene"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert_eq!(line.matches("noscene.glb").count(), 1, "{line}");
+    assert_eq!(line.matches("warning:").count(), 1, "{line}");
+}
+
 /// The avatar's face with its FAT and feature points (metres, the file's world frame) for
 /// the FAP units and the chin.
 fn with_points(face: FaceModel) -> FaceModel {

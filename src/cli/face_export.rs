@@ -72,7 +72,7 @@ pub fn run_face_export(a: FaceExportArgs) -> Result<u8> {
         "`face export` output",
     )?;
     fbakit::format::refuse_overwriting_input(&a.output, &[&a.face])?;
-    let face = fbakit::face::read(&a.face)?;
+    let face = super::inputs::read_face(&a.face, None)?;
     let opts = ExportOptions {
         names: a.names.into(),
         units: a.units,

@@ -47,10 +47,11 @@ pub struct SubdivideArgs {
 pub fn run(a: SubdivideArgs) -> Result<u8> {
     OutputFormat::resolve(&a.output, OutputFormat::FACES, "`face subdivide` output")?;
     refuse_overwriting_input(&a.output, &[&a.input])?;
-    let (face, _) = read_with(
+    let (face, report) = read_with(
         &a.input,
         &FaceReadOptions::with_feature_points(a.fp.as_deref()),
     )?;
+    super::inputs::print_reader_warnings(&report);
     let scheme = match a.scheme {
         SchemeArg::Loop => Scheme::Loop,
         SchemeArg::Midpoint => Scheme::Midpoint,

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use fbakit::error::Diagnostic;
 use fbakit::error::Result;
-use fbakit::face::{FaceModel, FaceReadOptions};
+use fbakit::error::{Diagnostic, Severity};
+use fbakit::face::{FaceModel, FaceReadOptions, FaceReadReport};
 use fbakit::fap::{read_stream_file, FapStream, ReadOptions};
 
 /// Reads a face file, rig or bundled face; `fp` replaces its feature points (an OBJ needs
@@ -33,6 +33,7 @@ pub fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
                 });
             }
         };
+    print_reader_warnings(&report);
     if let Some(fp) = fp {
         // Points given by position were snapped to vertices: name the far snaps.
         super::print_warnings(&fbakit::face::attach::snap_warnings(
@@ -42,6 +43,19 @@ pub fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
         ));
     }
     Ok(face)
+}
+
+/// Prints the warnings a face reader noticed (a compressed glTF decoded, a file without a
+/// scene, a rig read without its feature points), so every command says them, not only
+/// `face info`.
+pub fn print_reader_warnings(report: &FaceReadReport) {
+    let warnings: Vec<Diagnostic> = report
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Warning)
+        .cloned()
+        .collect();
+    super::print_warnings(&warnings);
 }
 
 /// Reads a FAP stream, strictly or leniently, with its reader warnings.

@@ -27,11 +27,16 @@ pub(crate) fn rig_face(
         location: None,
         message,
     };
-    report.diagnostics.extend(
-        rig.warnings
-            .iter()
-            .map(|w| note(format!("{}: {w}", path.display()))),
-    );
+    // The rig readers' warnings name their file already; others get it in front (the
+    // diagnostic's own `warning:` prefix is not repeated).
+    let shown = path.display().to_string();
+    report.diagnostics.extend(rig.warnings.iter().map(|w| {
+        if w.message.contains(&shown) {
+            w.clone()
+        } else {
+            note(format!("{shown}: {}", w.message))
+        }
+    }));
     let Some(fp) = feature_points else {
         let mut face = rig.to_face();
         face.name = super::format::face_name(path);
@@ -61,7 +66,8 @@ pub(crate) fn rig_face(
         })?;
     face.name = super::format::face_name(path);
     report.fp_matches = std::mem::take(&mut fat.fp_matches);
-    if !fat.unmapped.is_empty() {
+    // A file without shapes (a plain glTF target) realises no FAP: nothing worth saying.
+    if !fat.unmapped.is_empty() && !rig.shapes.is_empty() {
         let keys: Vec<&str> = fat.unmapped.iter().map(|u| u.key.as_str()).collect();
         report.diagnostics.push(note(format!(
             "{}: {} FAP sides not realised by the rig's shapes (`fbakit face from-rig --json` \
