@@ -265,47 +265,6 @@ fn near_snaps_warn_with_their_distance() {
     assert!(err.contains("% of the face size"), "{err}");
 }
 
-/// A point given by position and snapped is where its vertex is, as a vertex id would put it:
-/// the library's face and `face info --json` show the vertex, not the file's position (which
-/// the FAP units and the clone's alignment used to take, 2 % of the head off here).
-#[test]
-fn a_snapped_point_sits_on_its_vertex() {
-    let ict = fbakit::face::read("ict").unwrap();
-    let size = fbakit::face::attach::face_size(&ict);
-    let id: fbakit::spec::FeaturePointId = "2.1".parse().unwrap();
-    let q = ict.feature_points.position(id).unwrap() + Vec3::new(0.0, -0.02 * size, 0.0);
-    let dir = tempfile::tempdir().unwrap();
-    let csv = dir.path().join("moved.csv");
-    std::fs::write(&csv, format!("fp,x,y,z\n2.1,{},{},{}\n", q.x, q.y, q.z)).unwrap();
-    let snapped = read_with_fp("ict", &csv);
-    let (m, v) = snapped.fp_vertex(id).unwrap();
-    let vertex = snapped.neutral_world_positions()[m][v as usize];
-    let at = snapped.feature_points.position(id).unwrap();
-    assert!(at.distance(vertex) < 1e-6 * size, "{at} vs vertex {vertex}");
-    assert!(at.distance(q) > 0.01 * size, "{at} vs the file's {q}");
-    let o = fbakit(&[
-        "face",
-        "info",
-        "ict",
-        "--fp",
-        csv.to_str().unwrap(),
-        "--json",
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let shown: Vec<f32> = info["feature_points"]["positions"]["2.1"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap() as f32)
-        .collect();
-    let shown = Vec3::new(shown[0], shown[1], shown[2]);
-    assert!(
-        shown.distance(vertex) < 1e-5 * size,
-        "{shown} vs vertex {vertex}"
-    );
-}
-
 #[test]
 fn landmarks_on_one_mesh_of_several_read_back_on_the_same_file() {
     let ict = Path::new(MANIFEST).join("../shared/data/ict-facekit");

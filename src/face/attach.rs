@@ -182,9 +182,6 @@ pub fn attach_feature_points(
         }
         matches.push(found);
     }
-    // A snapped point is where its vertex is, as if the file had given the vertex id: the
-    // FAP units, the alignment and `face info` then see the same point the FAT moves.
-    face.resolve_feature_points()?;
     Ok(matches)
 }
 
@@ -235,8 +232,6 @@ mod tests {
         );
         assert_eq!(m.len(), 1);
         assert_eq!((m[0].id, m[0].vertex), (fp("9.3"), 3));
-        // The snapped point sits on its vertex, not where the file put it.
-        assert_eq!(face.feature_points.position(fp("9.3")), Some(Vec3::Y));
         assert!((m[0].distance - 0.070_711).abs() < 1e-4);
         // A snap of more than 1 % of the face size (√2) is a warning naming the file.
         let w = snap_warnings(&face, &m, std::path::Path::new("p.csv"));
