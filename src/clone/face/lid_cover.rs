@@ -337,11 +337,13 @@ fn lid_vertices(
         .collect()
 }
 
-/// Steps 4–6 for one eye: the lid vertices `lids` of the eye with eye-white radius `r` and
+/// Steps 4–6 for one eye, pushing along `forward` (the target's own front, +z but for a
+/// turned alignment): the lid vertices `lids` of the eye with eye-white radius `r` and
 /// front `front`, the top and bottom FAPs' first-border fields `fields` (dense, changed in
 /// place) with their borders `borders`, at the values `values` (closing, then full). Returns
 /// how many vertices of each field changed.
 fn cover(
+    forward: Vec3,
     r: f32,
     front: &EyeFront,
     lids: &[LidVertex],
@@ -386,7 +388,7 @@ fn cover(
                     return None;
                 }
                 let scale = if l.upper { 1.0 / st } else { 1.0 / sb };
-                Some((k, Vec3::Z * (amount * scale)))
+                Some((k, forward * (amount * scale)))
             })
             .collect();
         for (k, d) in pushes {
@@ -605,9 +607,13 @@ pub(super) fn decide(mode: LidCover, source: Option<Seen>, target: Seen) -> (boo
 /// The step on every eye (module docs) under `mode` (not [`LidCover::Off`]): `motions` are
 /// the source's (on `ssurf`, the skin of `face` with parts `parts`), `out` the cloned ones
 /// (same order), `margins` the target's (with its eyeballs) and the source's, `fronts` the
-/// target's eye fronts ([`EyeFront::of`]). Returns what it measured and did per eye.
+/// target's eye fronts ([`EyeFront::of`]), `forward` the target's own front in the surface's
+/// frame (the lids come forward along it: along the frame's +z a turned target's lid points
+/// also moved along their FAPs, bruno → ict's 3.3 by 2.0 % at 3.15°). Returns what it
+/// measured and did per eye.
 pub(super) fn cover_lids(
     mode: LidCover,
+    forward: Vec3,
     (face, parts, ssurf): (&FaceModel, &FaceParts, &SkinSurface),
     motions: &[SurfaceMotion],
     target: &CloneSurface,
@@ -711,6 +717,7 @@ pub(super) fn cover_lids(
             vec![sc.value]
         };
         let [ct, cb] = cover(
+            forward,
             sphere.1,
             front,
             &lids,
@@ -861,6 +868,7 @@ mod tests {
         let (t0, b0) = (dt.clone(), db.clone());
         let r = 1.0;
         let changed = cover(
+            Vec3::Z,
             r,
             &f,
             &lids,
@@ -921,6 +929,7 @@ mod tests {
         let mut db = vec![Vec3::new(0.0, 0.6, 0.0); 8];
         let (t0, b0) = (dt.clone(), db.clone());
         let changed = cover(
+            Vec3::Z,
             1.0,
             &f,
             &lids,

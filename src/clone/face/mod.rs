@@ -858,13 +858,20 @@ fn clone_skin_motions(
         .push("smooth2", clock.elapsed().as_secs_f64());
 
     // Where the slits close, the closed lids cover the eyeballs from the front: by default
-    // only where they show clearly more of the eye than the source's own closed lids show.
+    // only where they leave otherwise of the eye than the source's own closed lids do.
     let clock = Instant::now();
     if opts.lid_cover != LidCover::Off {
         let fronts = lid_cover::EyeFront::of(target, tparts, alignment);
         if !fronts.is_empty() {
+            // The target's own front, as `gain` keeps FAP directions on the target's axes.
+            let forward = if alignment.keeps_own_axes() {
+                (alignment.rotation * glam::DVec3::Z).as_vec3()
+            } else {
+                glam::Vec3::Z
+            };
             report.lid_cover = lid_cover::cover_lids(
                 opts.lid_cover,
+                forward,
                 (source, sparts, ssurf),
                 &moving,
                 &tsurf.surface,
