@@ -530,13 +530,10 @@ pub fn run_demo(out_dir: &Path, opts: &DemoOptions) -> Result<DemoReport> {
         identity_cloned.name = "ict-identity".into();
 
         // ICT's closed lids cover its eyes; alma's lie behind her protruding eyes, so her
-        // blink carried over straight would show ICT's corneas through the closed lids.
-        let cover_opts = CloneOptions {
-            lid_cover: true,
-            ..clone_opts.clone()
-        };
+        // blink carried over straight would show ICT's corneas through the closed lids: the
+        // default `lid_cover` (auto) covers them.
         let t = Instant::now();
-        let cloned = clone_face(&alma, &strip_fat(&ict), &cover_opts)?;
+        let cloned = clone_face(&alma, &strip_fat(&ict), &clone_opts)?;
         let clone_seconds = t.elapsed().as_secs_f64();
         clock.lap(&format!("clone alma→ict-head ({method_name})"));
         warnings.extend(prefixed("ict-head-from-alma", &cloned.report.warnings));

@@ -139,8 +139,9 @@ fn eval_ground_truth_clones_and_measures() {
 }
 
 /// `--lid-cover` (alma's blink onto the real ICT head, whose corneas showed through the
-/// closed lids): the eyelid tables (FAPs 19–22) change, a table away from the eyes
-/// (`open_jaw`) is the same to the bit.
+/// closed lids): with `off` against `on` the eyelid tables (FAPs 19–22) change, a table away
+/// from the eyes (`open_jaw`) is the same to the bit; the default (`auto`) covers both eyes
+/// here, as `on` does, and `--lid-cover` alone means `on`. `--verbose` says per eye why.
 #[test]
 fn lid_cover_changes_the_lids_and_only_them() {
     let Ok(ict) = fbakit::face::read("ict") else {
@@ -159,12 +160,12 @@ fn lid_cover_changes_the_lids_and_only_them() {
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        fbakit::face::vrml::read_face_file(&out).unwrap().0
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        (fbakit::face::vrml::read_face_file(&out).unwrap().0, text)
     };
-    let (plain, covered) = (
-        clone("plain.wrl", &[]),
-        clone("covered.wrl", &["--lid-cover"]),
-    );
+    let (plain, _) = clone("plain.wrl", &["--lid-cover", "off"]);
+    let (covered, _) = clone("covered.wrl", &["--lid-cover"]);
+    let (auto, said) = clone("auto.wrl", &["--verbose"]);
     let table = |face: &fbakit::face::FaceModel, fap: u8| {
         let key = fbakit::fat::TableKey::LowLevel(fbakit::spec::FapId::new(fap).unwrap());
         face.fat.table(key).cloned()
@@ -173,8 +174,26 @@ fn lid_cover_changes_the_lids_and_only_them() {
         let (a, b) = (table(&plain, fap), table(&covered, fap));
         assert!(a.is_some() && b.is_some(), "FAP {fap}");
         assert_ne!(a, b, "FAP {fap} is the same with --lid-cover");
+        assert_eq!(
+            b,
+            table(&auto, fap),
+            "FAP {fap}: auto does not cover as on does"
+        );
     }
     let (a, b) = (table(&plain, 3), table(&covered, 3));
     assert!(a.is_some());
     assert_eq!(a, b, "open_jaw changed with --lid-cover");
+    for eye in ["left", "right"] {
+        assert!(
+            said.contains(&format!("lid_cover (auto): {eye} eye covered")),
+            "{said}"
+        );
+    }
+    let o = fbakit()
+        .args(["clone", "alma", target.to_str().unwrap(), "-o"])
+        .arg(dir.path().join("bad.wrl"))
+        .args(["--lid-cover", "sometimes"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
 }

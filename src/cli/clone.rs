@@ -7,7 +7,7 @@ use fbakit::clone::eval::{
     clone_against_truth, compliance, ground_truth_error, self_clone_error_with, ComplianceReport,
     GroundTruthReport,
 };
-use fbakit::clone::face::{clone_face, CloneOptions, CloneReport};
+use fbakit::clone::face::{clone_face, CloneOptions, CloneReport, LidCover};
 use fbakit::error::{Error, Result, ResultExt};
 use fbakit::export::obj_shapes::ObjShapesReport;
 use fbakit::face::{FaceFormat, FaceModel};
@@ -41,10 +41,21 @@ pub struct CloneArgs {
     pub no_align: bool,
     /// Where the source's blink closes its eyes, bring the target's closed lids forward until
     /// they cover its eyeballs from the front (a real head under a cartoon's blink, whose
-    /// closed lids lie behind its protruding eyes). Off by default: it changes a self-clone
-    /// of a face whose own blink leaves its eyes showing.
-    #[arg(long)]
-    pub lid_cover: bool,
+    /// closed lids lie behind its protruding eyes). `auto` (default): only on an eye whose
+    /// closed lids leave otherwise of it than the source's own closed lids leave of the
+    /// source's — clearly more of it, or a sliver where the source's whole eye stands out —
+    /// so a self-clone, or a cartoon whose own blink leaves its eye showing, is kept; `on`
+    /// (also `--lid-cover` alone): every eye; `off`: never. `--verbose` says per eye what was
+    /// measured and done.
+    #[arg(
+        long,
+        value_enum,
+        value_name = "auto|on|off",
+        default_value = "auto",
+        num_args = 0..=1,
+        default_missing_value = "on"
+    )]
+    pub lid_cover: LidCoverArg,
     /// Feature points of an OBJ source.
     #[arg(long, value_name = "FILE")]
     pub fp_source: Option<PathBuf>,
@@ -75,6 +86,29 @@ pub struct CloneArgs {
     pub new_document: bool,
     #[command(flatten)]
     pub nodes: super::play::NodeArgs,
+}
+
+/// `--lid-cover auto|on|off` ([`fbakit::clone::face::LidCover`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum LidCoverArg {
+    /// Cover an eye only where the clone's closed lids leave otherwise of it than the
+    /// source's leave of the source's (more of it, or a sliver).
+    #[default]
+    Auto,
+    /// Cover every eye the source's blink closes.
+    On,
+    /// Never.
+    Off,
+}
+
+impl From<LidCoverArg> for LidCover {
+    fn from(a: LidCoverArg) -> Self {
+        match a {
+            LidCoverArg::Auto => LidCover::Auto,
+            LidCoverArg::On => LidCover::On,
+            LidCoverArg::Off => LidCover::Off,
+        }
+    }
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -320,7 +354,7 @@ pub fn run(args: CloneArgs) -> Result<u8> {
         method: args.method.into(),
         rbf_fapu_rescale: !args.rbf_paper,
         align: !args.no_align,
-        lid_cover: args.lid_cover,
+        lid_cover: args.lid_cover.into(),
         ..CloneOptions::default()
     };
     let outcome = clone_face(&source, &target, &opts).with_context(|| {
@@ -411,6 +445,9 @@ pub fn run(args: CloneArgs) -> Result<u8> {
     if args.verbose {
         for (step, s) in &r.timings.steps {
             println!("  {step:<20} {:>8.1} ms", s * 1000.0);
+        }
+        for eye in &r.lid_cover {
+            println!("lid_cover ({}): {eye}", opts.lid_cover.name());
         }
     }
     if let Some(sh) = &shapes {

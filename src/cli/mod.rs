@@ -214,7 +214,7 @@ pub enum Command {
                       fbakit clone alma.wrl bruno.wrl -o out.wrl --json > report.json\n  \
                       fbakit clone alma bruno -o bruno-arkit.glb --method rbf --names arkit\n  \
                       fbakit clone alma head.obj --fp-target fp.csv -o shapes/ --names arkit\n  \
-                      fbakit clone alma ict -o ict-blinks.glb --lid-cover"
+                      fbakit clone alma ict -o ict-blinks.glb -v --lid-cover on"
     )]
     Clone(clone::CloneArgs),
     /// Quality figures of a face's FAT (compliance, self-cloning error).

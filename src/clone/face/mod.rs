@@ -132,7 +132,7 @@
 //!    own chords dip into its eyeball under that motion (in radii; a self-clone is kept
 //!    exactly) is pushed out along the eyeball's normal, the push spread smoothly over half
 //!    a radius; before `smooth`'s second pass and `bound`.
-//!    **`lid_cover`** (with [`CloneOptions::lid_cover`], default off; `lid_cover.rs`), after
+//!    **`lid_cover`** (with [`CloneOptions::lid_cover`], default `Auto`; `lid_cover.rs`), after
 //!    `eyeball` and `smooth`'s second pass (which took a single margin vertex's closing
 //!    back, reopening the slit over the eye): at the source's closing value, where the
 //!    target's margins are still apart over its eyeball part, they close to 0.02 IRISD0 of
@@ -144,8 +144,12 @@
 //!    half a radius, straight forward (no height change), through its lid's FAP at its
 //!    first border. A target whose closed lids cover its eye is not changed.
 //!    Alma's blink on ICT's head: eye vertices seen through the closed lids 69 / 70 per eye
-//!    → 0 (ICT's own blink 0); off by default because a cartoon's own blink may leave its
-//!    eye showing (alma's own: 59 of 338), and the step would change its self-clone.
+//!    → 0 (ICT's own blink 0). By default (`Auto`) only on an eye where what the clone's
+//!    closed lids leave of it differs from what the source's own leave of the source's: a
+//!    share of the open eye more than 0.1 over the source's, or a sliver standing out less
+//!    than half as far in front of the lids (alma → ICT 20 % at 0.033 half widths against
+//!    alma's own 58 % at 0.137): a self-clone, and a cartoon whose own blink leaves its eye
+//!    showing onto another (alma ↔ bruno), are kept.
 //!    **`mouth`** (every method, `mouth_fill.rs`): the target's hidden mouth interior
 //!    (skin behind the lips' front and hidden from the front, reached from the inner lip
 //!    contour) takes a harmonic extension (edges weighed by inverse length) of the lips'
@@ -297,9 +301,9 @@ use rayon::prelude::*;
 
 pub use align::Similarity;
 pub use lid_resting::{lid_resting_layers, LidRestingLayer};
-pub use options::{face_fmc_options, face_rbf_options, CloneOptions, Method};
+pub use options::{face_fmc_options, face_rbf_options, CloneOptions, LidCover, Method};
 pub use parts::{identify_parts, FaceParts, Part};
-pub use report::{CloneOutcome, CloneReport, RigidReport};
+pub use report::{CloneOutcome, CloneReport, LidCoverEye, RigidReport};
 pub use rescale::{FapFailure, FapRepair};
 pub use rigid::install_center;
 pub use rigid::standard;
@@ -853,19 +857,29 @@ fn clone_skin_motions(
         .timings
         .push("smooth2", clock.elapsed().as_secs_f64());
 
-    // Where the slits close, the closed lids cover the eyeballs from the front (off by
-    // default: a cartoon's own blink may not).
+    // Where the slits close, the closed lids cover the eyeballs from the front: by default
+    // only where they leave otherwise of the eye than the source's own closed lids do.
     let clock = Instant::now();
-    if opts.lid_cover {
+    if opts.lid_cover != LidCover::Off {
         let fronts = lid_cover::EyeFront::of(target, tparts, alignment);
-        lid_cover::cover_lids(
-            &ssurf.surface,
-            &moving,
-            &tsurf.surface,
-            [&margins[0], &margins[1]],
-            &fronts,
-            &mut result.motions,
-        );
+        if !fronts.is_empty() {
+            // The target's own front, as `gain` keeps FAP directions on the target's axes.
+            let forward = if alignment.keeps_own_axes() {
+                (alignment.rotation * glam::DVec3::Z).as_vec3()
+            } else {
+                glam::Vec3::Z
+            };
+            report.lid_cover = lid_cover::cover_lids(
+                opts.lid_cover,
+                forward,
+                (source, sparts, ssurf),
+                &moving,
+                &tsurf.surface,
+                [&margins[0], &margins[1]],
+                &fronts,
+                &mut result.motions,
+            );
+        }
     }
     report
         .timings

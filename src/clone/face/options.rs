@@ -41,6 +41,40 @@ impl std::fmt::Display for Method {
     }
 }
 
+/// When the `lid_cover` step runs ([`CloneOptions::lid_cover`]; its module docs in
+/// `lid_cover.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LidCover {
+    /// Per eye the source's blink closes: cover it only where what the clone's closed lids
+    /// leave of it differs from what the source's own closed lids leave of the source's
+    /// (`lid_cover.rs` module docs, "When"): the clone shows a share of its eye more than
+    /// 0.1 over the source's (a source whose closed lids hide its eye, or that has none), or
+    /// a sliver standing out in front of its closed lids less than half as far as the
+    /// source's eye stands out in front of the source's (alma's blink on ICT's head: 20 % of
+    /// the eye standing out 0.03 half widths, alma's own 58 % standing out 0.14). A
+    /// self-clone sees the same on both sides and is kept exactly; so is a cartoon onto a
+    /// cartoon whose blinks both leave the eye showing (alma ↔ bruno).
+    #[default]
+    Auto,
+    /// Cover every eye the source's blink closes (self-clones change: alma → alma's lid FAPs
+    /// 4.6 % upper / 3.7 % lower off the truth, bruno → bruno's 4.6 % / 3.4 %).
+    On,
+    /// Never run the step.
+    Off,
+}
+
+impl LidCover {
+    /// `auto`, `on` or `off`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LidCover::Auto => "auto",
+            LidCover::On => "on",
+            LidCover::Off => "off",
+        }
+    }
+}
+
 /// Settings of [`clone_face`](super::clone_face).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CloneOptions {
@@ -70,17 +104,15 @@ pub struct CloneOptions {
     /// `lid_seam`: there the lids meet along one smooth line; and `eyeball`: no lid vertex
     /// passes into an eyeball part on its way to any border. Default on.
     pub lid_close: bool,
-    /// Run `lid_cover` (module docs, after `eyeball` and `smooth`'s second pass): where the source's blink closes its
-    /// eye, the target's slit closes over its eyeball and the closed lids come forward until
-    /// they cover it from the front. Alma's blink on ICT's head left 69 / 70 eye
-    /// vertices per eye seen through the closed lids, none with this on. Default off: the
-    /// step forces a cover on any target, but a cartoon's own blink may leave its eye showing
-    /// (alma's shows 59 of her 338 eye vertices), so self-clones change (alma → alma's lid
-    /// FAPs 4.6 % upper / 3.7 % lower off the truth, bruno → bruno's 4.6 % / 3.4 %; median
-    /// 0.000 % for both; off: 0.00 %), and no rule on the target's resting geometry was found
-    /// that tells a cartoon target from a real one. Turn it on for a real head whose closed
-    /// lids must cover its eyes.
-    pub lid_cover: bool,
+    /// When to run `lid_cover` (module docs, after `eyeball` and `smooth`'s second pass):
+    /// where the source's blink closes its eye, the target's slit closes over its eyeball and
+    /// the closed lids come forward until they cover it from the front. Default
+    /// [`LidCover::Auto`]: only on an eye whose closed lids leave otherwise of it than the
+    /// source's own closed lids leave of the source's (alma's blink on ICT's head: 69 / 70
+    /// eye vertices per eye seen through the closed lids, none with the step), so a
+    /// self-clone is kept exactly. The report says per eye what it measured and did
+    /// ([`CloneReport::lid_cover`](super::CloneReport::lid_cover)).
+    pub lid_cover: LidCover,
 }
 
 impl Default for CloneOptions {
@@ -95,7 +127,7 @@ impl Default for CloneOptions {
             align_snap_degrees: 3.0,
             smooth_shares: true,
             lid_close: true,
-            lid_cover: false,
+            lid_cover: LidCover::default(),
         }
     }
 }

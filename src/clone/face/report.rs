@@ -29,6 +29,41 @@ pub struct RigidReport {
     pub baked_transforms: Vec<String>,
 }
 
+/// What `lid_cover` ([`CloneOptions::lid_cover`](super::CloneOptions::lid_cover)) found for
+/// one eye the source's blink closes (its module docs, "When"): what of the eye shows from
+/// the front through the closed lids, on the source at its closing value and on the clone
+/// before the step, and whether the step covered the eye.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LidCoverEye {
+    /// `left` or `right` (the face's own).
+    pub eye: &'static str,
+    /// The source's eye through its own closed lids: the share (0–1) of what its open eye
+    /// shows, and how far that stands out in front of the lids (median, in half widths of
+    /// the eye). `None`: the source has no eyeball there (taken as nothing seen).
+    pub source_seen: Option<[f64; 2]>,
+    /// The same for the target's eye through the clone's closed lids, before the step.
+    pub target_seen: [f64; 2],
+    /// Whether the step covered the eye.
+    pub covered: bool,
+    /// Why, in words.
+    pub reason: String,
+}
+
+impl std::fmt::Display for LidCoverEye {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let seen = |s: [f64; 2]| format!("{:.0} % standing out {:.3}", 100.0 * s[0], s[1]);
+        write!(
+            f,
+            "{} eye {}: seen through the closed lids {} (the source's: {}); {}",
+            self.eye,
+            if self.covered { "covered" } else { "kept" },
+            seen(self.target_seen),
+            self.source_seen.map_or("no eyeball".to_string(), seen),
+            self.reason
+        )
+    }
+}
+
 /// Everything [`clone_face`](super::clone_face) reports besides the face.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct CloneReport {
@@ -75,6 +110,9 @@ pub struct CloneReport {
     pub failed_faps: Vec<FapFailure>,
     /// Meshes of neither skin nor a part that ride on the skin (lashes; step 8).
     pub attached_meshes: Vec<String>,
+    /// Per eye the source's blink closes, what `lid_cover` measured and did (empty when it
+    /// is off or the target has no eyeball parts).
+    pub lid_cover: Vec<LidCoverEye>,
 }
 
 /// The report as the CLI prints it: a summary line, the alignment, the warnings.
