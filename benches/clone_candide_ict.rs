@@ -113,6 +113,7 @@
 //! dropped: gradients after a change of `α` (10 iterations at 100, 14 at 10: as dear as a
 //! factorisation) and on the soft steps (10, 1: not converged in 8); a looser residual
 //! (1e-4: 3 iterations, a larger change of the output). Not attempted: the `bound` step.
+//! Peak memory (this bench, load 13): 114–117 MB before, 111 MB after (one run).
 
 use std::path::Path;
 use std::sync::OnceLock;
