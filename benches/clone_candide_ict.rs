@@ -88,6 +88,32 @@
 //! attempted: `fit:register`'s factorisations (the largest lever left) each wait for the
 //! searches before them and the searches for them, so only work outside the registration
 //! could use the idle core.
+//!
+//! Helper `speed10`: a registration step at the stiffness of the step before (three of the
+//! four steps at `α` = 300 after the first with data, the second at 100) changes only the
+//! data weights of the vertices whose match came or went; it is solved by conjugate
+//! gradients from the last answer, preconditioned by the last factorisation (relative
+//! residual 1e-6, at most 8 iterations, given up after two when the rate so far needs more),
+//! instead of a new factorisation: 11 → 7 factorisations, the four others 5 iterations each.
+//! Per solve (minimum of three runs, load 8): factorisation and solve 14.7 ms, five
+//! iterations 7.5 ms. The output changes slightly (digest `b30de834699e5e7f` →
+//! `4683ab52835c4e01`; the bench now prints it, streamed into the hasher): the accuracy
+//! suites (`clone_ict_identities`, `clone_known_fat`, `clone_heads`, `clone_ict`,
+//! `clone_styles`, `clone_lids`) print the same medians and worsts before and after, but
+//! for lid depths ~2e-6 apart and one non-worst ratio (CANDIDE-3 → ICT rig `thrust_jaw`
+//! 2.72 → 2.84; the pair's worst 9.16 the same); `fat_snapshots` unchanged (within its
+//! tolerance). Measured on the shared machine only (load 12–13, four sessions building),
+//! the measuring session's scheduler group at nice −20, one binary with the change switched
+//! off and on (off: main's output bit for bit), alternated: this bench's medians, six runs
+//! each, 506–588 → 469–599 ms (median of the six 553 → 520 ms); CPU time of the whole
+//! process (three clones of set-up and 5 samples, `perf stat -r 3`, two alternated pairs)
+//! 6.95 / 6.78 → 6.27 / 6.68 s. A first set of four alternated rounds (main's binary, off,
+//! on) showed no difference (medians 565–587, 512–580, 549–607 ms): the gain, ~15–20 ms
+//! expected quietly (four half factorisations), is within this load's noise. Tried and
+//! dropped: gradients after a change of `α` (10 iterations at 100, 14 at 10: as dear as a
+//! factorisation) and on the soft steps (10, 1: not converged in 8); a looser residual
+//! (1e-4: 3 iterations, a larger change of the output). Not attempted: the `bound` step.
+//! Peak memory (this bench, load 13): 114–117 MB before, 111 MB after (one run).
 
 use std::path::Path;
 use std::sync::OnceLock;
@@ -128,12 +154,13 @@ fn faces() -> Option<&'static (FaceModel, FaceModel)> {
                 .map(|(s, t)| format!("{s} {:.0} ms", t * 1e3))
                 .collect();
             eprintln!(
-                "{} ({} → {} vertices): {:.0} ms: {}",
+                "{} ({} → {} vertices): {:.0} ms: {}; digest {:016x}",
                 method.name(),
                 dense.vertex_count(),
                 ict.vertex_count(),
                 out.report.timings.total() * 1e3,
-                steps.join(", ")
+                steps.join(", "),
+                digest(&out.face)
             );
         }
         if let Some(peak) = peak_rss_mb() {
@@ -142,6 +169,26 @@ fn faces() -> Option<&'static (FaceModel, FaceModel)> {
         Some((dense, ict))
     })
     .as_ref()
+}
+
+/// A hash of the whole cloned face's `Debug` text (as `Hash` of that `String` gives): the
+/// same digest before and after a change shows the same output bit for bit. Streamed into
+/// the hasher: the text, tens of MB, would raise the peak memory printed.
+fn digest(face: &FaceModel) -> u64 {
+    use std::fmt::Write;
+    use std::hash::{DefaultHasher, Hasher};
+    struct Feed(DefaultHasher);
+    impl Write for Feed {
+        fn write_str(&mut self, s: &str) -> std::fmt::Result {
+            self.0.write(s.as_bytes());
+            Ok(())
+        }
+    }
+    let mut feed = Feed(DefaultHasher::new());
+    write!(feed, "{face:?}").expect("hashing never fails");
+    // `str`'s `Hash` ends with this byte.
+    feed.0.write_u8(0xff);
+    feed.0.finish()
 }
 
 /// The process's peak resident set (Linux `VmHWM`), in MB.

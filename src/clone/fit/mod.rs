@@ -30,7 +30,9 @@
 //!    2007 ("Optimal Step Nonrigid ICP Algorithms for Surface Registration"). Each step is one
 //!    sparse SPD system `(α(LᵀL+μL_g) + W + βB + εI) u = W(c−p) + βB(L−p)` in three
 //!    right-hand sides, solved by a sparse Cholesky factorisation (faer) whose pattern and
-//!    symbolic analysis are built once.
+//!    symbolic analysis are built once; a step at the stiffness of the step before, by
+//!    conjugate gradients preconditioned by that step's factor when they converge within a
+//!    few iterations (`system.rs`).
 //!    Defaults: `α` = 300, 300, 100, 10, 1 with two closest-point updates each, and `β` = 10,
 //!    or 100 on a dense source (median edge under [`DENSE_EDGE`] ES0; ICT's are 0.04).
 //!    Along the surface only the bending term and the landmarks hold the source, so it
