@@ -389,9 +389,9 @@ fn chains(
         }
     }
     let mut by: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-    for k in 0..apart.len() {
+    for (k, &ci) in apart.iter().enumerate() {
         let r = find(&mut root, k);
-        by.entry(r).or_default().push(apart[k]);
+        by.entry(r).or_default().push(ci);
     }
     by.into_values().collect()
 }
