@@ -152,7 +152,10 @@ pub fn build_skin_surface_like(
             }
             (l.welded.clone(), surface_positions)
         }
-        _ => weld_outside_mouth(&positions, &triangles, &starts, eps, mouth),
+        _ => {
+            let slit = mouth.map(|b| (b, closed_slit_middle(&fp_positions, &fapu)));
+            weld_outside_mouth(&positions, &triangles, &starts, eps, slit)
+        }
     };
     let (member_start, members) = duplicate_lists(&welded, surface_positions.len());
     let tris: Vec<[u32; 3]> = triangles
@@ -255,23 +258,35 @@ fn framed_feature_points(
     Ok((fp_positions, fapu))
 }
 
-/// Welds vertices within `eps` of each other. Inside the `mouth` box a closed mouth's upper
-/// and lower lips coincide and must stay apart, while seam duplicates there (a UV seam down the
-/// lips, the border between a skin and a mouth primitive) must not: coincident vertices in the
-/// box are welded unless one's polygons lie all above it and the other's all below (the
-/// opposite lips of the closed slit; `y` is up in the frame cloning works in) — or they come
-/// from different meshes (`starts`: each mesh's first vertex), which meet there along a
-/// border: ICT's lips end on its mouth socket, the lip's polygons above the lower lip's inner
-/// edge and the socket's below; as two glTF primitives they parted there (a crack) while the
-/// one OBJ mesh holds one vertex. Returns the surface vertex of every input vertex and the
-/// surface positions.
+/// Welds vertices within `eps` of each other. Inside the mouth box (`slit.0`) a closed
+/// mouth's upper and lower lips coincide and must stay apart, while seam duplicates there (a
+/// UV seam down the lips, the border between a skin and a mouth primitive) must not:
+/// coincident vertices in the box are welded unless one's polygons lie all above it and the
+/// other's all below (the opposite lips of the closed slit; `y` is up in the frame cloning
+/// works in) — or they come from different meshes (`starts`: each mesh's first vertex), which
+/// meet there along a border: ICT's lips end on its mouth socket, the lip's polygons above the
+/// lower lip's inner edge and the socket's below; as two glTF primitives they parted there (a
+/// crack) while the one OBJ mesh holds one vertex.
+///
+/// Locally a UV seam along the lip's edge on its socket, inside one primitive, is exactly such
+/// a slit (two boundary fans, one above and one below, continuing each other: a closed slit
+/// cut in a sheet is a seam, bruno's lips too), so what tells them apart is where the chain
+/// runs: a closed slit is the mouth's opening and runs through the middle of the inner lip
+/// line (2.2/2.3, `slit.1`), while a seam on the socket lies behind the lips. Vertices kept
+/// apart are chained by the edges joining them; only a chain passing within its reach of
+/// that middle stays apart, every other is welded (ICT's lips on their socket, split at UV
+/// seams in one glTF primitive, parted by 11 % of `open_jaw`'s peak). Without the middle
+/// (no 2.2/2.3) every chain stays apart. Returns the surface vertex of every input vertex and
+/// the surface positions.
 fn weld_outside_mouth(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
     starts: &[usize],
     eps: f32,
-    mouth: Option<Box3>,
+    slit: Option<(Box3, Option<(Vec3, f32)>)>,
 ) -> (Vec<u32>, Vec<Vec3>) {
+    let mouth = slit.map(|s| s.0);
+    let middle = slit.and_then(|s| s.1);
     let mesh_of = |v: u32| starts.partition_point(|&s| s <= v as usize);
     let coincident = find_coincident_vertices(positions, eps);
     let mut rep = coincident.representative.clone();
@@ -282,11 +297,13 @@ fn weld_outside_mouth(
         .collect();
     if !in_mouth.is_empty() {
         let side = lip_sides(positions, triangles);
-        for cluster in in_mouth {
+        // The clusters kept apart, by index in `in_mouth`, to chain them after.
+        let mut apart: Vec<usize> = Vec::new();
+        for (ci, cluster) in in_mouth.iter().enumerate() {
             // Members join the first group whose side is compatible, else the first group
             // holding no vertex of their own mesh; a group takes the side of a sided member.
             let mut groups: Vec<(u32, LipSide, Vec<usize>)> = Vec::new();
-            for &v in cluster {
+            for &v in cluster.iter() {
                 let (s, m) = (side[v as usize], mesh_of(v));
                 let join = groups
                     .iter()
@@ -307,6 +324,23 @@ fn weld_outside_mouth(
                     }
                 }
             }
+            if groups.len() > 1 {
+                apart.push(ci);
+            }
+        }
+        if let Some((middle, reach)) = middle {
+            for chain in chains(&apart, &in_mouth, triangles, positions.len()) {
+                let at_middle = chain
+                    .iter()
+                    .any(|&ci| positions[in_mouth[ci][0] as usize].distance(middle) <= reach);
+                if !at_middle {
+                    for &ci in &chain {
+                        for &v in in_mouth[ci] {
+                            rep[v as usize] = coincident.representative[v as usize];
+                        }
+                    }
+                }
+            }
         }
     }
     let mut welded = vec![u32::MAX; positions.len()];
@@ -321,6 +355,56 @@ fn weld_outside_mouth(
         welded[i] = welded[rep[i] as usize];
     }
     (welded, surface_positions)
+}
+
+/// The clusters `apart` (indices into `clusters`) joined into chains: two are in one chain
+/// when an edge of `triangles` joins a member of one to a member of the other.
+fn chains(
+    apart: &[usize],
+    clusters: &[&Vec<u32>],
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+) -> Vec<Vec<usize>> {
+    let mut slot = vec![u32::MAX; vertex_count];
+    for (k, &ci) in apart.iter().enumerate() {
+        for &v in clusters[ci] {
+            slot[v as usize] = k as u32;
+        }
+    }
+    let mut root: Vec<usize> = (0..apart.len()).collect();
+    fn find(root: &mut [usize], mut a: usize) -> usize {
+        while root[a] != a {
+            root[a] = root[root[a]];
+            a = root[a];
+        }
+        a
+    }
+    for t in triangles {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let (sa, sb) = (slot[a as usize], slot[b as usize]);
+            if sa != u32::MAX && sb != u32::MAX {
+                let (ra, rb) = (find(&mut root, sa as usize), find(&mut root, sb as usize));
+                root[ra] = rb;
+            }
+        }
+    }
+    let mut by: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (k, &ci) in apart.iter().enumerate() {
+        let r = find(&mut root, k);
+        by.entry(r).or_default().push(ci);
+    }
+    by.into_values().collect()
+}
+
+/// The middle of a closed mouth's inner lip line (between 2.2 and 2.3) and how near a chain
+/// of lip vertices kept apart must pass to be its slit: a tenth of MNS0 (a closed slit holds
+/// 2.2 and 2.3 on its own vertices; ICT's lip/socket seam passes 0.34 MNS0 away).
+fn closed_slit_middle(fps: &BTreeMap<FeaturePointId, Vec3>, fapu: &Fapu) -> Option<(Vec3, f32)> {
+    let (a, b) = (
+        fps.get(&FeaturePointId::FP_2_2)?,
+        fps.get(&FeaturePointId::FP_2_3)?,
+    );
+    Some(((*a + *b) / 2.0, 0.1 * fapu.distances.mns0 as f32))
 }
 
 /// Where a vertex's polygons lie, vertically.
@@ -451,11 +535,28 @@ mod tests {
             hi: Vec3::splat(0.5),
         });
         // One mesh: the closed slit's lips.
-        let (welded, surface) = weld_outside_mouth(&positions, &triangles, &[0], 1e-6, mouth);
+        let at = |m: Vec3| mouth.map(|b| (b, Some((m, 0.1))));
+        let (welded, surface) =
+            weld_outside_mouth(&positions, &triangles, &[0], 1e-6, at(Vec3::ZERO));
         assert_ne!(welded[0], welded[3]);
         assert_eq!(surface.len(), 6);
+        // Without the lip line's middle too.
+        let (welded, _) =
+            weld_outside_mouth(&positions, &triangles, &[0], 1e-6, mouth.map(|b| (b, None)));
+        assert_ne!(welded[0], welded[3]);
+        // The same fans away from the lip line's middle: a seam (a lip on its socket).
+        let (welded, surface) = weld_outside_mouth(
+            &positions,
+            &triangles,
+            &[0],
+            1e-6,
+            at(Vec3::new(0.0, 0.3, -0.3)),
+        );
+        assert_eq!(welded[0], welded[3]);
+        assert_eq!(surface.len(), 5);
         // Two meshes meeting there (a lip ending on a mouth socket primitive): one vertex.
-        let (welded, surface) = weld_outside_mouth(&positions, &triangles, &[0, 3], 1e-6, mouth);
+        let (welded, surface) =
+            weld_outside_mouth(&positions, &triangles, &[0, 3], 1e-6, at(Vec3::ZERO));
         assert_eq!(welded[0], welded[3]);
         assert_eq!(surface.len(), 5);
         // Outside the mouth box duplicates weld anyway.
