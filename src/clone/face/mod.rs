@@ -163,7 +163,11 @@
 //!    length) over their corners and a ring that grows each round, and in triangles still
 //!    above the bound, if a sliver, the corner opposite the longest edge following that edge (a sliver
 //!    moves with its base) — feature points, the lips' and lids' margins held, the round turning least kept
-//!    if it turns less than the clone's own. It settles what `smooth`'s uniform steps cannot:
+//!    if it turns less than the clone's own. Before the rounds, a FAP's own feature point
+//!    whose triangles turn over the bound pulls its surroundings (the slit too, both lips
+//!    alike) towards its motion by a bump along the mesh, the radius turning least kept:
+//!    a coarse target's lip corner sampled at the peak of a dense source's motion no longer
+//!    overtakes its neighbours (ict → bruno 172° → under 142°). It settles what `smooth`'s uniform steps cannot:
 //!    CANDIDE-3's slivers at the sides of the head under the brow FAPs, ICT's tenth-of-a-
 //!    millimetre triangles at the inner lip corners. Re-solved motions join
 //!    [`CloneReport::smoothed`].

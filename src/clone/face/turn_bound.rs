@@ -25,6 +25,15 @@
 //! touched. Each round's motion is measured over every triangle, also faded into the clone's
 //! own motion over the region's outer rings, and the one turning least is kept, if it turns
 //! less than the clone's own; a motion already under the bound is not changed at all.
+//!
+//! Before the rounds, when a triangle at the FAP's own feature point turns over the bound,
+//! the point *pulls* its surroundings along: every vertex within a radius along the mesh
+//! (lid margins not entered, the lips' slit entered: both lips near the point move alike)
+//! moves towards the point's motion by a Wendland bump of its distance; radii of 2–16 mean
+//! edges at the point are tried and the one turning least kept if it beats the clone's own.
+//! A coarse target's point sampled at the peak of a dense source's motion overtakes its
+//! neighbours otherwise — on the held slit no round could reach it (ICT's lip corner under
+//! `stretch_r_cornerlip_o` on bruno's: 172°, bruno's own FAT 4.6°).
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -265,6 +274,71 @@ impl PointSpread {
     }
 }
 
+/// Radii of the pull's ball (along the mesh) tried, as multiples of the mean length of the
+/// target's edges at the feature point: a pull one ring wide only moves the fold one ring
+/// out (ict → bruno's right lip corner: 2×, 3× and 5× leave 173°, 173°, 159°; 8× 31°).
+const PULL_REACH: [f32; 6] = [2.0, 3.0, 5.0, 8.0, 12.0, 16.0];
+
+/// The target vertices within mesh distance `radius` (along edges) of `from`, with their
+/// distances; `held` vertices (the lid margins) are not entered.
+fn within(
+    positions: &[Vec3],
+    adj: &[Vec<u32>],
+    from: u32,
+    radius: f32,
+    held: &[bool],
+) -> Vec<(u32, f32)> {
+    let mut dist: HashMap<u32, f32> = HashMap::from([(from, 0.0)]);
+    let mut heap = std::collections::BinaryHeap::new();
+    heap.push((std::cmp::Reverse(0u32), from));
+    let mut out = Vec::new();
+    while let Some((std::cmp::Reverse(bits), v)) = heap.pop() {
+        let dv = f32::from_bits(bits);
+        if dist.get(&v).is_some_and(|&d| d < dv) {
+            continue;
+        }
+        out.push((v, dv));
+        for &w in &adj[v as usize] {
+            if held[w as usize] {
+                continue;
+            }
+            let dw = dv + positions[v as usize].distance(positions[w as usize]);
+            if dw < radius && dist.get(&w).is_none_or(|&d| dw < d) {
+                dist.insert(w, dw);
+                // Non-negative floats order as their bits.
+                heap.push((std::cmp::Reverse(dw.to_bits()), w));
+            }
+        }
+    }
+    out
+}
+
+/// The FAP's own feature point `p` pulling its surroundings along (module docs): every
+/// vertex within `radius` along the mesh moves towards the point's motion by a Wendland
+/// bump of its distance, 1 at the point. A coarse target's point sampled at the peak of a
+/// dense source's motion (ICT's lip corner under `stretch_cornerlip_o`, 0.48 MNS0 back and
+/// out) otherwise overtakes its neighbours, which read the source beside the peak: its
+/// triangles fold (ict → bruno: 172°, bruno's own FAT 4.6°). Returns the changed vertices
+/// with their new motion.
+fn pull(
+    positions: &[Vec3],
+    adj: &[Vec<u32>],
+    d: &[Vec3],
+    p: u32,
+    radius: f32,
+    held: &[bool],
+) -> Vec<(u32, Vec3)> {
+    let at = d[p as usize];
+    within(positions, adj, p, radius, held)
+        .into_iter()
+        .filter(|&(v, _)| v != p)
+        .map(|(v, r)| {
+            let o = d[v as usize];
+            (v, o + bump(r / radius) * (at - o))
+        })
+        .collect()
+}
+
 /// The vertices every motion keeps (module docs): the surface's borders near the mouth with
 /// two rings around them and the `held` ones (the lid margins). A motion's own feature point
 /// is kept by [`bound_turns`].
@@ -478,6 +552,12 @@ pub(super) fn bound_turns(
     let n = target.positions.len();
     let (incident, tn) = (&topology.incident, &topology.tn);
     let fixed = fixed_vertices(target, &topology.adj, held);
+    let mut held_lids = vec![false; n];
+    for &v in held {
+        if let Some(h) = held_lids.get_mut(v as usize) {
+            *h = true;
+        }
+    }
     let bounds = Bounds {
         topology,
         source,
@@ -535,6 +615,55 @@ pub(super) fn bound_turns(
                     t.contains(&tv) && rough(pos, &d, t, tn[i as usize], cos_tau)
                 })
             });
+            // The point pulls its surroundings along first, when a triangle at it turns over
+            // the bound ([`pull`]; the lips' slit is not held: the pull moves both lips
+            // near the point alike): of the radii tried, the pull turning least is kept if
+            // it turns less than the clone's own, and the rounds start from it.
+            let (mut d, mut moving, mut own_cos) = (d, moving, own_cos);
+            let mut pulled = 0usize;
+            if let (Some((_, tv)), true) = (own, starts_at_own) {
+                let at = pos[tv as usize];
+                let nb = &topology.adj[tv as usize];
+                let mean = nb
+                    .iter()
+                    .map(|&w| pos[w as usize].distance(at))
+                    .sum::<f32>()
+                    / nb.len().max(1) as f32;
+                let mut best: Option<(f32, Vec<(u32, Vec3)>, Vec<u32>)> = None;
+                for k in PULL_REACH {
+                    let changed = pull(pos, &topology.adj, &d, tv, k * mean, &held_lids);
+                    let mut t = d.clone();
+                    for &(v, o) in &changed {
+                        t[v as usize] = o;
+                    }
+                    let mut m = moving.clone();
+                    m.extend(
+                        changed
+                            .iter()
+                            .flat_map(|&(v, _)| incident[v as usize].iter().copied()),
+                    );
+                    m.sort_unstable();
+                    m.dedup();
+                    let c = worst_cos(pos, &t, tris, tn, &m);
+                    if c > best.as_ref().map_or(own_cos, |b| b.0) {
+                        best = Some((c, changed, m));
+                    }
+                }
+                if let Some((c, changed, m)) = best {
+                    let changed_len = changed.len();
+                    for (v, o) in changed {
+                        d[v as usize] = o;
+                    }
+                    (moving, own_cos) = (m, c);
+                    pulled = changed_len;
+                }
+            }
+            let starts_at_own = own.is_some_and(|(_, tv)| {
+                moving.iter().any(|&i| {
+                    let t = &tris[i as usize];
+                    t.contains(&tv) && rough(pos, &d, t, tn[i as usize], cos_tau)
+                })
+            });
             let (held_round, spread_round) = if starts_at_own {
                 let held_moving = moving.clone();
                 let (held, spread) = rayon::join(
@@ -555,16 +684,19 @@ pub(super) fn bound_turns(
                 };
                 (held, spread)
             };
-            let kept = spread_round.or(held_round)?;
+            let kept = spread_round.or(held_round);
+            if kept.is_none() && pulled == 0 {
+                return None;
+            }
             // The clone's own motion with the best round's region put back.
             let mut d = d;
-            for &(v, o) in &kept.values {
+            for &(v, o) in kept.iter().flat_map(|k| &k.values) {
                 d[v as usize] = o;
             }
             dst.offsets = sparse_offsets(&d);
             Some((
                 format!("{}@{}", src.key.name(), src.value),
-                kept.values.len(),
+                kept.map_or(0, |k| k.values.len()).max(pulled),
             ))
         })
         .collect();
@@ -677,6 +809,40 @@ mod tests {
         // The FAP still moves its point exactly.
         let d = crate::clone::quality::dense(&out[0], t.positions.len());
         assert_eq!(d[fp as usize], wanted);
+    }
+
+    #[test]
+    fn a_feature_point_overtaking_its_neighbours_pulls_them_along() {
+        // A fine grid (spacing 0.5) whose feature point sits on the border (every border is
+        // held with two rings: no round reaches it, like a lip corner on the slit), moving
+        // sideways by more than an edge beyond the tent its neighbours read: its triangles
+        // fold. The source: a coarse grid under the tent.
+        let s = chin_grid(3, 4.0);
+        let mut t = chin_grid(17, 0.5);
+        let fp = 8; // (4, 0): the middle of the bottom row
+        t.fp_vertices
+            .insert(crate::spec::FeaturePointId::FP_2_1, fp);
+        let src = vec![motion(tent(&s))];
+        let mut offsets = tent(&t);
+        offsets[fp as usize].1 += Vec3::new(0.8, 0.0, 0.0);
+        let wanted = offsets[fp as usize].1;
+        let mut out = vec![motion(offsets)];
+        let before = turn(&t, &out[0]);
+        assert!(before > 2.0, "{before}");
+        bound_turns(
+            &SmoothTopology::new(&s, &src, &t, false),
+            &s,
+            &src,
+            &t,
+            &[],
+            &mut out,
+        );
+        let after = turn(&t, &out[0]);
+        assert!(after < 0.5 * before, "{after} {before}");
+        // The FAP still moves its point exactly; far away the motion is the clone's own.
+        let d = crate::clone::quality::dense(&out[0], t.positions.len());
+        assert_eq!(d[fp as usize], wanted);
+        assert_eq!(d[16 * 17 + 16], tent(&t)[16 * 17 + 16].1);
     }
 
     #[test]
