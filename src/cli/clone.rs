@@ -42,8 +42,8 @@ pub struct CloneArgs {
     /// Where the source's blink closes its eyes, bring the target's closed lids forward until
     /// they cover its eyeballs from the front (a real head under a cartoon's blink, whose
     /// closed lids lie behind its protruding eyes). `auto` (default): only on an eye whose
-    /// closed lids leave otherwise of it than the source's own closed lids leave of the
-    /// source's — clearly more of it, or a sliver where the source's whole eye stands out —
+    /// closed lids leave it seen differently from how the source's own closed lids leave
+    /// the source's — clearly more of it, or a sliver where the source's whole eye stands out —
     /// so a self-clone, or a cartoon whose own blink leaves its eye showing, is kept; `on`
     /// (also `--lid-cover` alone): every eye; `off`: never. `--verbose` says per eye what was
     /// measured and done.
@@ -91,8 +91,8 @@ pub struct CloneArgs {
 /// `--lid-cover auto|on|off` ([`fbakit::clone::face::LidCover`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum LidCoverArg {
-    /// Cover an eye only where the clone's closed lids leave otherwise of it than the
-    /// source's leave of the source's (more of it, or a sliver).
+    /// Cover an eye only where the clone's closed lids leave it seen differently
+    /// from how the source's leave the source's (more of it, or a sliver).
     #[default]
     Auto,
     /// Cover every eye the source's blink closes.

@@ -611,6 +611,7 @@ pub(super) fn decide(mode: LidCover, source: Option<Seen>, target: Seen) -> (boo
 /// frame (the lids come forward along it: along the frame's +z a turned target's lid points
 /// also moved along their FAPs, bruno → ict's 3.3 by 2.0 % at 3.15°). Returns what it
 /// measured and did per eye.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn cover_lids(
     mode: LidCover,
     forward: Vec3,

@@ -862,7 +862,7 @@ fn clone_skin_motions(
         .push("smooth2", clock.elapsed().as_secs_f64());
 
     // Where the slits close, the closed lids cover the eyeballs from the front: by default
-    // only where they leave otherwise of the eye than the source's own closed lids do.
+    // only where they leave the eye seen differently from the source's own closed lids.
     let clock = Instant::now();
     if opts.lid_cover != LidCover::Off {
         let fronts = lid_cover::EyeFront::of(target, tparts, alignment);

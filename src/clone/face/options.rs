@@ -107,8 +107,8 @@ pub struct CloneOptions {
     /// When to run `lid_cover` (module docs, after `eyeball` and `smooth`'s second pass):
     /// where the source's blink closes its eye, the target's slit closes over its eyeball and
     /// the closed lids come forward until they cover it from the front. Default
-    /// [`LidCover::Auto`]: only on an eye whose closed lids leave otherwise of it than the
-    /// source's own closed lids leave of the source's (alma's blink on ICT's head: 69 / 70
+    /// [`LidCover::Auto`]: only on an eye whose closed lids leave it seen differently from
+    /// how the source's own closed lids leave the source's (alma's blink on ICT's head: 69 / 70
     /// eye vertices per eye seen through the closed lids, none with the step), so a
     /// self-clone is kept exactly. The report says per eye what it measured and did
     /// ([`CloneReport::lid_cover`](super::CloneReport::lid_cover)).

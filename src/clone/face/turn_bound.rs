@@ -68,6 +68,9 @@ const SLIVER: f32 = 0.2;
 /// edge's ends interpolated at its foot on that edge (`a`, `b`, parameter `t`).
 type Follows = BTreeMap<u32, (u32, u32, f32)>;
 
+/// A pull tried at one radius: its worst turn, the changed vertices and the moving set.
+type PullTry = (f32, Vec<(u32, Vec3)>, Vec<u32>);
+
 /// The vertex of triangle `t` opposite its longest edge, that edge's ends and the parameter
 /// of the vertex's foot on it (clamped to the edge), when `t` is a sliver: the vertex's
 /// height over the edge under `SLIVER` × the edge's length.
@@ -629,7 +632,7 @@ pub(super) fn bound_turns(
                     .map(|&w| pos[w as usize].distance(at))
                     .sum::<f32>()
                     / nb.len().max(1) as f32;
-                let mut best: Option<(f32, Vec<(u32, Vec3)>, Vec<u32>)> = None;
+                let mut best: Option<PullTry> = None;
                 for k in PULL_REACH {
                     let changed = pull(pos, &topology.adj, &d, tv, k * mean, &held_lids);
                     let mut t = d.clone();
@@ -689,7 +692,6 @@ pub(super) fn bound_turns(
                 return None;
             }
             // The clone's own motion with the best round's region put back.
-            let mut d = d;
             for &(v, o) in kept.iter().flat_map(|k| &k.values) {
                 d[v as usize] = o;
             }
