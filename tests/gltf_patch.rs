@@ -528,15 +528,21 @@ fn target_names_that_do_not_match_are_refused() {
     assert!(!out.exists());
 }
 
-#[test]
-fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
-    let dir = tempfile::tempdir().unwrap();
+/// The test avatar without `scene` and `scenes`, written as `dir/noscene.glb`.
+fn sceneless_avatar(dir: &std::path::Path) -> std::path::PathBuf {
     let mut a = avatar::build();
     let o = a.json.as_object_mut().unwrap();
     o.remove("scene");
     o.remove("scenes");
-    let input = dir.path().join("noscene.glb");
+    let input = dir.join("noscene.glb");
     std::fs::write(&input, a.to_glb()).unwrap();
+    input
+}
+
+#[test]
+fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sceneless_avatar(dir.path());
     let (face, report) = fbakit::face::read_with(&input, &Default::default()).unwrap();
     assert_eq!(face.meshes.len(), 5);
     assert!(
@@ -555,12 +561,7 @@ fn a_file_without_scenes_reads_every_mesh_with_a_warning() {
 #[test]
 fn reader_warnings_are_said_once_by_clone_and_face_info() {
     let dir = tempfile::tempdir().unwrap();
-    let mut a = avatar::build();
-    let o = a.json.as_object_mut().unwrap();
-    o.remove("scene");
-    o.remove("scenes");
-    let input = dir.path().join("noscene.glb");
-    std::fs::write(&input, a.to_glb()).unwrap();
+    let input = sceneless_avatar(dir.path());
     let alma = fbakit::face::read("alma").unwrap();
     let fp = avatar::fp_csv(&alma, dir.path(), "");
     let stderr = support::cli::clone_alma_to(&input, &fp, &dir.path().join("out.glb"));

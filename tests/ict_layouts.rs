@@ -19,6 +19,10 @@
 
 #[path = "support/candide.rs"]
 mod candide_data;
+#[path = "support/glb.rs"]
+mod glb;
+#[path = "support/ict_fp.rs"]
+mod ict_fp;
 #[path = "support/ict_truth.rs"]
 mod ict_truth;
 
@@ -150,41 +154,18 @@ fn prims_by_material(obj: &Obj) -> Vec<Prim> {
 /// `Head` with every primitive when `one_mesh`, else one mesh and node per primitive, named
 /// after its material.
 fn glb(obj: &Obj, prims: &[Prim], one_mesh: bool) -> Vec<u8> {
-    let mut bin: Vec<u8> = Vec::new();
-    let (mut views, mut accessors, mut primitives) = (Vec::new(), Vec::new(), Vec::new());
-    for p in prims {
-        let pos: Vec<Vec3> = p
-            .vertices
-            .iter()
-            .map(|&v| obj.positions[v as usize])
-            .collect();
-        let lo = pos
-            .iter()
-            .fold(Vec3::splat(f32::INFINITY), |a, &b| a.min(b));
-        let hi = pos
-            .iter()
-            .fold(Vec3::splat(f32::NEG_INFINITY), |a, &b| a.max(b));
-        let start = bin.len();
-        for q in &pos {
-            for c in q.to_array() {
-                bin.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}));
-        accessors.push(json!({"bufferView": views.len() - 1, "componentType": 5126,
-            "count": pos.len(), "type": "VEC3", "min": lo.to_array(), "max": hi.to_array()}));
-        let start = bin.len();
-        for t in &p.triangles {
-            for i in t {
-                bin.extend_from_slice(&i.to_le_bytes());
-            }
-        }
-        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}));
-        accessors.push(json!({"bufferView": views.len() - 1, "componentType": 5125,
-            "count": p.triangles.len() * 3, "type": "SCALAR"}));
-        primitives.push(json!({"attributes": {"POSITION": accessors.len() - 2},
-            "indices": accessors.len() - 1}));
-    }
+    let mut buf = glb::Buffer::default();
+    let primitives: Vec<_> = prims
+        .iter()
+        .map(|p| {
+            let pos: Vec<Vec3> = p
+                .vertices
+                .iter()
+                .map(|&v| obj.positions[v as usize])
+                .collect();
+            buf.primitive(&pos, &p.triangles)
+        })
+        .collect();
     let (meshes, nodes) = if one_mesh {
         (
             vec![json!({"name": "Head", "primitives": primitives})],
@@ -210,51 +191,16 @@ fn glb(obj: &Obj, prims: &[Prim], one_mesh: bool) -> Vec<u8> {
         "scenes": [{"nodes": scene_nodes}],
         "nodes": nodes,
         "meshes": meshes,
-        "accessors": accessors,
-        "bufferViews": views,
-        "buffers": [{"byteLength": bin.len()}],
+        "accessors": buf.accessors,
+        "bufferViews": buf.views,
+        "buffers": [{"byteLength": buf.bin.len()}],
     });
-    let mut text = serde_json::to_vec(&doc).unwrap();
-    while text.len() % 4 != 0 {
-        text.push(b' ');
-    }
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    for w in [
-        0x4654_6C67u32,
-        2,
-        total as u32,
-        text.len() as u32,
-        0x4E4F_534A,
-    ] {
-        out.extend_from_slice(&w.to_le_bytes());
-    }
-    out.extend_from_slice(&text);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
-    out.extend_from_slice(&bin);
-    out
+    glb::pack(&doc, &buf.bin)
 }
 
-/// The bundled ICT feature points (OBJ vertex ids: the sample keeps the OBJ's first 24 591
-/// vertices in order) rebound to a glTF layout: each point to its vertex in the first
-/// primitive holding it, `spec(k)` naming primitive `k`'s face mesh.
-fn fp_csv(prims: &[Prim], spec: impl Fn(usize) -> String) -> String {
-    let sample =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/faces/ict-head/ict-head-fp.csv");
-    let text = std::fs::read_to_string(sample).unwrap();
-    let mut out = String::from("fp,vertices,mesh\n");
-    for line in text.lines().skip(1) {
-        let mut c = line.split(',');
-        let (fp, v) = (c.next().unwrap(), c.next().unwrap().parse::<u32>().unwrap());
-        let (k, local) = prims
-            .iter()
-            .enumerate()
-            .find_map(|(k, p)| p.vertices.binary_search(&v).ok().map(|i| (k, i)))
-            .unwrap();
-        out += &format!("{fp},{local},{}\n", spec(k));
-    }
-    out
+/// Per primitive, its OBJ vertex per glTF vertex.
+fn vertex_lists(prims: &[Prim]) -> Vec<&[u32]> {
+    prims.iter().map(|p| p.vertices.as_slice()).collect()
 }
 
 /// One layout of the head, read and cloned: per face mesh of the target, the OBJ vertex of
@@ -302,9 +248,9 @@ fn setup() -> Option<&'static Setup> {
             std::fs::write(&path, glb(&obj, &prims, one_mesh)).unwrap();
             let fp = dir.path().join(format!("{name}.csv"));
             let csv = if one_mesh {
-                fp_csv(&prims, |k| format!("Head/{k}"))
+                ict_fp::csv(&vertex_lists(&prims), |k| format!("Head/{k}"))
             } else {
-                fp_csv(&prims, |k| prims[k].material.clone())
+                ict_fp::csv(&vertex_lists(&prims), |k| prims[k].material.clone())
             };
             std::fs::write(&fp, csv).unwrap();
             let face = read(&path, &fp);

@@ -12,11 +12,14 @@
 //! apart: 16 OBJ vertices parted by up to 11 % of `open_jaw`'s peak (a crack at the inner
 //! lips). Skipped with a note when the data is absent.
 
+#[path = "support/glb.rs"]
+mod glb;
+#[path = "support/ict_fp.rs"]
+mod ict_fp;
 #[path = "support/ict_truth.rs"]
 mod ict_truth;
 
 use std::collections::{BTreeMap, HashMap};
-use std::path::Path;
 
 use fbakit::clone::face::{clone_face, CloneOptions};
 use fbakit::face::FaceReadOptions;
@@ -98,78 +101,25 @@ fn split_at_uv_seams(text: &str) -> (Vec<Vec3>, Vec<Prim>) {
 
 /// A `.glb` with one mesh `Head` holding `prims` (positions and indices only).
 fn glb(positions: &[Vec3], prims: &[Prim]) -> Vec<u8> {
-    let mut bin: Vec<u8> = Vec::new();
-    let (mut views, mut accessors, mut primitives) = (Vec::new(), Vec::new(), Vec::new());
-    for p in prims {
-        let pos: Vec<Vec3> = p.vertices.iter().map(|&v| positions[v as usize]).collect();
-        let lo = pos.iter().fold(Vec3::splat(f32::MAX), |a, &b| a.min(b));
-        let hi = pos.iter().fold(Vec3::splat(f32::MIN), |a, &b| a.max(b));
-        let start = bin.len();
-        for c in pos.iter().flat_map(|q| q.to_array()) {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}));
-        accessors.push(json!({"bufferView": views.len() - 1, "componentType": 5126,
-            "count": pos.len(), "type": "VEC3", "min": lo.to_array(), "max": hi.to_array()}));
-        let start = bin.len();
-        for i in p.triangles.iter().flatten() {
-            bin.extend_from_slice(&i.to_le_bytes());
-        }
-        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}));
-        accessors.push(json!({"bufferView": views.len() - 1, "componentType": 5125,
-            "count": p.triangles.len() * 3, "type": "SCALAR"}));
-        primitives.push(json!({"attributes": {"POSITION": accessors.len() - 2},
-            "indices": accessors.len() - 1}));
-    }
+    let mut buf = glb::Buffer::default();
+    let primitives: Vec<_> = prims
+        .iter()
+        .map(|p| {
+            let pos: Vec<Vec3> = p.vertices.iter().map(|&v| positions[v as usize]).collect();
+            buf.primitive(&pos, &p.triangles)
+        })
+        .collect();
     let doc = json!({
         "asset": {"version": "2.0", "generator": "fbakit tests/uv_seam_twins.rs"},
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"name": "Head", "mesh": 0}],
         "meshes": [{"name": "Head", "primitives": primitives}],
-        "accessors": accessors,
-        "bufferViews": views,
-        "buffers": [{"byteLength": bin.len()}],
+        "accessors": buf.accessors,
+        "bufferViews": buf.views,
+        "buffers": [{"byteLength": buf.bin.len()}],
     });
-    let mut text = serde_json::to_vec(&doc).unwrap();
-    while text.len() % 4 != 0 {
-        text.push(b' ');
-    }
-    let mut out = Vec::new();
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    for w in [
-        0x4654_6C67u32,
-        2,
-        total as u32,
-        text.len() as u32,
-        0x4E4F_534A,
-    ] {
-        out.extend_from_slice(&w.to_le_bytes());
-    }
-    out.extend_from_slice(&text);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
-    out.extend_from_slice(&bin);
-    out
-}
-
-/// The bundled ICT feature points (OBJ vertex ids) bound to the first copy of their vertex.
-fn fp_csv(prims: &[Prim]) -> String {
-    let sample =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/faces/ict-head/ict-head-fp.csv");
-    let text = std::fs::read_to_string(sample).unwrap();
-    let mut out = String::from("fp,vertices,mesh\n");
-    for line in text.lines().skip(1) {
-        let mut c = line.split(',');
-        let (fp, v) = (c.next().unwrap(), c.next().unwrap().parse::<u32>().unwrap());
-        let (k, local) = prims
-            .iter()
-            .enumerate()
-            .find_map(|(k, p)| p.vertices.iter().position(|&o| o == v).map(|i| (k, i)))
-            .unwrap();
-        out += &format!("{fp},{local},Head/{k}\n");
-    }
-    out
+    glb::pack(&doc, &buf.bin)
 }
 
 #[test]
@@ -197,7 +147,17 @@ fn uv_seam_twins_in_one_primitive_move_as_one_vertex() {
     let dir = tempfile::tempdir().unwrap();
     let (path, fp) = (dir.path().join("head.glb"), dir.path().join("fp.csv"));
     std::fs::write(&path, glb(&positions, &prims)).unwrap();
-    std::fs::write(&fp, fp_csv(&prims)).unwrap();
+    std::fs::write(
+        &fp,
+        ict_fp::csv(
+            &prims
+                .iter()
+                .map(|p| p.vertices.as_slice())
+                .collect::<Vec<_>>(),
+            |k| format!("Head/{k}"),
+        ),
+    )
+    .unwrap();
     let target = fbakit::face::read_with(
         &path,
         &FaceReadOptions::with_feature_points(Some(fp.as_path())),

@@ -976,28 +976,7 @@ pub fn build_with(opts: &Options) -> Avatar {
 impl Avatar {
     /// The avatar as `.glb` bytes.
     pub fn to_glb(&self) -> Vec<u8> {
-        let mut json = self.json.clone();
-        json["buffers"][0]["byteLength"] = json!(self.bin.len());
-        let mut text = serde_json::to_vec(&json).unwrap();
-        while text.len() % 4 != 0 {
-            text.push(b' ');
-        }
-        let total = 12 + 8 + text.len() + 8 + self.bin.len();
-        let mut out = Vec::new();
-        for w in [
-            0x4654_6C67u32,
-            2,
-            total as u32,
-            text.len() as u32,
-            0x4E4F_534A,
-        ] {
-            out.extend_from_slice(&w.to_le_bytes());
-        }
-        out.extend_from_slice(&text);
-        out.extend_from_slice(&(self.bin.len() as u32).to_le_bytes());
-        out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
-        out.extend_from_slice(&self.bin);
-        out
+        super::glb::pack(&self.json, &self.bin)
     }
 
     /// Writes `dir/NAME.gltf` with its buffer in `dir/NAME.bin` and the texture as

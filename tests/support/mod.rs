@@ -3,6 +3,7 @@
 pub mod avatar;
 pub mod blender;
 pub mod cli;
+pub mod glb;
 pub mod gltf_scenes;
 pub mod gltf_transform;
 pub mod ict_full_head;

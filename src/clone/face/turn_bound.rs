@@ -780,6 +780,19 @@ mod tests {
             .collect()
     }
 
+    /// `bound_turns` on one motion `out[0]` of target `t` cloned from `src` on `s`: the
+    /// target's largest turn before and after.
+    fn bounded(
+        s: &CloneSurface,
+        src: &[SurfaceMotion],
+        t: &CloneSurface,
+        out: &mut [SurfaceMotion],
+    ) -> (f64, f64) {
+        let before = turn(t, &out[0]);
+        bound_turns(&SmoothTopology::new(s, src, t, false), s, src, t, &[], out);
+        (before, turn(t, &out[0]))
+    }
+
     #[test]
     fn a_feature_point_standing_out_of_its_fill_is_spread_not_held() {
         // The source: a coarse 3 × 3 grid (spacing 4) whose centre, the FAP's feature
@@ -793,18 +806,9 @@ mod tests {
         offsets[fp as usize].1.z += 0.3;
         let wanted = offsets[fp as usize].1;
         let mut out = vec![motion(offsets)];
-        let before = turn(&t, &out[0]);
         let theta = turn(&s, &src[0]);
+        let (before, after) = bounded(&s, &src, &t, &mut out);
         assert!(before > BOUND * theta, "{before} {theta}");
-        bound_turns(
-            &SmoothTopology::new(&s, &src, &t, false),
-            &s,
-            &src,
-            &t,
-            &[],
-            &mut out,
-        );
-        let after = turn(&t, &out[0]);
         // Held as one vertex the point stays a spike whatever its neighbours do (the fill
         // pinned at one vertex falls off within an edge); spread, its neighbours rise with it.
         assert!(after < 0.75 * before, "{after} {before} {theta}");
@@ -829,17 +833,8 @@ mod tests {
         offsets[fp as usize].1 += Vec3::new(0.8, 0.0, 0.0);
         let wanted = offsets[fp as usize].1;
         let mut out = vec![motion(offsets)];
-        let before = turn(&t, &out[0]);
+        let (before, after) = bounded(&s, &src, &t, &mut out);
         assert!(before > 2.0, "{before}");
-        bound_turns(
-            &SmoothTopology::new(&s, &src, &t, false),
-            &s,
-            &src,
-            &t,
-            &[],
-            &mut out,
-        );
-        let after = turn(&t, &out[0]);
         assert!(after < 0.5 * before, "{after} {before}");
         // The FAP still moves its point exactly; far away the motion is the clone's own.
         let d = crate::clone::quality::dense(&out[0], t.positions.len());

@@ -489,13 +489,7 @@ impl SmoothSystem {
         for it in 1..=max_iter {
             self.apply(&p, &mut q);
             let pq = dot(&p, &q);
-            let a: [f64; 3] = std::array::from_fn(|k| {
-                if active[k] && pq[k] > 0.0 {
-                    rz[k] / pq[k]
-                } else {
-                    0.0
-                }
-            });
+            let a = step_ratio(rz, pq, active);
             for i in 0..n {
                 for k in 0..3 {
                     x[i][k] += a[k] * p[i][k];
@@ -520,13 +514,7 @@ impl SmoothSystem {
             }
             precond(self, &r, &mut z);
             let rz_new = dot(&r, &z);
-            let beta: [f64; 3] = std::array::from_fn(|k| {
-                if active[k] && rz[k] > 0.0 {
-                    rz_new[k] / rz[k]
-                } else {
-                    0.0
-                }
-            });
+            let beta = step_ratio(rz_new, rz, active);
             rz = rz_new;
             for i in 0..n {
                 for k in 0..3 {
@@ -536,6 +524,18 @@ impl SmoothSystem {
         }
         None
     }
+}
+
+/// Per column `num / den` where the column still iterates and `den > 0`, else 0 (a column
+/// that converged, or met no positive curvature, takes no step).
+fn step_ratio(num: [f64; 3], den: [f64; 3], active: [bool; 3]) -> [f64; 3] {
+    std::array::from_fn(|k| {
+        if active[k] && den[k] > 0.0 {
+            num[k] / den[k]
+        } else {
+            0.0
+        }
+    })
 }
 
 fn finite(out: Vec<[f64; 3]>) -> Result<Vec<[f64; 3]>> {
