@@ -347,8 +347,8 @@ fn bad_capture_files_exit_2_with_one_line_and_write_nothing() {
             "broken.jsonl:2:",
         ),
         (
-            put("missing.jsonl", "{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.1}}\n{\"timestamp_ms\": 33, \"blendshapes\": {\"mouthClose\": 0}}\n"),
-            "missing.jsonl:2:38: expected only the shapes of line 1",
+            put("score.jsonl", "{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.1}}\n{\"timestamp_ms\": 33, \"blendshapes\": {\"jawOpen\": \"x\"}}\n"),
+            "score.jsonl:2:38: expected `blendshapes.jawOpen`: a finite score",
         ),
         (
             put("degrees.csv", "Timecode,BlendShapeCount,JawOpen,HeadYaw\n00:00:00:00.000,61,0.1,0.1\n00:00:00:01.000,61,0.1,25\n"),

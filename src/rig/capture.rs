@@ -10,9 +10,11 @@
 //!   browDownLeft,...`: 52 categories, `_neutral` skipped, no `tongueOut`).
 //! - **MediaPipe JSON lines**: one object per line,
 //!   `{"timestamp_ms": 33, "blendshapes": {"jawOpen": 0.12, ...}}` (the category list form
-//!   `"blendshapes": [{"categoryName": "jawOpen", "score": 0.12}, ...]` is read too). Every
-//!   line must give the shapes of the first line. Errors name the file, the line and column
-//!   where the JSON breaks, or the line and the JSON path (`blendshapes.jawOpen`).
+//!   `"blendshapes": [{"categoryName": "jawOpen", "score": 0.12}, ...]` is read too). The
+//!   shapes are those of every line, in the order they first appear (within one object by
+//!   name); a shape a line leaves out (writers that drop zero scores) scores 0 there, with
+//!   one warning. Errors name the file, the line and column where the JSON breaks, or the
+//!   line and the JSON path (`blendshapes.jawOpen`).
 //!
 //! A text whose first non-blank character is `{` (or `[`) is JSON lines, anything else CSV. Both are
 //! bounded like every reader: the text by [`crate::io::DEFAULT_MAX_INPUT_BYTES`], columns by
@@ -233,7 +235,6 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
     let body_start = if text.starts_with('\u{feff}') { 3 } else { 0 };
     let mut columns: Vec<WeightColumn> = Vec::new();
     let mut index: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-    let mut first_line = 0usize;
     let mut raw: Vec<RawRow> = Vec::new();
     let mut starts: Vec<usize> = Vec::new();
     let mut clamped = 0usize;
@@ -310,51 +311,34 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
                 ))
             }
         };
-        let first = columns.is_empty() && raw.is_empty();
-        if first {
-            first_line = lineno;
-            for (name, _) in &scores {
-                if name.eq_ignore_ascii_case("_neutral") {
-                    continue;
-                }
-                if name.is_empty() {
-                    return Err(err(
-                        key_at("blendshapes"),
-                        "a shape name in `blendshapes`".into(),
-                    ));
-                }
-                if columns.len() == MAX_COLUMNS {
-                    return Err(err(key_at(name), format!("at most {MAX_COLUMNS} shapes")));
-                }
-                let key = normalise_shape_name(name);
-                if index.insert(key, columns.len()).is_some() {
-                    return Err(err(
-                        key_at(name),
-                        format!("one score per shape (`{name}` repeats)"),
-                    ));
-                }
-                columns.push(WeightColumn {
-                    name: (*name).to_string(),
-                    column: columns.len() + 1,
-                });
-            }
-            if columns.is_empty() {
-                return Err(err(
-                    key_at("blendshapes"),
-                    "`blendshapes`: at least one shape score".into(),
-                ));
-            }
-        }
+        // Columns are the shapes of every line, in the order they first appear: a writer
+        // that leaves out zero scores, or adds a shape later on, is read (module docs).
         let mut row = vec![f32::NAN; columns.len()];
         for (name, v) in &scores {
             if name.eq_ignore_ascii_case("_neutral") {
                 continue;
             }
-            let Some(&c) = index.get(&normalise_shape_name(name)) else {
-                return Err(err(
-                    key_at(name),
-                    format!("only the shapes of line {first_line} (`blendshapes.{name}` is new)"),
-                ));
+            let key = normalise_shape_name(name);
+            let c = match index.get(&key) {
+                Some(&c) => c,
+                None => {
+                    if name.is_empty() {
+                        return Err(err(
+                            key_at("blendshapes"),
+                            "a shape name in `blendshapes`".into(),
+                        ));
+                    }
+                    if columns.len() == MAX_COLUMNS {
+                        return Err(err(key_at(name), format!("at most {MAX_COLUMNS} shapes")));
+                    }
+                    index.insert(key, columns.len());
+                    columns.push(WeightColumn {
+                        name: (*name).to_string(),
+                        column: columns.len() + 1,
+                    });
+                    row.push(f32::NAN);
+                    columns.len() - 1
+                }
             };
             let Some(v) = v.filter(|v| v.is_finite()) else {
                 return Err(err(
@@ -387,12 +371,6 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
                 v.clamp(0.0, 1.0) as f32
             };
         }
-        if let Some(c) = row.iter().position(|v| v.is_nan()) {
-            return Err(err(
-                key_at("blendshapes"),
-                format!("`blendshapes.{}` as on line {first_line}", columns[c].name),
-            ));
-        }
         starts.push(key_at("timestamp_ms"));
         raw.push(RawRow {
             stamp: Stamp {
@@ -409,7 +387,36 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
             "a JSON object per line: {\"timestamp_ms\": ..., \"blendshapes\": {...}}".into(),
         ));
     }
+    if columns.is_empty() {
+        return Err(err(
+            starts[0],
+            "`blendshapes`: at least one shape score on some line".into(),
+        ));
+    }
     let mut warnings = Vec::new();
+    // A shape a line leaves out scores 0 there (a rotation: straight ahead), as when the
+    // writer drops zero scores; said once, with the first place.
+    let mut missing = 0usize;
+    let mut first_missing: Option<(usize, String)> = None;
+    for r in &mut raw {
+        r.weights.resize(columns.len(), f32::NAN);
+        for (c, w) in r.weights.iter_mut().enumerate() {
+            if w.is_nan() {
+                *w = 0.0;
+                missing += 1;
+                if first_missing.is_none() {
+                    first_missing = Some((r.line, columns[c].name.clone()));
+                }
+            }
+        }
+    }
+    if let Some((line, name)) = first_missing {
+        warnings.push(Diagnostic::warning(format!(
+            "{}: {missing} score{} left out read as 0 (first at line {line}, `blendshapes.{name}`)",
+            file.display(),
+            if missing == 1 { "" } else { "s" }
+        )));
+    }
     if let Some((line, name)) = first_clamp {
         warnings.push(Diagnostic::warning(format!(
             "{}: {clamped} score{} outside 0..1 clamped (first at line {line}, `blendshapes.{name}`)",
@@ -607,6 +614,33 @@ mod tests {
     }
 
     #[test]
+    fn json_lines_that_leave_out_shapes_score_them_0() {
+        // A writer that drops zero scores: line 1 has jawOpen only, line 2 adds a blink and
+        // a head turn, line 3 gives nothing but `_neutral`.
+        let text = "{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.4}}\n\
+                    {\"timestamp_ms\": 33, \"blendshapes\": {\"eyeBlinkLeft\": 0.5, \"HeadYaw\": 0.1}}\n\
+                    {\"timestamp_ms\": 67, \"blendshapes\": {\"_neutral\": 1}}\n";
+        let w = jsonl(text).unwrap();
+        let names: Vec<&str> = w.columns.iter().map(|c| c.name.as_str()).collect();
+        // Within one object serde_json keeps keys by name.
+        assert_eq!(names, ["jawOpen", "HeadYaw", "eyeBlinkLeft"]);
+        let rows: Vec<&[f32]> = w.rows.iter().map(|r| r.weights.as_slice()).collect();
+        assert_eq!(
+            rows,
+            [&[0.4, 0.0, 0.0][..], &[0.0, 0.1, 0.5], &[0.0, 0.0, 0.0]]
+        );
+        assert_eq!(w.warnings.len(), 1, "{:?}", w.warnings);
+        assert_eq!(
+            w.warnings[0].message,
+            "mp.jsonl: 6 scores left out read as 0 (first at line 1, `blendshapes.HeadYaw`)"
+        );
+        // A full file says nothing.
+        let full = "{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.4}}\n\
+                    {\"timestamp_ms\": 33, \"blendshapes\": {\"jawOpen\": 0.5}}\n";
+        assert!(jsonl(full).unwrap().warnings.is_empty());
+    }
+
+    #[test]
     fn hostile_json_lines_are_located_errors() {
         let ok = "{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": 0.1}}\n";
         let broken = message(&format!(
@@ -614,20 +648,10 @@ mod tests {
         ));
         assert!(broken.starts_with("mp.jsonl:2:"), "{broken}");
         assert!(broken.contains("one JSON object per line"), "{broken}");
-        let missing = message(&format!(
-            "{ok}{{\"timestamp_ms\": 5, \"blendshapes\": {{}}}}\n"
-        ));
-        assert!(missing.contains("mp.jsonl:2:"), "{missing}");
+        let none = message("{\"timestamp_ms\": 0, \"blendshapes\": {}}\n{\"timestamp_ms\": 5, \"blendshapes\": {\"_neutral\": 1}}\n");
         assert!(
-            missing.contains("`blendshapes.jawOpen` as on line 1"),
-            "{missing}"
-        );
-        let new = message(&format!(
-            "{ok}{{\"timestamp_ms\": 5, \"blendshapes\": {{\"jawOpen\": 0, \"mouthClose\": 0}}}}\n"
-        ));
-        assert!(
-            new.contains("mp.jsonl:2:51: expected only the shapes of line 1"),
-            "{new}"
+            none.contains("mp.jsonl:1:2: expected `blendshapes`: at least one shape score"),
+            "{none}"
         );
         let nan = message("{\"timestamp_ms\": 0, \"blendshapes\": {\"jawOpen\": \"x\"}}\n");
         assert!(
