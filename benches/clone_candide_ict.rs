@@ -114,6 +114,14 @@
 //! factorisation) and on the soft steps (10, 1: not converged in 8); a looser residual
 //! (1e-4: 3 iterations, a larger change of the output). Not attempted: the `bound` step.
 //! Peak memory (this bench, load 13): 114–117 MB before, 111 MB after (one run).
+//!
+//! Stop 40, a quiet machine (load under 0.1, 2 cores), with `lid_cover` auto (runs here:
+//! 13 ms) and the bound step's pull (bound 72–107 ms): three runs, medians 455.1 / 484.5 /
+//! 495.6 ms, fastest 432.9–452.8 ms; the step split of one run register 180–252, bound
+//! 72–90, parts 37–50, fold 14–18 ms; peak memory 116 MB. Until this stop the set-up (read,
+//! subdivide, three clones: ~2.5 s) ran inside the first sample, which was each run's
+//! slowest (2.9–3.4 s) and lifted the median; it now runs before divan samples. The
+//! 0.3 s target is not met.
 
 use std::path::Path;
 use std::sync::OnceLock;
@@ -125,6 +133,9 @@ use fbakit::face::FaceModel;
 use fbakit::mesh::subdivide::Scheme;
 
 fn main() {
+    // Read, subdivide and print the step timings before divan samples: inside the first
+    // sample that set-up (about 2.5 s) was its slowest run and lifted the median.
+    faces();
     divan::main();
 }
 
