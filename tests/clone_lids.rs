@@ -623,9 +623,9 @@ fn alma_onto_ict_lids() {
     };
     // The default options (`smooth_shares` and `lid_close` on), `lid_cover` off: this checks
     // the lids `lid_close` makes; `alma_onto_ict_blink_hides_the_eye` checks them with the
-    // cover (at 512). With the cover on (auto covers alma → ICT), `close_b` at 256 turns
-    // 95.7° against ICT's own 65.2° (1.47×; 1.25× held at 512): the push added at the lid
-    // FAP's first border shows, interpolated, a quarter of the way — left to mend.
+    // cover (auto covers alma → ICT), where `close_b` at 256 turns 95.7° against ICT's own
+    // 65.2° (1.47×; 1.25× held at 512): the push added at the lid FAP's first border shows,
+    // interpolated, half of it with the lid a quarter up — left to mend.
     let opts = CloneOptions {
         lid_cover: LidCover::Off,
         ..fit()
@@ -994,17 +994,24 @@ fn closed_line_check(eyes_hidden: bool) {
         assert!(out.report.lid_cover.is_empty());
     }
     for f in 19u8..=22 {
-        let a = [Activation {
-            key: key(f),
-            value: 512.0,
-        }];
-        let (turn, own) = (max_turn(c, &a), max_turn(&ict, &a));
-        eprintln!("FAP {f} @512: turn {turn:.1}° (ICT's own {own:.1}°)");
-        // As `alma_onto_ict_lids` holds the default clone: the cover creases no lid.
-        assert!(
-            turn <= 1.25 * own,
-            "FAP {f} @512: {turn:.1}° against ICT's own {own:.1}°"
-        );
+        for v in [256.0, 512.0] {
+            let a = [Activation {
+                key: key(f),
+                value: v,
+            }];
+            let (turn, own) = (max_turn(c, &a), max_turn(&ict, &a));
+            eprintln!("FAP {f} @{v}: turn {turn:.1}° (ICT's own {own:.1}°)");
+            // As `alma_onto_ict_lids` holds the clone without the cover: 1.25× ICT's own.
+            // With it, the lower lid's push (added through the FAP's first border, so half
+            // of it shows with the lid a quarter up) turns `close_b` at 256 95.7° against
+            // ICT's own 65.2° (without the cover 80.8°; the lower lid's push left out, 82.1°
+            // and 46 eye vertices seen per eye): held to the 1.5× there, 1.25× at 512.
+            let bound = if eyes_hidden && v < 512.0 { 1.5 } else { 1.25 };
+            assert!(
+                turn <= bound * own,
+                "FAP {f} @{v}: {turn:.1}° against ICT's own {own:.1}°"
+            );
+        }
     }
     let mut bad = Vec::new();
     for eye in &EYES {
