@@ -129,6 +129,10 @@ pub const ROTATIONS: [Rotation; 9] = [
 /// Radians per angle unit (AU), the standard's unit of FAPs 23–26 and 48–50.
 pub const RADIANS_PER_AU: f64 = 1e-5;
 
+/// Most scores (lines × shapes) a JSON-lines capture may hold once every line has every
+/// shape: 2^27 (512 MB as `f32`; an hour at 60 fps with 61 columns is 13 million).
+pub const MAX_SCORES: usize = 1 << 27;
+
 /// `BlendShapeCount` of the Live Link Face layout: 52 shapes and 9 rotations.
 pub const BLEND_SHAPE_COUNT: usize = 61;
 
@@ -370,6 +374,14 @@ pub fn parse_mediapipe_jsonl(text: &str, file: &Path, fps: Option<f64>) -> Resul
                 }
                 v.clamp(0.0, 1.0) as f32
             };
+        }
+        // Every line is padded to every shape at the end: bounded, as a line naming few
+        // shapes after one that named many would otherwise cost far more than its bytes.
+        if (raw.len() + 1).saturating_mul(columns.len()) > MAX_SCORES {
+            return Err(err(
+                start + lead,
+                format!("at most {MAX_SCORES} scores in all (lines × shapes); split the file"),
+            ));
         }
         starts.push(key_at("timestamp_ms"));
         raw.push(RawRow {
@@ -673,6 +685,23 @@ mod tests {
         assert!(message("[1, 2]\n").contains("mp.jsonl:1:1: expected a JSON object"));
         assert!(message("{\"timestamp_ms\": 0, \"blendshapes\": 3}")
             .contains("`blendshapes`: an object"));
+        // Few shapes a line after one naming many: refused before the padding is paid.
+        let wide: String = (0..MAX_COLUMNS)
+            .map(|k| format!("\"s{k}\": 0"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let mut many = format!("{{\"timestamp_ms\": 0, \"blendshapes\": {{{wide}}}}}\n");
+        for i in 1..=MAX_SCORES / MAX_COLUMNS {
+            many += &format!("{{\"timestamp_ms\": {i}, \"blendshapes\": {{}}}}\n");
+        }
+        let last = MAX_SCORES / MAX_COLUMNS + 1;
+        assert!(
+            message(&many).contains(&format!(
+                "mp.jsonl:{last}:1: expected at most 134217728 scores"
+            )),
+            "{}",
+            message(&many)
+        );
         let deep = format!("{{\"a\": {}{}}}", "[".repeat(10_000), "]".repeat(10_000));
         assert!(jsonl(&deep).is_err());
         for junk in [
