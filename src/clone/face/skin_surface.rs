@@ -12,6 +12,7 @@ use crate::clone::CloneSurface;
 use crate::error::Result;
 use crate::face::{FaceFrames, FaceModel};
 use crate::fdp::{Fapu, FeaturePoint, FeaturePointSet};
+use crate::mesh::components::UnionFind;
 use crate::mesh::find_coincident_vertices;
 use crate::mesh::geometry::triangulate;
 use crate::spec::FeaturePointId;
@@ -371,29 +372,21 @@ fn chains(
             slot[v as usize] = k as u32;
         }
     }
-    let mut root: Vec<usize> = (0..apart.len()).collect();
-    fn find(root: &mut [usize], mut a: usize) -> usize {
-        while root[a] != a {
-            root[a] = root[root[a]];
-            a = root[a];
-        }
-        a
-    }
+    let mut sets = UnionFind::new(apart.len());
     for t in triangles {
         for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
             let (sa, sb) = (slot[a as usize], slot[b as usize]);
             if sa != u32::MAX && sb != u32::MAX {
-                let (ra, rb) = (find(&mut root, sa as usize), find(&mut root, sb as usize));
-                root[ra] = rb;
+                sets.union(sa, sb);
             }
         }
     }
-    let mut by: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    let (label, count) = sets.labels();
+    let mut by = vec![Vec::new(); count];
     for (k, &ci) in apart.iter().enumerate() {
-        let r = find(&mut root, k);
-        by.entry(r).or_default().push(ci);
+        by[label[k] as usize].push(ci);
     }
-    by.into_values().collect()
+    by
 }
 
 /// The middle of a closed mouth's inner lip line (between 2.2 and 2.3) and how near a chain
