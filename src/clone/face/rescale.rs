@@ -151,9 +151,16 @@ pub(super) fn bump(x: f32) -> f32 {
 const MAX_GAIN_TURN: f64 = std::f64::consts::FRAC_PI_4;
 
 /// Target vertices within `reach` of `centre` along mesh edges, with that distance (Dijkstra,
-/// stopped at `reach`). Along edges, not straight: a bump around an upper-lip point does not
-/// jump the open slit onto the lower lip, nor from a lid onto the other lid.
-fn edge_ball(positions: &[Vec3], adj: &[Vec<u32>], centre: u32, reach: f32) -> Vec<(u32, f32)> {
+/// stopped at `reach`); vertices marked in `closed` (indexed by vertex; shorter or empty:
+/// none) are not entered. Along edges, not straight: a bump around an upper-lip point does
+/// not jump the open slit onto the lower lip, nor from a lid onto the other lid.
+pub(super) fn edge_ball(
+    positions: &[Vec3],
+    adj: &[Vec<u32>],
+    centre: u32,
+    reach: f32,
+    closed: &[bool],
+) -> Vec<(u32, f32)> {
     use std::cmp::Reverse;
     use std::collections::{BinaryHeap, HashMap};
     let mut best: HashMap<u32, f32> = HashMap::from([(centre, 0.0)]);
@@ -167,6 +174,9 @@ fn edge_ball(positions: &[Vec3], adj: &[Vec<u32>], centre: u32, reach: f32) -> V
         }
         done.push((v, d));
         for &w in adj.get(v as usize).map_or(&[][..], |a| a.as_slice()) {
+            if closed.get(w as usize).copied().unwrap_or(false) {
+                continue;
+            }
             let nd = d + positions[v as usize].distance(positions[w as usize]);
             if nd < reach && best.get(&w).is_none_or(|&b| nd < b) {
                 best.insert(w, nd);
@@ -255,7 +265,7 @@ pub(super) fn gain_to_fapu(
         } else {
             let fix = (want - got).as_vec3();
             let mut dense: BTreeMap<u32, Vec3> = dst.offsets.iter().copied().collect();
-            for (v, x) in edge_ball(&target.positions, &adj, tv, reach) {
+            for (v, x) in edge_ball(&target.positions, &adj, tv, reach, &[]) {
                 *dense.entry(v).or_insert(Vec3::ZERO) += fix * bump(x / reach);
             }
             dst.offsets = dense

@@ -40,7 +40,7 @@ use std::collections::{BTreeMap, HashMap};
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
-use super::rescale::{bump, fap_fp};
+use super::rescale::{bump, edge_ball, fap_fp};
 use super::smooth::{dense_field, rough, sparse_offsets, touching, SmoothTopology};
 use crate::clone::quality::NORMAL_TURN_FLOOR;
 use crate::clone::{CloneSurface, SurfaceMotion};
@@ -282,47 +282,13 @@ impl PointSpread {
 /// out (ict → bruno's right lip corner: 2×, 3× and 5× leave 173°, 173°, 159°; 8× 31°).
 const PULL_REACH: [f32; 6] = [2.0, 3.0, 5.0, 8.0, 12.0, 16.0];
 
-/// The target vertices within mesh distance `radius` (along edges) of `from`, with their
-/// distances; `held` vertices (the lid margins) are not entered.
-fn within(
-    positions: &[Vec3],
-    adj: &[Vec<u32>],
-    from: u32,
-    radius: f32,
-    held: &[bool],
-) -> Vec<(u32, f32)> {
-    let mut dist: HashMap<u32, f32> = HashMap::from([(from, 0.0)]);
-    let mut heap = std::collections::BinaryHeap::new();
-    heap.push((std::cmp::Reverse(0u32), from));
-    let mut out = Vec::new();
-    while let Some((std::cmp::Reverse(bits), v)) = heap.pop() {
-        let dv = f32::from_bits(bits);
-        if dist.get(&v).is_some_and(|&d| d < dv) {
-            continue;
-        }
-        out.push((v, dv));
-        for &w in &adj[v as usize] {
-            if held[w as usize] {
-                continue;
-            }
-            let dw = dv + positions[v as usize].distance(positions[w as usize]);
-            if dw < radius && dist.get(&w).is_none_or(|&d| dw < d) {
-                dist.insert(w, dw);
-                // Non-negative floats order as their bits.
-                heap.push((std::cmp::Reverse(dw.to_bits()), w));
-            }
-        }
-    }
-    out
-}
-
 /// The FAP's own feature point `p` pulling its surroundings along (module docs): every
 /// vertex within `radius` along the mesh moves towards the point's motion by a Wendland
 /// bump of its distance, 1 at the point. A coarse target's point sampled at the peak of a
 /// dense source's motion (ICT's lip corner under `stretch_cornerlip_o`, 0.48 MNS0 back and
 /// out) otherwise overtakes its neighbours, which read the source beside the peak: its
-/// triangles fold (ict → bruno: 172°, bruno's own FAT 4.6°). Returns the changed vertices
-/// with their new motion.
+/// triangles fold (ict → bruno: 172°, bruno's own FAT 4.6°). `held` vertices (the lid
+/// margins) are not entered. Returns the changed vertices with their new motion.
 fn pull(
     positions: &[Vec3],
     adj: &[Vec<u32>],
@@ -332,7 +298,7 @@ fn pull(
     held: &[bool],
 ) -> Vec<(u32, Vec3)> {
     let at = d[p as usize];
-    within(positions, adj, p, radius, held)
+    edge_ball(positions, adj, p, radius, held)
         .into_iter()
         .filter(|&(v, _)| v != p)
         .map(|(v, r)| {
@@ -612,12 +578,16 @@ pub(super) fn bound_turns(
             // is then judged as if it had run after the held rounds: its best round beats
             // the clone's own and the held one's, or it is dropped (its best round is the
             // same whichever of the two it was told to beat).
-            let starts_at_own = own.is_some_and(|(_, tv)| {
-                moving.iter().any(|&i| {
-                    let t = &tris[i as usize];
-                    t.contains(&tv) && rough(pos, &d, t, tn[i as usize], cos_tau)
+            // Whether a triangle at the point, among `moving`, turns over the bound under `d`.
+            let rough_at_own = |moving: &[u32], d: &[Vec3]| {
+                own.is_some_and(|(_, tv)| {
+                    moving.iter().any(|&i| {
+                        let t = &tris[i as usize];
+                        t.contains(&tv) && rough(pos, d, t, tn[i as usize], cos_tau)
+                    })
                 })
-            });
+            };
+            let starts_at_own = rough_at_own(&moving, &d);
             // The point pulls its surroundings along first, when a triangle at it turns over
             // the bound ([`pull`]; the lips' slit is not held: the pull moves both lips
             // near the point alike): of the radii tried, the pull turning least is kept if
@@ -661,12 +631,7 @@ pub(super) fn bound_turns(
                     pulled = changed_len;
                 }
             }
-            let starts_at_own = own.is_some_and(|(_, tv)| {
-                moving.iter().any(|&i| {
-                    let t = &tris[i as usize];
-                    t.contains(&tv) && rough(pos, &d, t, tn[i as usize], cos_tau)
-                })
-            });
+            let starts_at_own = rough_at_own(&moving, &d);
             let (held_round, spread_round) = if starts_at_own {
                 let held_moving = moving.clone();
                 let (held, spread) = rayon::join(
