@@ -305,11 +305,7 @@ fn validate(a: ValidateArgs) -> Result<u8> {
 fn convert(a: ConvertArgs) -> Result<u8> {
     OutputFormat::resolve(&a.output, OutputFormat::FACES, "`face convert` output")?;
     refuse_overwriting_input(&a.output, &[&a.input])?;
-    let (face, report) = read_with(
-        &a.input,
-        &FaceReadOptions::with_feature_points(a.fp.as_deref()),
-    )?;
-    super::inputs::print_reader_warnings(&report);
+    let face = super::inputs::read_face(&a.input, a.fp.as_deref())?;
     let warnings = write_face(&a.output, &face)?;
     if a.json {
         print_json(&serde_json::json!({
@@ -374,8 +370,7 @@ fn from_morphs(a: FromMorphsArgs) -> Result<u8> {
 }
 
 fn to_morphs(a: ToMorphsArgs) -> Result<u8> {
-    let (face, report) = read_with(&a.face, &FaceReadOptions::default())?;
-    super::inputs::print_reader_warnings(&report);
+    let face = super::inputs::read_face(&a.face, None)?;
     let written = write_morph_set(&face, &a.dir, a.value)?;
     if a.json {
         print_json(&serde_json::json!({

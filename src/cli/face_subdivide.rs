@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use fbakit::error::Result;
 use fbakit::export::write_face;
 use fbakit::face::subdivide::subdivide_face;
-use fbakit::face::{read_with, FaceReadOptions};
 use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use fbakit::mesh::subdivide::Scheme;
 
@@ -47,11 +46,7 @@ pub struct SubdivideArgs {
 pub fn run(a: SubdivideArgs) -> Result<u8> {
     OutputFormat::resolve(&a.output, OutputFormat::FACES, "`face subdivide` output")?;
     refuse_overwriting_input(&a.output, &[&a.input])?;
-    let (face, report) = read_with(
-        &a.input,
-        &FaceReadOptions::with_feature_points(a.fp.as_deref()),
-    )?;
-    super::inputs::print_reader_warnings(&report);
+    let face = super::inputs::read_face(&a.input, a.fp.as_deref())?;
     let scheme = match a.scheme {
         SchemeArg::Loop => Scheme::Loop,
         SchemeArg::Midpoint => Scheme::Midpoint,

@@ -48,7 +48,7 @@ pub fn read_face(path: &Path, fp: Option<&Path>) -> Result<FaceModel> {
 /// Prints the warnings a face reader noticed (a compressed glTF decoded, a file without a
 /// scene, a rig read without its feature points), so every command says them, not only
 /// `face info`.
-pub fn print_reader_warnings(report: &FaceReadReport) {
+fn print_reader_warnings(report: &FaceReadReport) {
     let warnings: Vec<Diagnostic> = report
         .diagnostics
         .iter()
