@@ -28,11 +28,10 @@ use crate::error::{Diagnostic, Result};
 use crate::face::morphs::{
     merged_feature_points, write_morph_set, FEATURE_POINTS_FILE, NEUTRAL_FILE,
 };
-use crate::face::write::{merged_mesh, source_obj_text};
+use crate::face::write::{source_obj_lines, ObjPose, ObjPoses};
 use crate::face::FaceModel;
 use crate::fdp::csv::{write_csv_file, FeaturePointTable};
 use crate::format::OutputFormat;
-use crate::mesh::obj::{write_obj_file, ObjScene};
 use crate::rig::arkit_export::{face_to_arkit_rig, ArkitExportReport};
 
 /// How the shapes of a set are named (module docs).
@@ -95,7 +94,7 @@ pub fn write_obj_shapes(
         _ => shapes_folder(out),
     };
     let neutral_world: Vec<Vec3> = face.neutral_world_positions().concat();
-    let user_layout = source_obj_text(face, &neutral_world).is_some();
+    let user_layout = source_obj_lines(face).is_some();
     let mut report = ObjShapesReport {
         neutral: folder.join(NEUTRAL_FILE),
         folder: folder.clone(),
@@ -258,21 +257,16 @@ fn write_arkit_set(
     let (rig, arkit) = face_to_arkit_rig(face, &amplitudes)?;
     let out_dir =
         crate::io::open_frame_dir(dir, |n| n.ends_with(".obj") || n == FEATURE_POINTS_FILE)?;
-    let frames = face.frames();
-    let merged = merged_mesh(face, &frames.meshes, None)?;
-    let write = |name: &str, positions: &[Vec3]| match source_obj_text(face, positions) {
-        Some(text) => out_dir.write_file(name, |p| crate::io::write_atomic(p, text.as_bytes())),
-        None => {
-            let mut mesh = merged.clone();
-            mesh.positions = positions.to_vec();
-            let scene = ObjScene {
-                mesh,
-                material_libraries: Vec::new(),
-            };
-            out_dir.write_file(name, |p| write_obj_file(&scene, p))
-        }
+    let poses = ObjPoses::new(face)?;
+    let pose = |name: String, positions: Vec<Vec3>| ObjPose {
+        file: name,
+        mesh_name: None,
+        positions,
     };
-    write(NEUTRAL_FILE, neutral_world)?;
+    poses.write(
+        &out_dir,
+        &[pose(NEUTRAL_FILE.to_string(), neutral_world.to_vec())],
+    )?;
     let points = FeaturePointTable::from_set(&merged_feature_points(face));
     out_dir.write_file(FEATURE_POINTS_FILE, |p| write_csv_file(p, &points))?;
     // Where each of the rig's meshes (the face's, in order) starts in the merged numbering.
@@ -283,19 +277,24 @@ fn write_arkit_set(
         n += m.mesh.positions.len();
     }
     let mut files = Vec::new();
-    for shape in &rig.shapes {
-        let mut positions = neutral_world.to_vec();
-        for d in &shape.deltas {
-            let b = base.get(d.mesh).copied().unwrap_or(0);
-            for (&v, &o) in d.vertices.iter().zip(&d.offsets) {
-                if let Some(p) = positions.get_mut(b + v as usize) {
-                    *p += o;
+    // A batch at a time on rayon's threads, as the FAT-named set.
+    for shapes in rig.shapes.chunks(2 * rayon::current_num_threads().max(1)) {
+        let mut batch = Vec::with_capacity(shapes.len());
+        for shape in shapes {
+            let mut positions = neutral_world.to_vec();
+            for d in &shape.deltas {
+                let b = base.get(d.mesh).copied().unwrap_or(0);
+                for (&v, &o) in d.vertices.iter().zip(&d.offsets) {
+                    if let Some(p) = positions.get_mut(b + v as usize) {
+                        *p += o;
+                    }
                 }
             }
+            let name = format!("{}.obj", shape.name);
+            files.push(dir.join(&name));
+            batch.push(pose(name, positions));
         }
-        let name = format!("{}.obj", shape.name);
-        write(&name, &positions)?;
-        files.push(dir.join(name));
+        poses.write(&out_dir, &batch)?;
     }
     out_dir.commit()?;
     Ok((files, arkit))

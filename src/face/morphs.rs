@@ -32,7 +32,7 @@ use glam::{Affine3A, DVec3, Vec3};
 use serde::Serialize;
 
 use super::attach::attach_feature_points;
-use super::write::{merged_mesh, source_obj_text};
+use super::write::{merged_positions, ObjPose, ObjPoses};
 use super::{FaceError, FaceModel};
 use crate::error::{Error, Location, Result};
 use crate::fat::eval::Activation;
@@ -40,7 +40,7 @@ use crate::fat::morph::{default_value, fat_from_morph_targets, MorphMesh, MorphT
 use crate::fat::TableKey;
 use crate::fdp::csv::{write_csv_file, FeaturePointTable};
 use crate::fdp::{FeaturePoint, FeaturePointSet, VertexBinding};
-use crate::mesh::obj::{read_obj_file, write_obj_file, ObjScene};
+use crate::mesh::obj::read_obj_file;
 use crate::mesh::Mesh;
 
 /// Most files a morph folder may hold (a bound against hostile folders).
@@ -435,21 +435,20 @@ pub fn write_morph_set(
     let out_dir =
         crate::io::open_frame_dir(dir, |n| n.ends_with(".obj") || n == FEATURE_POINTS_FILE)?;
 
-    let neutral_frames = face.frames();
-    let neutral = ObjScene {
-        mesh: merged_mesh(face, &neutral_frames.meshes, None)?,
-        material_libraries: Vec::new(),
+    let poses = ObjPoses::new(face)?;
+    let neutral = ObjPose {
+        file: NEUTRAL_FILE.to_string(),
+        mesh_name: None,
+        positions: merged_positions(face, &face.frames().meshes, None),
     };
-    // A face read from OBJ keeps the user's file: only the `v` lines change.
-    let write_obj =
-        |name: &str, scene: &ObjScene| match source_obj_text(face, &scene.mesh.positions) {
-            Some(text) => out_dir.write_file(name, |p| crate::io::write_atomic(p, text.as_bytes())),
-            None => out_dir.write_file(name, |p| write_obj_file(scene, p)),
-        };
-    write_obj(NEUTRAL_FILE, &neutral)?;
+    poses.write(&out_dir, std::slice::from_ref(&neutral))?;
     let points = FeaturePointTable::from_set(&merged_feature_points(face));
     out_dir.write_file(FEATURE_POINTS_FILE, |p| write_csv_file(p, &points))?;
 
+    // Poses are evaluated one by one and written a batch at a time on rayon's threads, so the
+    // memory held is a few poses whatever the FAT's size.
+    let batch_len = 2 * rayon::current_num_threads().max(1);
+    let mut batch = Vec::with_capacity(batch_len);
     let mut written = Vec::new();
     for (key, values) in morph_values(face, value) {
         for v in values {
@@ -461,14 +460,16 @@ pub fn write_morph_set(
                 .map(|(t, d)| t.animated_matrix(d))
                 .collect();
             let frames = face.frames_with(&locals);
-            let mut mesh = merged_mesh(face, &frames.meshes, Some(&out.displacements))?;
-            mesh.name = key.name();
             let name = morph_file_name(key, v);
-            let scene = ObjScene {
-                mesh,
-                material_libraries: Vec::new(),
-            };
-            write_obj(&name, &scene)?;
+            batch.push(ObjPose {
+                file: name.clone(),
+                mesh_name: Some(key.name()),
+                positions: merged_positions(face, &frames.meshes, Some(&out.displacements)),
+            });
+            if batch.len() == batch_len {
+                poses.write(&out_dir, &batch)?;
+                batch.clear();
+            }
             written.push(WrittenMorph {
                 file: dir.join(name),
                 key,
@@ -476,6 +477,7 @@ pub fn write_morph_set(
             });
         }
     }
+    poses.write(&out_dir, &batch)?;
     out_dir.commit()?;
     Ok(written)
 }

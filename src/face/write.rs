@@ -14,6 +14,7 @@ use crate::error::Result;
 use crate::format::OutputFormat;
 use crate::io::gzip;
 use crate::mesh::obj::ObjScene;
+use crate::mesh::obj_patch::ObjVertexLines;
 use crate::mesh::{FaceGroup, Mesh, Polygons};
 
 /// The formats [`write()`] writes.
@@ -50,15 +51,117 @@ pub fn write(path: impl AsRef<Path>, face: &FaceModel) -> Result<()> {
 /// layout (one mesh with as many vertices and polygons as the text has `v` and `f`
 /// statements) — then [`merged_mesh`] is the fallback.
 pub fn source_obj_text(face: &FaceModel, positions: &[Vec3]) -> Option<String> {
+    source_obj_lines(face)?.with_positions(positions)
+}
+
+/// The OBJ text `face` was read from, cut at its `v` statements to write many sets of
+/// positions ([`source_obj_text`] for one); `None` as there.
+pub fn source_obj_lines(face: &FaceModel) -> Option<ObjVertexLines<'_>> {
     let text = face.obj_source.as_deref()?;
     let [only] = face.meshes.as_slice() else {
         return None;
     };
-    let layout = crate::mesh::obj_patch::obj_layout(text);
+    let lines = ObjVertexLines::parse(text);
+    let layout = lines.layout();
     if layout.vertices != only.mesh.positions.len() || layout.faces != only.mesh.polygons.len() {
         return None;
     }
-    crate::mesh::obj_patch::patch_vertex_lines(text, positions)
+    Some(lines)
+}
+
+/// Many poses of one face written as OBJ files: the user's own text with its `v` lines
+/// rewritten where the face still has it ([`source_obj_lines`]), else the merged mesh
+/// ([`merged_mesh`]) with the pose's positions. The text is cut once; [`ObjPoses::write`]
+/// builds and writes a batch of poses on rayon's threads.
+#[derive(Debug)]
+pub struct ObjPoses<'f> {
+    lines: Option<ObjVertexLines<'f>>,
+    merged: Mesh,
+}
+
+/// One OBJ file of a pose: its file name in the folder, the name its merged mesh takes (when
+/// the face has no OBJ text of its own), and its positions in merged order (face frame).
+#[derive(Clone, Debug)]
+pub struct ObjPose {
+    /// The file's name inside the folder.
+    pub file: String,
+    /// The mesh name written when the merged mesh is the fallback (`None`: the face's name).
+    pub mesh_name: Option<String>,
+    /// Every vertex of the face, in merged order.
+    pub positions: Vec<Vec3>,
+}
+
+impl<'f> ObjPoses<'f> {
+    /// Cuts the face's OBJ text (if it has one) and merges its meshes once.
+    pub fn new(face: &'f FaceModel) -> Result<Self> {
+        Ok(Self {
+            lines: source_obj_lines(face),
+            merged: merged_mesh(face, &face.frames().meshes, None)?,
+        })
+    }
+
+    /// Whether the files are the user's OBJ text with only the `v` lines rewritten.
+    pub fn user_layout(&self) -> bool {
+        self.lines.is_some()
+    }
+
+    /// The OBJ text of one pose.
+    pub fn text(&self, pose: &ObjPose) -> Result<String> {
+        if let Some(text) = self
+            .lines
+            .as_ref()
+            .and_then(|l| l.with_positions(&pose.positions))
+        {
+            return Ok(text);
+        }
+        let mut mesh = self.merged.clone();
+        mesh.positions.clone_from(&pose.positions);
+        if let Some(name) = &pose.mesh_name {
+            mesh.name.clone_from(name);
+        }
+        crate::mesh::obj::write_obj_string(&ObjScene {
+            mesh,
+            material_libraries: Vec::new(),
+        })
+    }
+
+    /// Writes `poses` into `dir`, each file atomically, several at once.
+    pub fn write(&self, dir: &crate::io::AtomicDir, poses: &[ObjPose]) -> Result<()> {
+        use rayon::prelude::*;
+        poses.par_iter().try_for_each(|pose| {
+            let text = self.text(pose)?;
+            dir.write_file(&pose.file, |p| crate::io::write_atomic(p, text.as_bytes()))
+        })
+    }
+}
+
+/// The positions of [`merged_mesh`] alone (no polygons copied): each mesh's vertices
+/// displaced by `displacements[i]` and placed by `mesh_frames[i]`, in merged order.
+pub fn merged_positions(
+    face: &FaceModel,
+    mesh_frames: &[Affine3A],
+    displacements: Option<&[Vec<Vec3>]>,
+) -> Vec<Vec3> {
+    let mut out = Vec::with_capacity(face.meshes.iter().map(|m| m.mesh.positions.len()).sum());
+    for (mi, fm) in face.meshes.iter().enumerate() {
+        let frame = mesh_frames.get(mi).copied().unwrap_or(Affine3A::IDENTITY);
+        push_placed(
+            &mut out,
+            &fm.mesh.positions,
+            frame,
+            displacements.and_then(|d| d.get(mi)),
+        );
+    }
+    out
+}
+
+/// `positions`, each displaced by its entry of `disp` (none: zero) then placed by `frame`,
+/// appended to `out`.
+fn push_placed(out: &mut Vec<Vec3>, positions: &[Vec3], frame: Affine3A, disp: Option<&Vec<Vec3>>) {
+    out.extend(positions.iter().enumerate().map(|(vi, p)| {
+        let d = disp.and_then(|d| d.get(vi)).copied().unwrap_or(Vec3::ZERO);
+        frame.transform_point3(*p + d)
+    }));
 }
 
 /// All meshes of `face` merged into one in face coordinates, each mesh placed by
@@ -96,11 +199,12 @@ pub fn merged_mesh(
             object: Some(fm.name.clone()),
             ..FaceGroup::default()
         });
-        let disp = displacements.and_then(|d| d.get(mi));
-        for (vi, p) in m.positions.iter().enumerate() {
-            let d = disp.and_then(|d| d.get(vi)).copied().unwrap_or(Vec3::ZERO);
-            out.positions.push(frame.transform_point3(*p + d));
-        }
+        push_placed(
+            &mut out.positions,
+            &m.positions,
+            frame,
+            displacements.and_then(|d| d.get(mi)),
+        );
         for poly in m.polygons.iter() {
             corner.clear();
             corner.extend(poly.iter().map(|&i| i + base));

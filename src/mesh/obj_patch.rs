@@ -66,31 +66,106 @@ pub fn obj_layout(text: &str) -> ObjLayout {
 }
 
 /// `text` with its `k`-th `v` statement moved to `positions[k]` (module docs); `None` when the
-/// text has not exactly `positions.len()` `v` statements.
+/// text has not exactly `positions.len()` `v` statements. To write many poses of one text,
+/// parse it once with [`ObjVertexLines::parse`].
 pub fn patch_vertex_lines(text: &str, positions: &[Vec3]) -> Option<String> {
-    if obj_layout(text).vertices != positions.len() {
-        return None;
-    }
-    let mut out = String::with_capacity(text.len() + text.len() / 8);
-    let mut next = positions.iter();
-    for s in statements(text) {
-        if keyword(s) != "v" {
-            out.push_str(s);
-            continue;
+    ObjVertexLines::parse(text).with_positions(positions)
+}
+
+/// An OBJ text cut at its `v` statements, once, so that each new set of positions costs only
+/// the rewritten `v` lines and copies of the text between them (a shape set writes the same
+/// 2.5 MB head eighty times).
+#[derive(Clone, Debug)]
+pub struct ObjVertexLines<'a> {
+    text: &'a str,
+    /// The `v` statements in order, each with the text before it since the previous one.
+    vertices: Vec<VertexLine<'a>>,
+    /// Where the text after the last `v` statement starts.
+    tail: usize,
+    layout: ObjLayout,
+}
+
+/// One `v` statement, split into what a rewrite keeps and what it replaces.
+#[derive(Clone, Debug)]
+struct VertexLine<'a> {
+    /// The text from the end of the previous `v` statement to the start of this one.
+    before: std::ops::Range<usize>,
+    /// The statement as written (kept when the vertex does not move).
+    statement: &'a str,
+    /// The coordinates as read (`None` where a token is not a number).
+    at: [Option<f32>; 3],
+    /// A BOM or indentation before the keyword.
+    lead: &'a str,
+    /// Tokens after `v x y z` (`w`, or `r g b`), continuations joined, each with a leading
+    /// space, then the trailing comment.
+    rest: String,
+    /// `\r\n`, `\n` or nothing.
+    ending: &'static str,
+}
+
+impl<'a> ObjVertexLines<'a> {
+    /// Cuts `text` at its `v` statements.
+    pub fn parse(text: &'a str) -> Self {
+        let mut vertices = Vec::new();
+        let mut layout = ObjLayout::default();
+        let mut offset = 0usize;
+        let mut kept_from = 0usize;
+        for s in statements(text) {
+            let start = offset;
+            offset += s.len();
+            match keyword(s) {
+                "v" => layout.vertices += 1,
+                "f" => {
+                    layout.faces += 1;
+                    continue;
+                }
+                _ => continue,
+            }
+            vertices.push(VertexLine::parse(s, kept_from..start));
+            kept_from = offset;
         }
-        let p = next.next()?;
-        // A vertex already where it should be keeps its line, spelling and all.
+        Self {
+            text,
+            vertices,
+            tail: kept_from,
+            layout,
+        }
+    }
+
+    /// How many `v` and `f` statements the text has.
+    pub fn layout(&self) -> ObjLayout {
+        self.layout
+    }
+
+    /// The text with its `k`-th `v` statement moved to `positions[k]` (module docs); `None`
+    /// when the text has not exactly `positions.len()` `v` statements.
+    pub fn with_positions(&self, positions: &[Vec3]) -> Option<String> {
+        if positions.len() != self.vertices.len() {
+            return None;
+        }
+        let mut out = String::with_capacity(self.text.len() + self.text.len() / 8);
+        for (line, p) in self.vertices.iter().zip(positions) {
+            out.push_str(&self.text[line.before.clone()]);
+            line.write(*p, &mut out);
+        }
+        out.push_str(&self.text[self.tail..]);
+        Some(out)
+    }
+}
+
+impl<'a> VertexLine<'a> {
+    fn parse(s: &'a str, before: std::ops::Range<usize>) -> Self {
         let mut coords = s
             .split_whitespace()
             .filter(|t| *t != "\\")
             .skip(1)
             .take(3)
             .map(|t| t.trim_end_matches('\\').parse::<f32>().ok());
-        let (x, y, z) = (coords.next(), coords.next(), coords.next());
-        if (x.flatten(), y.flatten(), z.flatten()) == (Some(p.x), Some(p.y), Some(p.z)) {
-            out.push_str(s);
-            continue;
-        }
+        let at = [
+            coords.next().flatten(),
+            coords.next().flatten(),
+            coords.next().flatten(),
+        ];
         let ending = if s.ends_with("\r\n") {
             "\r\n"
         } else if s.ends_with('\n') {
@@ -99,30 +174,47 @@ pub fn patch_vertex_lines(text: &str, positions: &[Vec3]) -> Option<String> {
             ""
         };
         let body = s.trim_end_matches(['\n', '\r']);
-        // A BOM or indentation before the keyword stays.
         let lead_len = body.len() - body.trim_start_matches(['\u{feff}', ' ', '\t']).len();
         let (data, comment) = match body.find('#') {
             Some(i) => (&body[..i], Some(&body[i..])),
             None => (body, None),
         };
-        out.push_str(&body[..lead_len]);
-        out.push_str(&format!("v {} {} {}", p.x, p.y, p.z));
-        // Tokens after `v x y z` (w, or r g b), continuations joined.
+        let mut rest = String::new();
         for t in data[lead_len..]
             .split_whitespace()
             .filter(|t| *t != "\\")
             .skip(4)
         {
-            out.push(' ');
-            out.push_str(t.trim_end_matches('\\'));
+            rest.push(' ');
+            rest.push_str(t.trim_end_matches('\\'));
         }
         if let Some(c) = comment {
-            out.push(' ');
-            out.push_str(c.trim_end());
+            rest.push(' ');
+            rest.push_str(c.trim_end());
         }
-        out.push_str(ending);
+        Self {
+            before,
+            statement: s,
+            at,
+            lead: &body[..lead_len],
+            rest,
+            ending,
+        }
     }
-    Some(out)
+
+    fn write(&self, p: Vec3, out: &mut String) {
+        use std::fmt::Write;
+        // A vertex already where it should be keeps its line, spelling and all.
+        if self.at == [Some(p.x), Some(p.y), Some(p.z)] {
+            out.push_str(self.statement);
+            return;
+        }
+        out.push_str(self.lead);
+        // Writing into a String cannot fail.
+        let _ = write!(out, "v {} {} {}", p.x, p.y, p.z);
+        out.push_str(&self.rest);
+        out.push_str(self.ending);
+    }
 }
 
 #[cfg(test)]
@@ -160,6 +252,34 @@ f 1/1/1 2/1/1 3/1/1\r\nv -7 8.5 0.0000001";
         assert_eq!(patch_vertex_lines(TEXT, &unmoved).unwrap(), TEXT);
         assert!(patch_vertex_lines(TEXT, &pts[..3]).is_none());
         assert_eq!(patch_vertex_lines("", &[]).as_deref(), Some(""));
+    }
+
+    #[test]
+    fn one_cut_writes_many_poses() {
+        let lines = ObjVertexLines::parse(TEXT);
+        assert_eq!(lines.layout(), obj_layout(TEXT));
+        let unmoved = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::splat(9.0)];
+        for k in 0..4 {
+            let mut pts = unmoved;
+            pts[k] += Vec3::new(0.5, -0.25, 2.0);
+            let text = lines.with_positions(&pts).unwrap();
+            // Only statement k changes (the continued one, k = 2, becomes one line).
+            let changed: Vec<_> = text
+                .split('\n')
+                .zip(TEXT.split('\n'))
+                .filter(|(a, b)| a != b)
+                .collect();
+            if k != 2 {
+                assert_eq!(changed.len(), 1, "pose {k}: {changed:?}");
+            }
+            assert_eq!(text, patch_vertex_lines(TEXT, &pts).unwrap());
+            assert_eq!(
+                ObjVertexLines::parse(&text).with_positions(&pts).unwrap(),
+                text
+            );
+        }
+        assert_eq!(lines.with_positions(&unmoved).unwrap(), TEXT);
+        assert!(lines.with_positions(&unmoved[..2]).is_none());
     }
 
     #[test]
