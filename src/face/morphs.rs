@@ -483,7 +483,7 @@ pub fn write_morph_set(
 }
 
 /// The face's feature points re-bound to the vertices of its merged mesh (see
-/// [`merged_mesh`]), with no mesh name.
+/// [`super::write::merged_mesh`]), with no mesh name.
 pub fn merged_feature_points(face: &FaceModel) -> FeaturePointSet {
     let mut base = HashMap::new();
     let mut n = 0u32;
