@@ -136,14 +136,24 @@ fn round_trip(dir: &Path, face_args: &[&str]) -> String {
     let v = stream.frames[10].value(yaw).unwrap();
     assert!((v - (rotation(0, 10) * 1e5).round()).abs() <= 1.0, "{v}");
 
+    // The capture's time of day is reported, and written back with --start.
+    let start = report["start_timecode"].as_str().unwrap();
+    assert_eq!(start, "10:23:45:50.000");
     let back = dir.join("back.csv");
     let mut args = vec!["fap", "to-arkit", fap.to_str().unwrap()];
     args.extend(face_args);
-    args.extend(["-o", back.to_str().unwrap()]);
+    args.extend(["-o", back.to_str().unwrap(), "--start", start]);
     let o = fbakit(&args);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(text(&o.stdout).contains("rotations (radians): HeadYaw, HeadPitch, HeadRoll, LeftEyeYaw, LeftEyePitch, RightEyeYaw, RightEyePitch"), "{}", text(&o.stdout));
-    std::fs::read_to_string(&back).unwrap()
+    let back = std::fs::read_to_string(&back).unwrap();
+    let times = |t: &str| -> Vec<String> {
+        t.lines()
+            .map(|l| l.split(',').next().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(times(&back), times(&live_link_csv()));
+    back
 }
 
 /// Checks the layout and the rotations of a CSV written back; returns it parsed.
@@ -375,6 +385,34 @@ fn bad_capture_files_exit_2_with_one_line_and_write_nothing() {
         assert!(err.contains(expect), "{expect}: {err}");
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(!out.exists());
+    }
+    // A start timecode that is none, or whose frame the stream's rate does not have.
+    let stream = put(
+        "s.fap",
+        &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/samples/speech.fap"))
+            .unwrap(),
+    );
+    let csv = d.join("out.csv");
+    for bad in ["10:00:00:25", "10:00:00", "10:61:00:00", "x"] {
+        let o = fbakit(&[
+            "fap",
+            "to-arkit",
+            &stream,
+            "--face",
+            "bruno",
+            "--start",
+            bad,
+            "-o",
+            csv.to_str().unwrap(),
+        ]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!("--start `{bad}`")) && err.contains("25 fps"),
+            "{err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!csv.exists());
     }
     // A face without a FAT and no --fp: the file and the way out are named.
     let obj = put("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");

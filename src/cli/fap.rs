@@ -50,7 +50,8 @@ pub enum FapCommand {
         name = "to-arkit",
         after_help = "Examples:\n  fbakit fap to-arkit samples/speech.fap --face ict/ --fp ict-fp.csv -o speech-arkit.csv\n  \
                       fbakit clone alma head.obj --fp-target head-fp.csv -o head.wrl\n  \
-                      fbakit fap to-arkit samples/speech.fap --face head.wrl -o speech-arkit.csv"
+                      fbakit fap to-arkit samples/speech.fap --face head.wrl -o speech-arkit.csv\n  \
+                      fbakit fap to-arkit take.fap --face head.wrl --start 14:03:22:15 -o take.csv"
     )]
     ToArkit(super::fap_arkit::ToArkitArgs),
     /// Compare two FAP streams: frame rate, transmitted frames and masks, and every FAP's

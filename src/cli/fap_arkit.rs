@@ -13,6 +13,7 @@ use fbakit::format::{refuse_overwriting_input, OutputFormat};
 use fbakit::rig::arkit_weights::{arkit_rig_of_face, ArkitBridge, FromArkitReport, ToArkitReport};
 use fbakit::rig::capture::{read_capture_file, stream_rotations, write_live_link_csv, ROTATIONS};
 use fbakit::rig::fat_build::{face_from_rig, RigFatReport};
+use fbakit::rig::weights_csv::timecode_seconds;
 use fbakit::rig::{read_rig, Rig, RigError};
 use serde::Serialize;
 
@@ -79,11 +80,16 @@ pub struct ToArkitArgs {
     /// Output CSV in Live Link Face's layout: `Timecode,BlendShapeCount`, the 52 ARKit shapes
     /// (EyeBlinkLeft, ...), then HeadYaw, HeadPitch, HeadRoll, LeftEyeYaw, LeftEyePitch,
     /// LeftEyeRoll, RightEyeYaw, RightEyePitch, RightEyeRoll in radians (from FAPs 48-50 and
-    /// 23-26; eye roll 0). Timecodes `HH:MM:SS:FF.mmm` at the stream's rate from
-    /// 00:00:00:00; reading one shorter than a second back with `from-arkit` needs `--fps`
-    /// (the timecode rate shows only once the seconds roll over).
+    /// 23-26; eye roll 0). Timecodes `HH:MM:SS:FF.mmm` at the stream's rate from `--start`
+    /// (00:00:00:00 by default); reading one shorter than a second back with `from-arkit`
+    /// needs `--fps` (the timecode rate shows only once the seconds roll over).
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
+    /// Timecode of the first frame, `HH:MM:SS:FF` (optionally `.fff`) at the stream's rate:
+    /// the time of day a capture started, as `fap from-arkit` reports it, so the CSV lines up
+    /// with the video and audio recorded beside it.
+    #[arg(long, value_name = "TIMECODE")]
+    pub start: Option<String>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -184,6 +190,13 @@ pub fn from_arkit(a: FromArkitArgs) -> Result<u8> {
         },
         report.faps.len()
     );
+    if let Some(t) = report
+        .start_timecode
+        .as_deref()
+        .filter(|t| !t.starts_with("00:00:00:00.000"))
+    {
+        println!("first frame at timecode {t} (`fap to-arkit --start {t}` writes it back)");
+    }
     let ignored: Vec<String> = report
         .columns
         .iter()
@@ -223,11 +236,22 @@ pub fn to_arkit(a: ToArkitArgs) -> Result<u8> {
     refuse_overwriting_input(&a.output, &inputs)?;
     let (stream, warnings) = fbakit::fap::read_stream_file(&a.stream, &ReadOptions::lenient())?;
     super::print_warnings(&warnings);
+    let start = match &a.start {
+        None => 0.0,
+        Some(t) => {
+            let fps = stream.frame_rate;
+            timecode_seconds(t, fps).ok_or_else(|| {
+                fbakit::error::Error::Usage(format!(
+                    "--start `{t}`: expected a timecode HH:MM:SS:FF (optionally .fff) with its frame below the stream's {fps} fps"
+                ))
+            })?
+        }
+    };
     let (rig, face, calibration) = load(&a.rig)?;
     let mut bridge = bridge(&rig, &face, &calibration)?;
     let (frames, report) = bridge.faps_to_weights(&stream)?;
     let rotations = stream_rotations(&FapTimeline::new(&stream), frames.len() as u64);
-    let text = write_live_link_csv(report.fps, &frames, &rotations);
+    let text = write_live_link_csv(report.fps, start, &frames, &rotations);
     fbakit::io::write_atomic(&a.output, text.as_bytes())?;
     // The rotation columns that move (the others are written as 0).
     let moving: Vec<String> = ROTATIONS

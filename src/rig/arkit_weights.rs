@@ -126,6 +126,11 @@ pub struct FromArkitReport {
     pub fps: f64,
     /// Whether it was detected from the times.
     pub fps_detected: bool,
+    /// The first row's time as a timecode at the stream's rate, for a file with a `Timecode`
+    /// column (Live Link Face writes the time of day): the stream's frame 0 stands for it,
+    /// and `fap to-arkit --start` writes it back.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start_timecode: Option<String>,
     /// Frames written (rows of the CSV, after replacements).
     pub frames: usize,
     /// Feature points compared.
@@ -423,6 +428,8 @@ impl<'a> ArkitBridge<'a> {
         let report = FromArkitReport {
             fps: csv.fps,
             fps_detected: csv.fps_detected,
+            start_timecode: (csv.time == super::weights_csv::TimeColumn::Timecode)
+                .then(|| super::weights_csv::timecode_at(csv.start, csv.fps)),
             frames: stream.frames.len(),
             feature_points: self.probes.len(),
             faps: faps.iter().map(|f| f.name().to_string()).collect(),

@@ -30,7 +30,9 @@
 //! and `MouthRight` before `MouthLeft`), `BlendShapeCount` 61 on every row, rotations in
 //! radians. The timecode is `HH:MM:SS:FF.mmm`: `FF` the frame within the second at the
 //! stream's rate, `.mmm` the sub-frame in thousandths (always `.000` for a whole rate, so it
-//! reads the same whether a reader takes it as a sub-frame or as milliseconds).
+//! reads the same whether a reader takes it as a sub-frame or as milliseconds). It starts at
+//! `00:00:00:00` or at a given time of day (the app writes the time of day; reading keeps a
+//! capture's first timecode, [`WeightCsv::start`], so it can be written back).
 //!
 //! ## Rotations ⇄ FAPs
 //!
@@ -61,7 +63,7 @@ use serde_json::Value;
 
 use super::fap_map::normalise_shape_name;
 use super::weights_csv::{assemble, parse_weights_csv, RawRow, Stamp, TimeColumn, WeightColumn};
-use super::weights_csv::{timecode, WeightCsv, MAX_COLUMNS, MAX_ROTATION};
+use super::weights_csv::{timecode_at, WeightCsv, MAX_COLUMNS, MAX_ROTATION};
 use crate::error::{Diagnostic, ParseError, Result};
 use crate::fap::FapTimeline;
 use crate::spec::FapId;
@@ -464,14 +466,21 @@ pub fn live_link_header() -> String {
 
 /// A Live Link Face CSV (module docs): frame `i` has the 52 weights `shapes[i]`
 /// ([`super::arkit_names::ARKIT_SHAPES`] order) and the 9 angles `rotations[i]` (radians,
-/// [`ROTATIONS`] order; missing rows are 0), at `fps`.
-pub fn write_live_link_csv(fps: f64, shapes: &[Vec<f32>], rotations: &[[f64; 9]]) -> String {
+/// [`ROTATIONS`] order; missing rows are 0), at `fps`, its timecodes from `start` (seconds
+/// since midnight: 0 writes `00:00:00:00.000` first; a capture's own start, as
+/// [`super::weights_csv::WeightCsv::start`] reads it, writes its time of day back).
+pub fn write_live_link_csv(
+    fps: f64,
+    start: f64,
+    shapes: &[Vec<f32>],
+    rotations: &[[f64; 9]],
+) -> String {
     use std::fmt::Write as _;
     let mut out = String::with_capacity(700 + shapes.len() * (24 + 61 * 8));
     out.push_str(&live_link_header());
     out.push('\n');
     for (i, w) in shapes.iter().enumerate() {
-        out.push_str(&timecode(i as u64, fps));
+        out.push_str(&timecode_at(start + i as f64 / fps, fps));
         let _ = write!(out, ",{BLEND_SHAPE_COUNT}");
         for k in 0..super::arkit_names::ARKIT_SHAPES.len() {
             let v = w.get(k).copied().unwrap_or(0.0);
@@ -727,7 +736,7 @@ mod tests {
         let rotations: Vec<[f64; 9]> = (0..70)
             .map(|i| [0.01 * i as f64, -0.2, 0.0, 0.1, -0.1, 0.3, 0.0, 0.0, 0.0])
             .collect();
-        let text = write_live_link_csv(60.0, &shapes, &rotations);
+        let text = write_live_link_csv(60.0, 0.0, &shapes, &rotations);
         let header = text.lines().next().unwrap();
         assert!(header.starts_with("Timecode,BlendShapeCount,EyeBlinkLeft,"));
         assert!(header.contains(",JawForward,JawRight,JawLeft,JawOpen,"));

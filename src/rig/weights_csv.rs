@@ -87,6 +87,10 @@ pub struct WeightCsv {
     pub fps: f64,
     /// Whether `fps` was detected from the times (false: given by the caller).
     pub fps_detected: bool,
+    /// Time of the first row in seconds: since midnight for a `Timecode` column (read at the
+    /// timecode's own rate; Live Link Face writes the time of day), else the time column in
+    /// seconds.
+    pub start: f64,
     /// The weight columns (time, `BlendShapeCount` and `_neutral` excluded).
     pub columns: Vec<WeightColumn>,
     /// The rows, frame numbers increasing.
@@ -510,6 +514,7 @@ pub(crate) fn assemble(
         time: time_kind,
         fps: fps_value,
         fps_detected: detected,
+        start: t0,
         columns,
         rows,
         warnings,
@@ -569,12 +574,22 @@ fn rate_from_milliseconds(t: &[f64]) -> Option<f64> {
 /// The timecode of frame `n` at `fps`: `HH:MM:SS:FF.fff` (frames within the second, with
 /// the sub-frame fraction for rates that are not whole).
 pub fn timecode(n: u64, fps: f64) -> String {
-    let t = n as f64 / fps;
-    let secs = t.floor();
-    let mut within = (t - secs) * fps;
-    // Snap rounding noise (59.99999 frames) to the whole frame.
+    timecode_at(n as f64 / fps, fps)
+}
+
+/// The timecode of time `t` (seconds since midnight, or since the capture's start) at `fps`,
+/// as [`timecode`] writes it.
+pub fn timecode_at(t: f64, fps: f64) -> String {
+    let mut secs = t.max(0.0).floor();
+    let mut within = (t.max(0.0) - secs) * fps;
+    // Snap rounding noise (59.99999 frames) to the whole frame, and a whole second's worth
+    // into the next second.
     if (within - within.round()).abs() < 1e-6 {
         within = within.round();
+    }
+    if within >= fps {
+        secs += 1.0;
+        within = (within - fps).max(0.0);
     }
     let s = secs as u64;
     format!(
@@ -584,6 +599,13 @@ pub fn timecode(n: u64, fps: f64) -> String {
         s % 60,
         within
     )
+}
+
+/// Seconds since midnight of a timecode `HH:MM:SS:FF[.fff]` at `fps` (`;` accepted for
+/// drop-frame); `None` when it is not one, or its frame is not below `fps`.
+pub fn timecode_seconds(text: &str, fps: f64) -> Option<f64> {
+    let stamp = parse_timecode(text.trim())?;
+    (stamp.frames < fps).then(|| stamp.seconds + stamp.frames / fps)
 }
 
 /// A weight CSV: `Timecode`, then `names` as columns, one row per frame (`frames[i]` holds
@@ -764,6 +786,32 @@ mod tests {
             let _ = parse(&t, None);
             let _ = parse(&t, Some(30.0));
         }
+    }
+
+    #[test]
+    fn timecodes_of_a_time_of_day() {
+        let start = timecode_seconds("14:03:22:15", 25.0).unwrap();
+        assert_eq!(start, 50_602.6);
+        assert_eq!(timecode_at(start, 25.0), "14:03:22:15.000");
+        assert_eq!(timecode_at(start + 10.0 / 25.0, 25.0), "14:03:23:00.000");
+        // Just under a whole second reads as the next second's frame 0, not frame 25.
+        assert_eq!(timecode_at(50_602.999_999_999_9, 25.0), "14:03:23:00.000");
+        assert_eq!(
+            timecode_seconds("10:00:00:29.500", 30.0),
+            Some(36_000.0 + 29.5 / 30.0)
+        );
+        assert_eq!(timecode_seconds("10:00:00:25", 25.0), None);
+        assert_eq!(timecode_seconds("10:00:00", 25.0), None);
+        assert_eq!(timecode_seconds("10:60:00:00", 25.0), None);
+        // A capture's first row is its start, at the timecode's own rate.
+        let w = parse(
+            "Timecode,A\n14:03:22:58.000,0.1\n14:03:22:59.000,0.2\n14:03:23:00.000,0.3\n",
+            None,
+        )
+        .unwrap();
+        assert_eq!(w.fps, 60.0);
+        assert!((w.start - (50_602.0 + 58.0 / 60.0)).abs() < 1e-9);
+        assert_eq!(timecode_at(w.start, w.fps), "14:03:22:58.000");
     }
 
     #[test]
