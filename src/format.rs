@@ -66,7 +66,7 @@ pub enum OutputFormat {
     VrmlGz,
     /// Wavefront OBJ (`.obj`).
     Obj,
-    /// Binary glTF 2.0 (`.glb`).
+    /// Binary glTF 2.0 (`.glb`; `.vrm`, a VRM avatar, is one too: see [`is_vrm_path`]).
     Glb,
     /// Text glTF 2.0 with embedded buffers (`.gltf`).
     Gltf,
@@ -106,6 +106,7 @@ const EXTENSIONS: &[(&str, OutputFormat)] = &[
     (".wrl", OutputFormat::Vrml),
     (".obj", OutputFormat::Obj),
     (".glb", OutputFormat::Glb),
+    (".vrm", OutputFormat::Glb),
     (".fap", OutputFormat::Fap),
     (".png", OutputFormat::Png),
     (".csv", OutputFormat::Csv),
@@ -201,6 +202,14 @@ impl fmt::Display for OutputFormat {
     }
 }
 
+/// Whether `path` names a VRM avatar (`.vrm`): a binary glTF whose document carries the VRM
+/// extension (`VRM` for VRM 0.x, `VRMC_vrm` for 1.0). fbakit writes one only by patching a
+/// VRM avatar it read ([`crate::gltf::check_vrm_output`]).
+pub fn is_vrm_path(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case("vrm"))
+}
+
 /// Refuses an `output` that is one of the `inputs` (same file after resolving links), so a
 /// command never replaces what it is reading. Paths that do not exist yet cannot collide.
 pub fn refuse_overwriting_input(output: &Path, inputs: &[&Path]) -> Result<()> {
@@ -239,6 +248,9 @@ mod tests {
         assert_eq!(f("a.vrml.gz"), Some(OutputFormat::VrmlGz));
         assert_eq!(f("a.wrz"), Some(OutputFormat::VrmlGz));
         assert_eq!(f("x/a.glb"), Some(OutputFormat::Glb));
+        // A VRM avatar is a binary glTF.
+        assert_eq!(f("x/a.VRM"), Some(OutputFormat::Glb));
+        assert!(is_vrm_path(Path::new("x/a.VRM")) && !is_vrm_path(Path::new("a.glb")));
         assert_eq!(f("frames/"), Some(OutputFormat::Directory));
         assert_eq!(f("a.html"), Some(OutputFormat::Html));
         assert_eq!(f("A.HTM"), Some(OutputFormat::Html));

@@ -24,7 +24,7 @@ pub struct CloneArgs {
     /// Target face: VRML (`.wrl`), or `.obj` with --fp-target.
     pub target: PathBuf,
     /// Output: a face file (`.wrl`, `.wrl.gz`), glTF (`.glb`, `.gltf`: the cloned FAT as
-    /// morph targets), or an OBJ shape set: `DIR/` (`neutral.obj`, `feature-points.csv` and
+    /// morph targets; `.vrm` for a VRM avatar target, written back as one), or an OBJ shape set: `DIR/` (`neutral.obj`, `feature-points.csv` and
     /// one OBJ per morph target) or `OUT.obj` (the neutral, the set in `OUT_shapes/`). An OBJ
     /// target comes back as the user's file with only its `v` lines rewritten.
     #[arg(short, long, value_name = "OUT")]

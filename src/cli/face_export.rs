@@ -15,8 +15,8 @@ use super::{print_json, EXIT_OK};
 pub struct FaceExportArgs {
     /// Face: any face file or rig, or a bundled face (`alma`, `bruno`, `ict`).
     pub face: PathBuf,
-    /// Output: `.glb`, `.gltf`, `.obj` or a directory (`DIR/`: OBJ shape set), `.wrl`,
-    /// `.wrl.gz`.
+    /// Output: `.glb`, `.gltf` (`.vrm` for a VRM avatar), `.obj` or a directory (`DIR/`: OBJ
+    /// shape set), `.wrl`, `.wrl.gz`.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Length unit of the face's coordinates (default: guessed from its size); a new glTF

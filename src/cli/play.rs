@@ -44,8 +44,8 @@ pub struct PlayArgs {
     pub fp: Option<PathBuf>,
     /// FAP stream (`.fap` or `.json`).
     pub stream: PathBuf,
-    /// Output: `.glb` / `.gltf` file, `.png` contact sheet, or a directory for an OBJ or PNG
-    /// sequence.
+    /// Output: `.glb` / `.gltf` file (`.vrm` for a VRM avatar), `.png` contact sheet, or a
+    /// directory for an OBJ or PNG sequence.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Output frame rate (the stream is resampled, values interpolated); default: the

@@ -85,8 +85,10 @@ impl GltfDocument {
         Ok(text)
     }
 
-    /// Writes `.glb` atomically.
+    /// Writes `.glb` atomically (not as `.vrm`: a document fbakit builds is no VRM avatar,
+    /// [`super::check_vrm_output`]).
     pub fn write_glb(&self, path: &Path) -> Result<()> {
+        super::check_vrm_output(path, None, "a new glTF document")?;
         crate::io::write_atomic(path, &self.to_glb()?)
     }
 

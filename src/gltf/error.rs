@@ -48,6 +48,15 @@ pub enum GltfError {
         /// What is wrong.
         what: String,
     },
+    /// A `.vrm` output for a document that is no VRM avatar (no `VRM` / `VRMC_vrm`
+    /// extension): written, it would not load as one.
+    #[error("{}: a .vrm is a VRM avatar, and {what} has no VRM extension (`VRM` or `VRMC_vrm`); write .glb instead", path.display())]
+    NotVrm {
+        /// The output asked for.
+        path: PathBuf,
+        /// What would be written (`the face's own glTF`, `a new glTF document`).
+        what: String,
+    },
 }
 
 impl GltfError {

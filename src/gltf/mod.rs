@@ -85,6 +85,7 @@ pub mod patch;
 mod reclaim;
 mod scene_data;
 pub mod source;
+pub mod vrm;
 
 pub use builder::SceneBuilder;
 pub use container::{parse_glb, GlbChunks, GltfDocument};
@@ -94,6 +95,7 @@ pub use scene_data::{
     AnimationData, ChannelData, ChannelValues, Interpolation, MaterialData, MeshData, MeshId,
     MorphOffsets, MorphTargetData, NodeData, NodeId,
 };
+pub use vrm::check_vrm_output;
 
 #[cfg(test)]
 mod tests;

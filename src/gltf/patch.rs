@@ -614,7 +614,8 @@ impl PatchedGltf {
     /// output itself, would replace one of the input's buffers or images: the input is read
     /// whole, but a `.gltf` and its `.bin` are two files, and a write stopped between them
     /// would leave the input's `.gltf` pointing into a rewritten buffer. The output may
-    /// replace the input document itself (it is replaced last, atomically).
+    /// replace the input document itself (it is replaced last, atomically). `.vrm` is a
+    /// `.glb` of a VRM avatar ([`super::vrm`]).
     pub fn write(&self, path: &Path) -> Result<()> {
         use crate::format::OutputFormat;
         let format = OutputFormat::resolve(
@@ -622,6 +623,7 @@ impl PatchedGltf {
             &[OutputFormat::Glb, OutputFormat::Gltf],
             "glTF output",
         )?;
+        super::check_vrm_output(path, Some(&self.json), "the face's own glTF")?;
         let out_dir = path
             .parent()
             .filter(|d| !d.as_os_str().is_empty())

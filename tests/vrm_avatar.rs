@@ -1,0 +1,162 @@
+//! VRM avatars (`.vrm`, VRoid Studio and VRM 1.0 exporters): a binary glTF with the VRM
+//! extension. `clone`, `play` and `face export` write one back as `.vrm` with the extension's
+//! data as the user wrote it and the avatar's own morph targets (which its expressions name by
+//! index) where they were; a document that is no VRM avatar is refused as `.vrm` (exit 2,
+//! nothing written).
+
+mod support;
+
+use std::path::Path;
+
+use serde_json::{json, Value};
+use support::avatar;
+use support::cli::{command, text};
+
+/// The JSON of a `.glb` / `.vrm` file.
+fn json_of(path: &Path) -> Value {
+    let bytes = std::fs::read(path).unwrap();
+    let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+    serde_json::from_slice(chunks.json).unwrap()
+}
+
+fn run(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    command().args(args).output().unwrap()
+}
+
+/// The test avatar as a VRM 1.0 avatar: a humanoid, meta and a `blink` expression bound to
+/// its own `Blink` morph target (mesh 0's target 0, on node `Body`).
+fn vrm_avatar() -> (Value, Vec<u8>) {
+    let mut a = avatar::build();
+    let body = a.json["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|n| n["name"] == "Body")
+        .unwrap();
+    a.json["extensionsUsed"] = json!(["VRMC_vrm"]);
+    a.json["extensions"] = json!({"VRMC_vrm": {
+        "specVersion": "1.0",
+        "meta": {"name": "test avatar", "authors": ["fbakit tests"], "licenseUrl": "https://vrm.dev/licenses/1.0/"},
+        "humanoid": {"humanBones": {"head": {"node": 3}}},
+        "expressions": {"preset": {"blink": {"morphTargetBinds": [{"node": body, "index": 0, "weight": 1.0}]}}}
+    }});
+    let bytes = a.to_glb();
+    (a.json, bytes)
+}
+
+#[test]
+fn a_vrm_avatar_comes_back_as_vrm_with_its_expressions() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (json, bytes) = vrm_avatar();
+    let input = d.join("avatar.vrm");
+    std::fs::write(&input, bytes).unwrap();
+    let alma = fbakit::face::read("alma").unwrap();
+    let fp = avatar::fp_csv(&alma, d, "");
+    let cloned = d.join("cloned.vrm");
+    let o = run(&[
+        "clone".as_ref(),
+        "alma".as_ref(),
+        input.as_os_str(),
+        "--fp-target".as_ref(),
+        fp.as_os_str(),
+        "-o".as_ref(),
+        cloned.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = json_of(&cloned);
+    assert_eq!(
+        out["extensions"]["VRMC_vrm"],
+        json["extensions"]["VRMC_vrm"]
+    );
+    assert!(out["extensionsUsed"]
+        .as_array()
+        .unwrap()
+        .contains(&json!("VRMC_vrm")));
+    // The user's own target keeps index 0 (the `blink` expression's bind), fbakit's follow.
+    let names = out["meshes"][0]["extras"]["targetNames"]
+        .as_array()
+        .unwrap();
+    assert_eq!(names[0], "Blink");
+    assert!(names.len() > 10, "{names:?}");
+    assert!(
+        names
+            .iter()
+            .any(|n| n.as_str().is_some_and(|n| n.starts_with("open_jaw"))),
+        "{names:?}"
+    );
+
+    // Played and exported with ARKit names, it stays a VRM avatar.
+    let played = d.join("played.vrm");
+    let speech = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/speech.fap");
+    let o = run(&[
+        "play".as_ref(),
+        cloned.as_os_str(),
+        speech.as_os_str(),
+        "-o".as_ref(),
+        played.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let p = json_of(&played);
+    assert_eq!(p["extensions"]["VRMC_vrm"], json["extensions"]["VRMC_vrm"]);
+    assert!(!p["animations"].as_array().unwrap().is_empty());
+    let arkit = d.join("arkit.vrm");
+    let o = run(&[
+        "face".as_ref(),
+        "export".as_ref(),
+        cloned.as_os_str(),
+        "-o".as_ref(),
+        arkit.as_os_str(),
+        "--names".as_ref(),
+        "arkit".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let k = json_of(&arkit);
+    assert_eq!(k["extensions"]["VRMC_vrm"], json["extensions"]["VRMC_vrm"]);
+    assert_eq!(k["meshes"][0]["extras"]["targetNames"][0], "Blink");
+}
+
+#[test]
+fn what_is_no_vrm_avatar_is_not_written_as_vrm() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let plain = d.join("avatar.glb");
+    std::fs::write(&plain, avatar::build().to_glb()).unwrap();
+    let alma = fbakit::face::read("alma").unwrap();
+    let fp = avatar::fp_csv(&alma, d, "");
+    let out = d.join("out.vrm");
+    let speech = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/speech.fap");
+    let cases: [(Vec<&std::ffi::OsStr>, &str); 2] = [
+        (
+            vec![
+                "clone".as_ref(),
+                "alma".as_ref(),
+                plain.as_os_str(),
+                "--fp-target".as_ref(),
+                fp.as_os_str(),
+            ],
+            "the face's own glTF has no VRM extension",
+        ),
+        (
+            vec!["play".as_ref(), "alma".as_ref(), speech.as_os_str()],
+            "a new glTF document has no VRM extension",
+        ),
+    ];
+    for (args, expect) in cases {
+        let mut args = args.clone();
+        args.extend(["-o".as_ref(), out.as_os_str()]);
+        let o = run(&args);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(expect) && err.contains("write .glb instead"),
+            "{err}"
+        );
+        assert_eq!(
+            err.lines().filter(|l| l.starts_with("error")).count(),
+            1,
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+}
