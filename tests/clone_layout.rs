@@ -315,3 +315,75 @@ fn cli_outputs_keep_the_users_obj() {
         original
     );
 }
+
+/// The same head modelled facing −z (turned 180° about y, as VRM 0.x avatars and some scans
+/// are) has its eyes, teeth and gums recognised as the upright one's (they were cloned as
+/// skin: no part was cut, the eyes' turns were dropped), and its clone is the upright clone
+/// turned: every FAP moves every vertex as the upright clone turned 180°.
+#[test]
+fn a_head_facing_back_clones_as_the_upright_one_turned() {
+    let Some((_, upright)) = cloned() else { return };
+    let setup = setup().unwrap();
+    let turn = |p: Vec3| Vec3::new(-p.x, p.y, -p.z);
+    let mut head = head(setup);
+    for p in &mut head.meshes[0].mesh.positions {
+        *p = turn(*p);
+    }
+    let ids: Vec<FeaturePointId> = head.feature_points.iter().map(|p| p.id).collect();
+    for id in ids {
+        let mut p = head.feature_points.remove(id).unwrap();
+        p.position = p.position.map(turn);
+        head.feature_points.insert(p);
+    }
+    let alma = fbakit::face::read("alma").unwrap();
+    let back = clone_face(&alma, &head, &CloneOptions::default()).unwrap();
+    let parts = |o: &CloneOutcome| -> Vec<(Part, usize)> {
+        o.report
+            .split_parts
+            .iter()
+            .map(|p| (p.part, p.vertices))
+            .collect()
+    };
+    assert_eq!(parts(&back), parts(upright));
+    let keys = |f: &FaceModel| -> Vec<TableKey> { f.fat.tables.iter().map(|t| t.key).collect() };
+    assert_eq!(keys(&back.face), keys(&upright.face));
+    // Each table at its largest border: the turned clone's motion is the upright one's
+    // turned, at every vertex (up to rounding: within 0.01 % of the motion's peak).
+    let mut worst = (0.0f32, String::new());
+    for t in &upright.face.fat.tables {
+        let value = t
+            .meshes
+            .iter()
+            .flat_map(|m| m.interval_borders.iter().copied())
+            .fold(0.0f64, |a, b| if b.abs() > a.abs() { b } else { a });
+        let at = |f: &FaceModel| -> Vec<Vec3> {
+            let neutral = f.pose(&[]).unwrap();
+            let posed = f.pose(&[Activation { key: t.key, value }]).unwrap();
+            neutral[0]
+                .iter()
+                .zip(&posed[0])
+                .map(|(a, b)| *b - *a)
+                .collect()
+        };
+        let (a, b) = (at(&upright.face), at(&back.face));
+        let peak = a.iter().map(|d| d.length()).fold(0.0f32, f32::max);
+        if peak == 0.0 {
+            continue;
+        }
+        let off = a
+            .iter()
+            .zip(&b)
+            .map(|(a, b)| turn(*a).distance(*b))
+            .fold(0.0f32, f32::max)
+            / peak;
+        if off > worst.0 {
+            worst = (off, format!("{}@{value}", t.key));
+        }
+    }
+    eprintln!(
+        "facing back vs upright: worst {:.5} % of the peak ({})",
+        100.0 * worst.0,
+        worst.1
+    );
+    assert!(worst.0 < 1e-4, "{worst:?}");
+}

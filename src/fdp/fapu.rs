@@ -122,9 +122,16 @@ impl Fapu {
         }
         let mut values = [0.0f64; 5];
         let mut bad = Vec::new();
+        // Along the face's own axes: a face modelled turned in its file (facing −z) is
+        // measured stood up ([`FeaturePointSet::upright_turn`]).
+        let turn = points.upright_turn();
+        let at = |id| {
+            let p = points.position(id).unwrap_or_default();
+            turn.map_or(p, |t| t * p).as_dvec3()
+        };
         for (k, (name, a, b, axis)) in defs.into_iter().enumerate() {
-            let pa = points.position(a).unwrap_or_default().as_dvec3();
-            let pb = points.position(b).unwrap_or_default().as_dvec3();
+            let pa = at(a);
+            let pb = at(b);
             let d = pa[axis] - pb[axis];
             let axis_name = if axis == 0 { "x" } else { "y" };
             if !d.is_finite() || d <= 0.0 {

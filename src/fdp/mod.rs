@@ -12,6 +12,7 @@ pub mod fapu;
 pub mod feature_points;
 pub mod file;
 pub mod landmarks;
+mod upright;
 
 pub use error::FdpError;
 pub use fapu::{Fapu, FapuDistances, FapuMeasurement};

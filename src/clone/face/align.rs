@@ -109,23 +109,36 @@ impl Similarity {
         })
     }
 
-    /// [`Similarity::fit`], except that a rotation of at most `snap_degrees` is taken as no
-    /// rotation at all: scale and translation are then refitted without it (least squares
-    /// about the centroids, `s = Σ a·b / Σ |a|²`). Faces modelled upright in the MPEG-4 frame
-    /// but with other proportions fit with a small spurious tilt (0.94° for the synthetic
-    /// alma → bruno), which only turns FAP directions away from the target's axes.
+    /// [`Similarity::fit`], except that a rotation within `snap_degrees` of a quarter-turn
+    /// rotation (one of the 24 that map the axes onto the axes: none at all for a face
+    /// modelled upright, a half turn about y for one modelled facing −z, as VRM 0.x avatars
+    /// are) is taken as exactly that turn: scale and translation are then refitted with it
+    /// (least squares about the centroids, `s = Σ Qa·b / Σ |a|²`). Faces modelled upright in
+    /// the MPEG-4 frame but with other proportions fit with a small spurious tilt (0.94° for
+    /// the synthetic alma → bruno), which only turns FAP directions away from the target's
+    /// axes — and, as the scale is fitted with the tilt, shrinks every FAPU-scaled motion
+    /// (the ICT head turned round: 4 % smaller than the upright head's).
     pub fn fit_snapped(from: &[DVec3], to: &[DVec3], snap_degrees: f64) -> Result<Similarity> {
         let full = Similarity::fit(from, to)?;
-        if full.angle_degrees().abs() > snap_degrees {
+        let Some(turn) = quarter_turns()
+            .into_iter()
+            .map(|q| (q, q.angle_between(full.rotation).to_degrees()))
+            .filter(|&(_, a)| a <= snap_degrees)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(q, _)| q)
+        else {
             return Ok(full);
-        }
+        };
         let n = from.len().min(to.len());
         let mf = from[..n].iter().sum::<DVec3>() / n as f64;
         let mt = to[..n].iter().sum::<DVec3>() / n as f64;
+        // No turn: the points as they are (bit for bit what an upright face always had).
+        let upright = turn == glam::DQuat::IDENTITY;
+        let turned = |v: DVec3| if upright { v } else { turn * v };
         let (mut num, mut den) = (0.0, 0.0);
         for i in 0..n {
             let a = from[i] - mf;
-            num += a.dot(to[i] - mt);
+            num += turned(a).dot(to[i] - mt);
             den += a.length_squared();
         }
         let scale = num / den;
@@ -134,8 +147,8 @@ impl Similarity {
         }
         Ok(Similarity {
             scale,
-            rotation: glam::DQuat::IDENTITY,
-            translation: mt - mf * scale,
+            rotation: turn,
+            translation: mt - turned(mf) * scale,
         })
     }
 
@@ -143,6 +156,29 @@ impl Similarity {
     pub fn angle_degrees(&self) -> f64 {
         self.rotation.to_axis_angle().1.to_degrees()
     }
+}
+
+/// The 24 rotations that map the coordinate axes onto the axes (signed permutations of
+/// determinant +1), the identity first.
+fn quarter_turns() -> Vec<glam::DQuat> {
+    let axes = [DVec3::X, DVec3::Y, DVec3::Z];
+    let mut out = vec![glam::DQuat::IDENTITY];
+    for x in axes {
+        for y in axes {
+            if x == y {
+                continue;
+            }
+            for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                let (x, y) = (x * sx, y * sy);
+                let m = glam::DMat3::from_cols(x, y, x.cross(y));
+                let q = glam::DQuat::from_mat3(&m).normalize();
+                if !out.iter().any(|o| o.angle_between(q) < 1e-9) {
+                    out.push(q);
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Feature points both faces place: `(target positions, source positions)`, in target order.

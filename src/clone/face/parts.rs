@@ -152,6 +152,9 @@ pub(super) fn face_diagonal(face: &FaceModel, frames: &FaceFrames) -> f32 {
 /// step 1). A mesh without feature points lying on an eyeball with its rim on the lids (an
 /// eye blend, occlusion or tear film of its own) is skin too.
 pub fn identify_parts(face: &FaceModel) -> FaceParts {
+    // By place in the face's upright frame ([`super::upright`]); the result is mesh indices.
+    let look = super::upright::for_recognition(face);
+    let face = look.as_ref();
     let frames = face.frames();
     let diag = face_diagonal(face, &frames);
     let n = face.meshes.len();

@@ -224,21 +224,29 @@ struct CutPlan {
 /// a one-mesh head ([`chin_plan`]) and every part mesh holding several parts
 /// ([`shared_part_plans`]) are cut, unless a FAT table deforms them.
 pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
-    let frames = face.frames();
-    let diag = face_diagonal(face, &frames);
     let deformed: BTreeSet<&str> = face
         .fat
         .tables
         .iter()
         .flat_map(|t| t.meshes.iter().map(|m| m.mesh.as_str()))
         .collect();
-    let chin = chin_plan(face, &frames, diag);
-    let chin_mesh = chin.as_ref().map(|p| p.mesh);
-    let mut plans: Vec<CutPlan> = chin.into_iter().collect();
-    plans.extend(shared_part_plans(face, &frames, diag, chin_mesh));
-    plans.extend(teeth_row_plans(face, &frames, diag, chin_mesh));
-    let planned: BTreeSet<usize> = plans.iter().map(|p| p.mesh).collect();
-    plans.extend(eye_layer_plans(face, &frames, diag, &planned));
+    // The cuts are found by place in the face's upright frame (a face modelled facing −z is
+    // read turned round, [`super::upright`]) and, being polygon lists, applied to the face.
+    let plans = {
+        let look = super::upright::for_recognition(face);
+        let look = look.as_ref();
+        let frames = look.frames();
+        let diag = face_diagonal(look, &frames);
+        let chin = chin_plan(look, &frames, diag);
+        let chin_mesh = chin.as_ref().map(|p| p.mesh);
+        let mut plans: Vec<CutPlan> = chin.into_iter().collect();
+        plans.extend(shared_part_plans(look, &frames, diag, chin_mesh));
+        plans.extend(teeth_row_plans(look, &frames, diag, chin_mesh));
+        let planned: BTreeSet<usize> = plans.iter().map(|p| p.mesh).collect();
+        plans.extend(eye_layer_plans(look, &frames, diag, &planned));
+        plans
+    };
+    let mut plans = plans;
     plans.retain(|p| !deformed.contains(face.meshes[p.mesh].name.as_str()));
     if plans.is_empty() {
         return None;

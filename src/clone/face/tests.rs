@@ -274,4 +274,21 @@ fn small_alignment_rotations_snap_to_none() {
     // Without snapping the small rotation is kept.
     let kept = Similarity::fit_snapped(&from, &moved(1.0), 0.0).unwrap();
     assert!((kept.angle_degrees() - 1.0).abs() < 1e-6);
+    // A face turned round (half a turn about y) and tilted 1°: exactly the half turn, and
+    // the scale refitted with it.
+    let half = glam::DQuat::from_rotation_y(std::f64::consts::PI);
+    let round: Vec<DVec3> = moved(1.0).iter().map(|&p| half * p).collect();
+    let snapped = Similarity::fit_snapped(&from, &round, 3.0).unwrap();
+    assert!(
+        snapped.rotation.angle_between(half) < 1e-12,
+        "{:?}",
+        snapped.rotation
+    );
+    assert!((snapped.scale - 2.0).abs() < 1e-3, "{}", snapped.scale);
+    for (a, b) in from.iter().zip(&round) {
+        assert!(
+            (snapped.rotation * *a * snapped.scale + snapped.translation).distance(*b) < 0.1,
+            "{a} {b}"
+        );
+    }
 }

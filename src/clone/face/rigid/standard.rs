@@ -152,6 +152,26 @@ pub(in crate::clone::face) fn add_standard_rotations_cut(
     out
 }
 
+/// The face's own axes in its file (`x` left, `y` up, `z` out of the face): the quarter
+/// turns that stand a face modelled facing −z or lying with z up upright
+/// ([`crate::clone::face::upright`]), as `(file → upright, upright → file)`; `None` for a
+/// face upright in its file (every standard rotation then turns about the file's axes as
+/// before, bit for bit).
+fn face_axes(face: &FaceModel) -> Option<(DMat3, DMat3)> {
+    let up = crate::clone::face::upright::upright_turn(face)?.as_dmat3();
+    Some((up, up.transpose()))
+}
+
+/// `axis` (the standard's, in the face's upright frame) in the face's file.
+fn file_axis(axes: Option<(DMat3, DMat3)>, axis: DVec3) -> DVec3 {
+    axes.map_or(axis, |(_, down)| down * axis)
+}
+
+/// The height of file point `p` in the face's upright frame.
+fn upright_y(axes: Option<(DMat3, DMat3)>, p: DVec3) -> f64 {
+    axes.map_or(p.y, |(up, _)| (up * p).y)
+}
+
 /// A rotation of the face frame: `axis` (unit, face frame) about `centre`, with a per-vertex
 /// weight on the angle.
 struct Turn {
@@ -352,7 +372,12 @@ fn add_transform_tables(
         let Some(axis) = f.info().rotation_axis() else {
             continue;
         };
-        let local = local_axis(face, &frames, t, axis.as_dvec3());
+        let local = local_axis(
+            face,
+            &frames,
+            t,
+            file_axis(face_axes(face), axis.as_dvec3()),
+        );
         let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
         table
             .transforms
@@ -431,7 +456,7 @@ fn add_eye_tables(
             };
             let turn = Turn {
                 centre: centre.as_dvec3(),
-                axis: axis.as_dvec3(),
+                axis: file_axis(face_axes(face), axis.as_dvec3()),
             };
             let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
             for (&fi, vs) in &rows {
@@ -466,15 +491,22 @@ pub fn head_pivot(face: &FaceModel) -> Option<(Vec3, PivotSource)> {
     if let Some(p) = fp(FeaturePointId::FP_7_1) {
         return Some((p, PivotSource::FeaturePoint));
     }
-    let (pl, pr) = (fp(FeaturePointId::FP_3_5)?, fp(FeaturePointId::FP_3_6)?);
+    // In the face's upright frame (behind the face is −z there), placed back in its file.
+    let axes = face_axes(face);
+    let up = |p: Vec3| axes.map_or(p, |(u, _)| (u * p.as_dvec3()).as_vec3());
+    let (pl, pr) = (
+        up(fp(FeaturePointId::FP_3_5)?),
+        up(fp(FeaturePointId::FP_3_6)?),
+    );
     let es0 = pl.distance(pr);
     let mid = (pl + pr) / 2.0;
     let y = match (fp(FeaturePointId::FP_8_3), fp(FeaturePointId::FP_8_4)) {
-        (Some(a), Some(b)) => (a.y + b.y) / 2.0,
+        (Some(a), Some(b)) => (up(a).y + up(b).y) / 2.0,
         _ => mid.y - es0,
     };
+    let pivot = Vec3::new(mid.x, y, mid.z - PIVOT_DEPTH as f32 * es0);
     Some((
-        Vec3::new(mid.x, y, mid.z - PIVOT_DEPTH as f32 * es0),
+        axes.map_or(pivot, |(_, down)| (down * pivot.as_dvec3()).as_vec3()),
         PivotSource::Derived,
     ))
 }
@@ -514,16 +546,16 @@ fn add_head_tables(
     let world: Vec<Vec<Vec3>> = all.iter().map(|&m| face.mesh_world(&frames, m)).collect();
     let pts = world.iter().flatten().copied().collect::<Vec<_>>();
     let size = f64::from(crate::fat::bake::part_size(&pts));
-    let lowest = pts
-        .iter()
-        .map(|p| f64::from(p.y))
-        .fold(f64::INFINITY, f64::min);
-    let chin = face
-        .feature_points
-        .position(FeaturePointId::FP_2_1)
-        .map_or(f64::from((pl.y + pr.y) / 2.0) - 2.0 * es0, |c| {
-            f64::from(c.y)
-        });
+    // Heights and axes in the face's upright frame.
+    let axes = face_axes(face);
+    let height = |p: Vec3| upright_y(axes, p.as_dvec3());
+    let lowest = pts.iter().map(|&p| height(p)).fold(f64::INFINITY, f64::min);
+    let chin = face.feature_points.position(FeaturePointId::FP_2_1).map_or(
+        axes.map_or(f64::from((pl.y + pr.y) / 2.0), |_| {
+            (height(pl) + height(pr)) / 2.0
+        }) - 2.0 * es0,
+        height,
+    );
     let top = chin - FADE_TOP * es0;
     let bottom = (top - FADE_LENGTH * es0).max(lowest);
     let c = pivot.as_dvec3();
@@ -540,7 +572,7 @@ fn add_head_tables(
             let axis = f.info().rotation_axis()?;
             let turn = Turn {
                 centre: c,
-                axis: axis.as_dvec3(),
+                axis: file_axis(axes, axis.as_dvec3()),
             };
             let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
             for &m in &all {
@@ -552,7 +584,7 @@ fn add_head_tables(
                     &mesh.mesh.positions,
                     frames.meshes[m],
                     &turn,
-                    |p| neck_weight(p.y, top, bottom),
+                    |p| neck_weight(upright_y(axes, p), top, bottom),
                     &borders,
                 );
                 if !entry.coord_index.is_empty() {
