@@ -83,13 +83,11 @@ pub fn feature_point_box(face: &FaceModel) -> Option<Aabb> {
     })
 }
 
-/// The front camera for a video of `face`: framed on its feature points, or on `view`'s
+/// The front camera for a video of `view`'s face: framed on its feature points, or on its
 /// neutral bounds when it has too few (second value false).
-pub fn movie_camera(face: &FaceModel, view: &FaceView) -> (Camera, bool) {
-    match feature_point_box(face) {
-        Some(b) => (Camera::framing(&b, 0.0, 0.0), true),
-        None => (view.front_camera(), false),
-    }
+pub fn movie_camera(view: &FaceView) -> (Camera, bool) {
+    // The view's own box: a face turned in its file is framed stood up, as it is drawn.
+    (view.face_camera(), view.framed_on_feature_points())
 }
 
 /// Plays `stream` on `face` and pushes every rendered frame into `sink` (which the caller
@@ -111,7 +109,7 @@ pub fn render_movie(
         },
     )?;
     let view = FaceView::new(face)?;
-    let (camera, framed) = movie_camera(face, &view);
+    let (camera, framed) = movie_camera(&view);
     let render_opts = RenderOptions::sized(opts.width, opts.height);
     let mut frame = player.new_frame();
     let mut positions = Vec::new();
@@ -158,14 +156,38 @@ mod tests {
         assert!(b.size().min_element() > 0.0);
         assert!(b.size().z < 0.8 * head.size().z, "{b:?} in {head:?}");
         assert!(b.size().y > 0.5 * head.size().y);
-        let (cam, framed) = movie_camera(&face, &view);
+        let (cam, framed) = movie_camera(&view);
         assert!(framed);
         let whole = view.front_camera();
         assert!(cam.eye.distance(cam.target) < 0.9 * whole.eye.distance(whole.target));
         let mut bare = face.clone();
         bare.feature_points = Default::default();
         assert!(feature_point_box(&bare).is_none());
-        assert!(!movie_camera(&bare, &view).1);
+        assert!(!movie_camera(&FaceView::new(&bare).unwrap()).1);
+    }
+
+    /// A face modelled facing −z is drawn from its own front, framed as the upright face:
+    /// the same picture.
+    #[test]
+    fn a_face_turned_round_is_drawn_from_its_front() {
+        let face = crate::synth::alma().to_face_model();
+        let half = glam::Mat3::from_cols(-Vec3::X, Vec3::Y, -Vec3::Z);
+        let turned = crate::clone::face::upright::upright_copy(&face, half);
+        let opts = RenderOptions {
+            width: 96,
+            height: 96,
+            ..RenderOptions::default()
+        };
+        let picture = |f: &FaceModel| {
+            let view = FaceView::new(f).unwrap();
+            let (camera, framed) = movie_camera(&view);
+            assert!(framed);
+            view.render(&f.neutral_world_positions(), &camera, &opts)
+        };
+        let (a, b) = (picture(&face), picture(&turned));
+        let covered = a.stats(opts.background).coverage;
+        assert!(covered > 0.2, "{covered}");
+        assert!(a.rgba == b.rgba, "the turned face is drawn otherwise");
     }
 
     #[test]

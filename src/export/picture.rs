@@ -12,7 +12,7 @@
 
 pub mod eyes;
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use crate::clone::face::{clone_face, lid_resting_layers, CloneOptions, Method};
 use crate::error::Result;
@@ -48,6 +48,10 @@ pub struct FaceView {
     /// The box around the neutral face's facial feature points
     /// ([`crate::export::movie::feature_point_box`]), when it has enough of them.
     face_box: Option<Aabb>,
+    /// For a face modelled turned in its file (facing −z), the turn that stands it up
+    /// ([`crate::fdp::FeaturePointSet::upright_turn`]): it is drawn and framed from its own
+    /// front, as every upright face is.
+    turn: Option<Mat3>,
 }
 
 /// Triangles of one mesh drawn in one material.
@@ -63,6 +67,10 @@ impl FaceView {
     /// Triangulates `face`'s meshes, orients and splits them into parts, and measures its
     /// neutral pose. Errors when the face has no finite vertex.
     pub fn new(face: &FaceModel) -> Result<FaceView> {
+        // A turned face is measured stood up, and every pose drawn turned so (`render`).
+        let turn = face.feature_points.upright_turn();
+        let upright = turn.map(|t| crate::clone::face::upright::upright_copy(face, t));
+        let face = upright.as_ref().unwrap_or(face);
         let neutral = face.neutral_world_positions();
         let eyes = eyes::eyeballs(face, &neutral);
         // Transparent in the user's materials, opaque here: drawn, they close the eyes.
@@ -122,6 +130,7 @@ impl FaceView {
             parts,
             neutral_bounds,
             face_box: super::movie::feature_point_box(face),
+            turn,
         })
     }
 
@@ -155,7 +164,16 @@ impl FaceView {
     /// Draws world positions (one list per mesh, as [`crate::face::FacePose::world_positions_into`]
     /// makes them).
     pub fn render(&self, positions: &[Vec<Vec3>], camera: &Camera, opts: &RenderOptions) -> Image {
-        render(&render_meshes(positions, &self.parts), camera, opts)
+        match self.turn {
+            None => render(&render_meshes(positions, &self.parts), camera, opts),
+            Some(t) => {
+                let upright: Vec<Vec<Vec3>> = positions
+                    .iter()
+                    .map(|m| m.iter().map(|&p| t * p).collect())
+                    .collect();
+                render(&render_meshes(&upright, &self.parts), camera, opts)
+            }
+        }
     }
 
     /// Like [`FaceView::render`] from several yaw angles (radians) at one distance.

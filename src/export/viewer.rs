@@ -169,9 +169,14 @@ pub struct CameraFrame {
     pub target: [f32; 3],
     /// Radius.
     pub radius: f32,
-    /// Half the size of the box around the same points along x, y, z (the camera fits the
-    /// x-y rectangle to the view, in front of the box).
+    /// Half the size of the box around the same points along the face's own x, y, z (the
+    /// camera fits the x-y rectangle to the view, in front of the box).
     pub half_extent: [f32; 3],
+    /// The face's own axes in its file: `right` (towards the face's left, x), `up` (y) and
+    /// `front` (out of the face, z) — the file's own for a face modelled upright, turned for
+    /// one modelled facing −z ([`crate::fdp::FeaturePointSet::upright_turn`]); the camera
+    /// starts in front of the face and keeps `up` up.
+    pub axes: [[f32; 3]; 3],
 }
 
 /// A feature point in the overlay.
@@ -603,11 +608,16 @@ fn fap_groups(face: &FaceModel, tracks: &[KeyTrack]) -> Vec<FapGroup> {
 /// A sphere around the feature points (the whole head from hairline to chin and ear to
 /// ear), or around all vertices when there are fewer than two.
 fn camera_frame(face: &FaceModel) -> CameraFrame {
+    // Measured in the face's own axes (a face modelled turned is measured stood up).
+    let turn = face.feature_points.upright_turn();
+    let up = |p: Vec3| turn.map_or(p, |t| t * p);
+    let down = |p: Vec3| turn.map_or(p, |t| t.transpose() * p);
     let mut points: Vec<Vec3> = face
         .feature_points
         .iter()
         .filter_map(|p| p.position)
         .filter(|p| p.is_finite())
+        .map(up)
         .collect();
     if points.len() < 2 {
         let frames = face.frames();
@@ -620,13 +630,16 @@ fn camera_frame(face: &FaceModel) -> CameraFrame {
                 m.mesh.positions.iter().map(move |&p| w.transform_point3(p))
             })
             .filter(|p| p.is_finite())
+            .map(up)
             .collect();
     }
+    let axes = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| down(a).to_array());
     let Some(first) = points.first().copied() else {
         return CameraFrame {
             target: [0.0; 3],
             radius: 1.0,
             half_extent: [1.0; 3],
+            axes,
         };
     };
     let (lo, hi) = points
@@ -634,9 +647,10 @@ fn camera_frame(face: &FaceModel) -> CameraFrame {
         .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     let radius = ((hi - lo).length() * 0.5).max(f32::EPSILON);
     CameraFrame {
-        target: ((lo + hi) * 0.5).to_array(),
+        target: down((lo + hi) * 0.5).to_array(),
         radius,
         half_extent: ((hi - lo) * 0.5).max(Vec3::splat(radius * 0.01)).to_array(),
+        axes,
     }
 }
 

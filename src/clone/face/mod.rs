@@ -297,7 +297,7 @@ mod smooth;
 mod split;
 mod target_check;
 mod turn_bound;
-mod upright;
+pub(crate) mod upright;
 
 use std::collections::HashMap;
 use std::time::Instant;

@@ -43,7 +43,7 @@ pub(super) fn for_recognition(face: &FaceModel) -> Cow<'_, FaceModel> {
 /// turned by `turn`, no mesh under a transform (the transforms stay, holding nothing), every
 /// feature point's position turned by `turn`. Meshes, vertices, polygons and feature-point
 /// bindings are the face's, in order.
-pub(super) fn upright_copy(face: &FaceModel, turn: Mat3) -> FaceModel {
+pub(crate) fn upright_copy(face: &FaceModel, turn: Mat3) -> FaceModel {
     let frames = face.frames();
     let mut out = face.clone();
     for (mi, m) in out.meshes.iter_mut().enumerate() {

@@ -265,6 +265,27 @@ fn feature_points_are_bound_to_mesh_nodes_and_frame_the_camera() {
     }
 }
 
+/// A face modelled facing −z is framed from its own front: the same box, turned round.
+#[test]
+fn a_face_turned_round_is_framed_from_its_front() {
+    let upright = camera_frame(alma());
+    assert_eq!(
+        upright.axes,
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    );
+    let half = glam::Mat3::from_cols(-Vec3::X, Vec3::Y, -Vec3::Z);
+    let turned = crate::clone::face::upright::upright_copy(alma(), half);
+    let frame = camera_frame(&turned);
+    assert_eq!(
+        frame.axes,
+        [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]
+    );
+    assert_eq!(frame.half_extent, upright.half_extent);
+    assert_eq!(frame.radius, upright.radius);
+    let t = Vec3::from_array(upright.target);
+    assert_eq!(Vec3::from_array(frame.target), half * t);
+}
+
 #[test]
 fn title_is_escaped_and_long_animations_are_refused() {
     let mut face = alma().clone();

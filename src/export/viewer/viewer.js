@@ -91,11 +91,14 @@
     // A little from the side and above, so the face reads as 3D from the first frame.
     const yaw = T.MathUtils.degToRad(14);
     const pitch = T.MathUtils.degToRad(5);
-    camera.position.set(
-      target.x + dist * Math.sin(yaw) * Math.cos(pitch),
-      target.y + dist * Math.sin(pitch),
-      target.z + dist * Math.cos(yaw) * Math.cos(pitch),
-    );
+    // Along the face's own axes: a face modelled facing -z is seen from its front too.
+    const [right, up, front] = model.camera.axes.map((a) => new T.Vector3().fromArray(a));
+    camera.up.copy(up);
+    camera.position
+      .copy(target)
+      .addScaledVector(right, dist * Math.sin(yaw) * Math.cos(pitch))
+      .addScaledVector(up, dist * Math.sin(pitch))
+      .addScaledVector(front, dist * Math.cos(yaw) * Math.cos(pitch));
     camera.near = dist / 100;
     camera.far = dist * 20;
     camera.updateProjectionMatrix();
