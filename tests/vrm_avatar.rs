@@ -160,3 +160,122 @@ fn what_is_no_vrm_avatar_is_not_written_as_vrm() {
         assert!(!out.exists());
     }
 }
+
+/// The values of float accessor `i` (dense, tightly packed, as fbakit writes its animation).
+fn floats(json: &Value, bin: &[u8], i: usize) -> Vec<f64> {
+    let a = &json["accessors"][i];
+    assert_eq!(a["componentType"], 5126);
+    let view = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+    let start =
+        (view["byteOffset"].as_u64().unwrap_or(0) + a["byteOffset"].as_u64().unwrap_or(0)) as usize;
+    let per = match a["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC3" => 3,
+        "VEC4" => 4,
+        t => panic!("{t}"),
+    };
+    let n = a["count"].as_u64().unwrap() as usize * per;
+    bin[start..start + 4 * n]
+        .chunks_exact(4)
+        .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+        .collect()
+}
+
+/// A VRM 0.x avatar faces −z in its file. The test avatar turned round so (its root turned
+/// half a turn about y, its feature points with it) clones and plays as the avatar facing
+/// +z: the same morph weights, and the same turns of its `Head` and `Jaw` joints in their
+/// parents' frames (head pitch about the face's own x, not the file's).
+#[test]
+fn an_avatar_facing_back_plays_as_the_one_facing_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let alma = fbakit::face::read("alma").unwrap();
+    let fp = avatar::fp_csv(&alma, d, "");
+    let fp_text = std::fs::read_to_string(&fp).unwrap();
+    let mut round_fp = String::from("fp,x,y,z\n");
+    for line in fp_text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let c: Vec<f32> = f[1..4].iter().map(|v| v.parse().unwrap()).collect();
+        round_fp.push_str(&format!("{},{},{},{}\n", f[0], -c[0], c[1], -c[2]));
+    }
+    let fp_round = d.join("round-fp.csv");
+    std::fs::write(&fp_round, round_fp).unwrap();
+    let front = avatar::build();
+    let mut round = avatar::build();
+    round.json["nodes"][0]["rotation"] = json!([0.0, 1.0, 0.0, 0.0]);
+    let speech = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/lowlevel.fap");
+    let played = |name: &str, a: &avatar::Avatar, fp: &Path| {
+        let input = d.join(format!("{name}.glb"));
+        std::fs::write(&input, a.to_glb()).unwrap();
+        let cloned = d.join(format!("{name}-cloned.glb"));
+        let o = run(&[
+            "clone".as_ref(),
+            "alma".as_ref(),
+            input.as_os_str(),
+            "--fp-target".as_ref(),
+            fp.as_os_str(),
+            "-o".as_ref(),
+            cloned.as_os_str(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let out = d.join(format!("{name}-played.glb"));
+        let o = run(&[
+            "play".as_ref(),
+            cloned.as_os_str(),
+            speech.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let bytes = std::fs::read(&out).unwrap();
+        let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+        let bin = chunks.bin.unwrap_or_default().to_vec();
+        let json: Value = serde_json::from_slice(chunks.json).unwrap();
+        let play = json["animations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|a| a["name"] == "play")
+            .unwrap()
+            .clone();
+        // (node, path) → sampler output values.
+        let mut channels: Vec<((u64, String), Vec<f64>)> = play["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                let s = &play["samplers"][c["sampler"].as_u64().unwrap() as usize];
+                let values = floats(&json, &bin, s["output"].as_u64().unwrap() as usize);
+                (
+                    (
+                        c["target"]["node"].as_u64().unwrap(),
+                        c["target"]["path"].as_str().unwrap().to_string(),
+                    ),
+                    values,
+                )
+            })
+            .collect();
+        channels.sort_by(|a, b| a.0.cmp(&b.0));
+        channels
+    };
+    let (a, b) = (
+        played("front", &front, &fp),
+        played("round", &round, &fp_round),
+    );
+    let keys = |c: &[((u64, String), Vec<f64>)]| c.iter().map(|x| x.0.clone()).collect::<Vec<_>>();
+    assert_eq!(keys(&a), keys(&b));
+    assert!(
+        a.iter().any(|((n, p), _)| *n == 3 && p == "rotation"),
+        "the Head joint turns: {:?}",
+        keys(&a)
+    );
+    for ((key, x), (_, y)) in a.iter().zip(&b) {
+        assert_eq!(x.len(), y.len(), "{key:?}");
+        let worst = x
+            .iter()
+            .zip(y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0f64, f64::max);
+        assert!(worst < 2e-3, "{key:?}: off by {worst}");
+    }
+}

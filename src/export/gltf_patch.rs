@@ -499,7 +499,7 @@ pub fn patch_face(
             frames
         };
         patch.animation = animation(source, &meshes, &layouts, weight_frames);
-        let mut turned = rotated_nodes(source, &face.fat, nodes);
+        let mut turned = rotated_nodes(source, face, nodes);
         // Eye joints turning eyeball parts take the eye FAPs by the parts' fitted turns.
         turned.retain(|n| !parts.iter().any(|p| p.node == n.node));
         if !turned.is_empty() {
@@ -681,6 +681,11 @@ fn head_turns_on_node(
         let Some(axis) = f.info().rotation_axis() else {
             continue;
         };
+        // About the face's own axis (turned from the file's for a face modelled facing −z).
+        let axis = face
+            .feature_points
+            .upright_turn()
+            .map_or(axis, |t| (t.transpose() * axis).normalize());
         table.meshes.clear();
         // One AU (1e-5 rad) per FAP unit, the standard's angle.
         table

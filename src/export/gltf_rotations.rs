@@ -1,7 +1,9 @@
 //! Head and eye rotations of a played stream on the user's own nodes: FAPs 48–50 (head
 //! pitch, yaw, roll) turn the head node, 23–26 (eyeball yaw, pitch) the eye nodes, in the
 //! standard's units (AU = 1e-5 rad) about the face frame's axes
-//! ([`crate::spec::FapInfo::rotation_axis`]).
+//! ([`crate::spec::FapInfo::rotation_axis`]) — the face's own, which are turned from the
+//! file's for a face modelled facing −z as VRM 0.x avatars are
+//! ([`crate::fdp::FeaturePointSet::upright_turn`]).
 //!
 //! Nodes are the ones the user names (`play --head-node`, `--eye-nodes`), else found by the
 //! usual names (`Head`, `LeftEye`/`RightEye`, `eye.L`, Mixamo, CC, VRM 0 bone names) or by
@@ -21,7 +23,7 @@ use glam::{Mat3, Mat4, Quat, Vec3};
 use serde_json::Value;
 
 use crate::fat::eval::Activation;
-use crate::fat::{Fat, TableKey};
+use crate::fat::TableKey;
 use crate::gltf::source::GltfSource;
 use crate::spec::FapId;
 
@@ -48,6 +50,8 @@ pub struct RotatedNode {
     rest: Quat,
     /// The parent's world rotation (world deltas are conjugated by it).
     parent: Quat,
+    /// The face's own axes in the file (columns: x, y, z; identity for an upright face).
+    axes: Mat3,
 }
 
 impl RotatedNode {
@@ -63,6 +67,7 @@ impl RotatedNode {
                 .filter(|a| a.key == TableKey::LowLevel(fap) && a.value.is_finite())
                 .map(|a| a.value)
                 .sum();
+            let axis = (self.axes * axis).normalize();
             world = Quat::from_axis_angle(axis, (value * 1e-5) as f32) * world;
         }
         ((self.parent.inverse() * world * self.parent) * self.rest).normalize()
@@ -245,9 +250,23 @@ fn local_rotation(n: &Value) -> Quat {
     }
 }
 
-/// The nodes `play` turns for `fat` in `source` (see the module docs). A node given by
+/// The face's own axes in its file as the columns of a matrix (face frame → file): the
+/// identity for a face modelled upright, quarter turns for one modelled turned.
+fn face_axes(face: &crate::face::FaceModel) -> Mat3 {
+    face.feature_points
+        .upright_turn()
+        .map_or(Mat3::IDENTITY, |t| t.transpose())
+}
+
+/// The nodes `play` turns for `face`'s FAT in `source` (see the module docs). A node given by
 /// `matrix` cannot be animated (glTF) and is skipped.
-pub fn rotated_nodes(source: &GltfSource, fat: &Fat, names: &RotationNodes) -> Vec<RotatedNode> {
+pub fn rotated_nodes(
+    source: &GltfSource,
+    face: &crate::face::FaceModel,
+    names: &RotationNodes,
+) -> Vec<RotatedNode> {
+    let fat = &face.fat;
+    let axes = face_axes(face);
     let json = &source.json;
     let has_table = |f: u8| {
         fat.tables
@@ -280,6 +299,7 @@ pub fn rotated_nodes(source: &GltfSource, fat: &Fat, names: &RotationNodes) -> V
             faps,
             rest: local_rotation(&json["nodes"][node]),
             parent: parent[node].map_or(Quat::IDENTITY, |p| world[p]),
+            axes,
         });
     }
     out
@@ -309,6 +329,8 @@ pub struct JawNode {
     parent_rotation: Quat,
     /// The inverse of the parent's world linear part (world moves into its frame).
     parent_inverse: Mat3,
+    /// The face's own x axis in the file (what `open_jaw` turns about).
+    face_x: Vec3,
     /// Radians per unit of `open_jaw`, signed so that the chin goes down.
     open_per_unit: f64,
     /// World move per unit of `thrust_jaw` and of `shift_jaw` (file units).
@@ -331,7 +353,7 @@ impl JawNode {
     /// The node's rotation for `activations`.
     pub fn rotation(&self, activations: &[Activation]) -> Quat {
         let angle = fap_value(activations, 3) * self.open_per_unit;
-        let world = Quat::from_axis_angle(Vec3::X, angle as f32);
+        let world = Quat::from_axis_angle(self.face_x, angle as f32);
         ((self.parent_rotation.inverse() * world * self.parent_rotation) * self.rest_rotation)
             .normalize()
     }
@@ -424,7 +446,9 @@ pub fn jaw_node(
         * unit;
     let (world, parent) = world_matrices(json);
     let pivot = world[node].w_axis.truncate();
-    let r = chin - pivot;
+    // In the face's own axes (turned from the file's for a face modelled facing −z).
+    let axes = face_axes(face);
+    let r = axes.transpose() * (chin - pivot);
     let radius = (r.y * r.y + r.z * r.z).sqrt();
     if !radius.is_finite() || radius <= 1e-6 * (chin.length() + 1.0) {
         return Err(format!(
@@ -454,8 +478,9 @@ pub fn jaw_node(
         parent_rotation,
         parent_inverse: parent_linear.inverse(),
         open_per_unit,
-        thrust_per_unit: dir(14) * mns as f32,
-        shift_per_unit: dir(15) * mw as f32,
+        thrust_per_unit: axes * dir(14) * mns as f32,
+        shift_per_unit: axes * dir(15) * mw as f32,
+        face_x: axes.x_axis,
     }))
 }
 
@@ -473,6 +498,7 @@ pub fn same_hemisphere(values: &mut [Quat]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::face::FaceModel;
     use glam::Vec3;
 
     #[test]
@@ -491,7 +517,8 @@ mod tests {
             buffers: vec![],
             parts: vec![],
         };
-        let nodes = rotated_nodes(&source, &Fat::default(), &RotationNodes::default());
+        let bare = FaceModel::new("face");
+        let nodes = rotated_nodes(&source, &bare, &RotationNodes::default());
         assert_eq!(nodes.iter().map(|n| n.node).collect::<Vec<_>>(), [1, 2]);
         // Head yaw of 0.1 rad turns about the world's +y whatever the armature's turn.
         let a = [Activation {
@@ -502,20 +529,44 @@ mod tests {
         let world = turn * local;
         let want = Quat::from_axis_angle(Vec3::Y, 0.1) * turn;
         assert!(world.abs_diff_eq(want, 1e-5) || world.abs_diff_eq(-want, 1e-5));
+        // A face facing −z (turned round in its file): its yaw turns about the world's +y
+        // still, its pitch about the world's −x (its own +x).
+        let mut round = FaceModel::new("face");
+        for (id, p) in [
+            ("3.5", Vec3::new(-3.2, 0.0, 0.0)),
+            ("3.6", Vec3::new(3.2, 0.0, 0.0)),
+            ("2.2", Vec3::new(0.0, -6.0, -1.2)),
+            ("2.3", Vec3::new(0.0, -6.4, -1.1)),
+            ("9.3", Vec3::new(0.0, -3.5, -2.5)),
+        ] {
+            round
+                .feature_points
+                .insert(crate::fdp::FeaturePoint::at(id.parse().unwrap(), p));
+        }
+        let nodes = rotated_nodes(&source, &round, &RotationNodes::default());
+        let world = turn * nodes[0].rotation(&a);
+        assert!(world.abs_diff_eq(want, 1e-5) || world.abs_diff_eq(-want, 1e-5));
+        let pitch = [Activation {
+            key: TableKey::LowLevel(FapId::new(48).unwrap()),
+            value: 10_000.0,
+        }];
+        let world = turn * nodes[0].rotation(&pitch);
+        let want = Quat::from_axis_angle(-Vec3::X, 0.1) * turn;
+        assert!(world.abs_diff_eq(want, 1e-5) || world.abs_diff_eq(-want, 1e-5));
         // A FAT table for head yaw leaves yaw to the table.
-        let mut fat = Fat::default();
-        fat.tables.push(crate::fat::FaceDefTable {
+        let mut with_table = FaceModel::new("face");
+        with_table.fat.tables.push(crate::fat::FaceDefTable {
             key: TableKey::LowLevel(FapId::new(49).unwrap()),
             meshes: vec![],
             transforms: vec![],
         });
-        let nodes = rotated_nodes(&source, &fat, &RotationNodes::default());
+        let nodes = rotated_nodes(&source, &with_table, &RotationNodes::default());
         assert_eq!(nodes[0].faps.len(), 2);
         // Named nodes win over usual names.
         let named = RotationNodes {
             head: Some("Armature".into()),
             ..RotationNodes::default()
         };
-        assert_eq!(rotated_nodes(&source, &Fat::default(), &named)[0].node, 0);
+        assert_eq!(rotated_nodes(&source, &bare, &named)[0].node, 0);
     }
 }

@@ -5,11 +5,12 @@
 //!
 //! `x` runs from the right pupil (3.6) to the left (3.5); `y` from the mouth (between 2.2
 //! and 2.3, else 8.1 and 8.2, else the chin 2.1) to the pupils, made orthogonal to `x`. Each
-//! is snapped to the nearest axis of the file (±x, ±y, ±z) and `z = x × y`; the front the
-//! points show — from the pupils to the nose tip (9.3), else to the mouth — must agree with
-//! that `z`, or the points are a mirror image (a model with its x reversed) rather than a
-//! turned face, and no turn is given. Every face modelled upright snaps to its file's own
-//! axes whatever its small tilts.
+//! is snapped to the nearest axis of the file (±x, ±y, ±z) and `z = x × y`. A turn is given
+//! only where the points agree on it: the chin's up (2.1, when placed) snaps as the mouth's,
+//! and the front they show — from the pupils to the nose tip (9.3), else to the mouth —
+//! snaps to that `z` (the other way round, the points are a mirror image: a model with its x
+//! reversed, not a turned face). Every face modelled upright snaps to its file's own axes
+//! whatever its small tilts, and one misplaced point does not turn it.
 
 use glam::{Mat3, Vec3};
 
@@ -32,16 +33,29 @@ impl FeaturePointSet {
         };
         let eyes = (left + right) / 2.0;
         let x = (left - right).try_normalize()?;
-        let up = eyes - mouth;
-        let y = (up - up.dot(x) * x).try_normalize()?;
+        // Up from a point below the eyes, made orthogonal to x.
+        let up_from = |below: Vec3| {
+            let u = eyes - below;
+            (u - u.dot(x) * x).try_normalize()
+        };
+        let y = up_from(mouth)?;
         let sx = snap(x, None);
         let sy = snap(y, Some(sx));
         if sx == Vec3::X && sy == Vec3::Y {
             return None;
         }
+        // A turn is taken only where every point agrees on it: the chin's up, and the
+        // front (the nose tip, else the mouth, lies in front of the eyes). One misplaced
+        // point (a lip bound to the back of the head) does not turn an upright face.
+        if let Some(chin) = p(FeaturePointId::FP_2_1) {
+            if snap(up_from(chin)?, Some(sx)) != sy {
+                return None;
+            }
+        }
         let sz = sx.cross(sy);
+        // The front, out of the plane of x and up: its side of that plane is all it says.
         let front = p(FeaturePointId::FP_9_3).unwrap_or(mouth) - eyes;
-        if front.dot(sz) <= 0.0 {
+        if front.dot(x.cross(y)) * x.cross(y).dot(sz) <= 0.0 {
             return None;
         }
         // Rows: the face's axes in the file; applied to a point, its upright coordinates.
@@ -107,6 +121,11 @@ mod tests {
             .map(|(i, p)| (i, Vec3::new(-p.x, p.y, p.z)))
             .collect();
         assert_eq!(set(&mirrored).upright_turn(), None);
+        // An upright face with its lower lip bound to the back of the head: not turned.
+        let mut broken = upright();
+        broken[3].1 = Vec3::new(0.0, -4.0, -12.0);
+        broken.push(("2.1", Vec3::new(0.0, -9.0, 0.8)));
+        assert_eq!(set(&broken).upright_turn(), None);
         // Without pupils: nothing to go by.
         assert_eq!(set(&upright()[2..]).upright_turn(), None);
     }
