@@ -28,6 +28,7 @@ use support::avatar::{
     self, same_fat_head_on_node, Options, VroidEyes, LEFT_EYE_JOINT, LEFT_EYE_MESH_NODE,
     LEFT_EYE_NODE, RIGHT_EYE_JOINT, RIGHT_EYE_MESH_NODE, RIGHT_EYE_NODE,
 };
+use support::glb::floats;
 
 const JAW_NODE: usize = 4;
 const HEAD_NODE: usize = 3;
@@ -88,24 +89,6 @@ fn glb_parts(p: &Path) -> (Value, Vec<u8>) {
     let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
     let json = serde_json::from_slice(chunks.json).unwrap();
     (json, chunks.bin.unwrap_or_default().to_vec())
-}
-
-/// The float values of accessor `a` (tightly packed, no sparse).
-fn floats(json: &Value, bin: &[u8], a: usize) -> Vec<f32> {
-    let acc = &json["accessors"][a];
-    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-    let per = match acc["type"].as_str().unwrap() {
-        "SCALAR" => 1,
-        "VEC3" => 3,
-        "VEC4" => 4,
-        t => panic!("{t}"),
-    };
-    let n = acc["count"].as_u64().unwrap() as usize * per;
-    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
-        + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
-    (0..n)
-        .map(|i| f32::from_le_bytes(bin[start + 4 * i..start + 4 * i + 4].try_into().unwrap()))
-        .collect()
 }
 
 /// A stream of FAPs 23–26 only: per frame (yaw_l, yaw_r, pitch_l, pitch_r).
@@ -422,13 +405,7 @@ fn head_rotations_are_recorded_on_the_head_node_and_read_back() {
         played.as_os_str(),
     ]);
     let (pj, bin) = glb_parts(&played);
-    let play = pj["animations"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["name"] == "play")
-        .unwrap()
-        .clone();
+    let play = support::glb::play_animation(&pj);
     let channel = |path: &str| {
         play["channels"]
             .as_array()
@@ -515,13 +492,7 @@ fn check_eyes_round_trip_and_play(
         played.as_os_str(),
     ]);
     let (pj, bin) = glb_parts(&played);
-    let play = pj["animations"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["name"] == "play")
-        .unwrap()
-        .clone();
+    let play = support::glb::play_animation(&pj);
     let channel = |node: usize, path: &str| {
         play["channels"]
             .as_array()
@@ -1042,13 +1013,7 @@ fn check_eye_joints_turn(opts: &Options, eye_meshes: &[&str]) {
     let (pj, bin) = glb_parts(&played);
     let names = all_target_names(&pj);
     assert!(!TURNS.iter().any(|t| names.contains(t)), "{names}");
-    let play = pj["animations"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["name"] == "play")
-        .unwrap()
-        .clone();
+    let play = support::glb::play_animation(&pj);
     let channel = |node: usize, path: &str| {
         play["channels"]
             .as_array()

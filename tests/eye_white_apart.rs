@@ -36,6 +36,7 @@ use support::avatar::{
     self, IrisNodes, Options, VroidEyes, EYE_WHITE_RADIUS, LEFT_EYE_JOINT, LEFT_EYE_NODE,
     RIGHT_EYE_JOINT, RIGHT_EYE_NODE,
 };
+use support::glb::floats;
 
 fn key(fap: u8) -> TableKey {
     TableKey::LowLevel(FapId::new(fap).unwrap())
@@ -112,24 +113,6 @@ fn glb_parts(p: &Path) -> (Value, Vec<u8>) {
     let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
     let json = serde_json::from_slice(chunks.json).unwrap();
     (json, chunks.bin.unwrap_or_default().to_vec())
-}
-
-/// The float values of accessor `a` (tightly packed, no sparse).
-fn floats(json: &Value, bin: &[u8], a: usize) -> Vec<f32> {
-    let acc = &json["accessors"][a];
-    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-    let per = match acc["type"].as_str().unwrap() {
-        "SCALAR" => 1,
-        "VEC3" => 3,
-        "VEC4" => 4,
-        t => panic!("{t}"),
-    };
-    let n = acc["count"].as_u64().unwrap() as usize * per;
-    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
-        + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
-    (0..n)
-        .map(|i| f32::from_le_bytes(bin[start + 4 * i..start + 4 * i + 4].try_into().unwrap()))
-        .collect()
 }
 
 /// World matrix of node `n` at rest, or with a local rotation (and translation) override.
@@ -479,13 +462,7 @@ fn check_play(
         .unwrap();
     assert!(o.status.success(), "{}", support::cli::text(&o.stderr));
     let (pj, bin) = glb_parts(&played);
-    let play = pj["animations"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["name"] == "play")
-        .unwrap()
-        .clone();
+    let play = support::glb::play_animation(&pj);
     let channel = |node: usize, path: &str| {
         play["channels"]
             .as_array()

@@ -623,13 +623,7 @@ fn eye_joints_turn_iris_and_eye_white_when_the_pupil_is_on_the_iris() {
         .unwrap();
     assert!(o.status.success(), "{}", support::cli::text(&o.stderr));
     let pj = glb_json(&played);
-    let play = pj["animations"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["name"] == "play")
-        .unwrap()
-        .clone();
+    let play = support::glb::play_animation(&pj);
     for node in [LEFT_EYE_JOINT, RIGHT_EYE_JOINT] {
         assert!(
             play["channels"]

@@ -10,7 +10,8 @@ use std::path::Path;
 
 use serde_json::{json, Value};
 use support::avatar;
-use support::cli::{command, text};
+use support::cli::{clone_alma_to, command, play_to, text};
+use support::glb::floats;
 
 /// The JSON of a `.glb` / `.vrm` file.
 fn json_of(path: &Path) -> Value {
@@ -54,16 +55,7 @@ fn a_vrm_avatar_comes_back_as_vrm_with_its_expressions() {
     let alma = fbakit::face::read("alma").unwrap();
     let fp = avatar::fp_csv(&alma, d, "");
     let cloned = d.join("cloned.vrm");
-    let o = run(&[
-        "clone".as_ref(),
-        "alma".as_ref(),
-        input.as_os_str(),
-        "--fp-target".as_ref(),
-        fp.as_os_str(),
-        "-o".as_ref(),
-        cloned.as_os_str(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    clone_alma_to(&input, &fp, &cloned);
     let out = json_of(&cloned);
     assert_eq!(
         out["extensions"]["VRMC_vrm"],
@@ -89,14 +81,7 @@ fn a_vrm_avatar_comes_back_as_vrm_with_its_expressions() {
     // Played and exported with ARKit names, it stays a VRM avatar.
     let played = d.join("played.vrm");
     let speech = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/speech.fap");
-    let o = run(&[
-        "play".as_ref(),
-        cloned.as_os_str(),
-        speech.as_os_str(),
-        "-o".as_ref(),
-        played.as_os_str(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    play_to(&cloned, &speech, &played);
     let p = json_of(&played);
     assert_eq!(p["extensions"]["VRMC_vrm"], json["extensions"]["VRMC_vrm"]);
     assert!(!p["animations"].as_array().unwrap().is_empty());
@@ -161,26 +146,6 @@ fn what_is_no_vrm_avatar_is_not_written_as_vrm() {
     }
 }
 
-/// The values of float accessor `i` (dense, tightly packed, as fbakit writes its animation).
-fn floats(json: &Value, bin: &[u8], i: usize) -> Vec<f64> {
-    let a = &json["accessors"][i];
-    assert_eq!(a["componentType"], 5126);
-    let view = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
-    let start =
-        (view["byteOffset"].as_u64().unwrap_or(0) + a["byteOffset"].as_u64().unwrap_or(0)) as usize;
-    let per = match a["type"].as_str().unwrap() {
-        "SCALAR" => 1,
-        "VEC3" => 3,
-        "VEC4" => 4,
-        t => panic!("{t}"),
-    };
-    let n = a["count"].as_u64().unwrap() as usize * per;
-    bin[start..start + 4 * n]
-        .chunks_exact(4)
-        .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
-        .collect()
-}
-
 /// A VRM 0.x avatar faces −z in its file. The test avatar turned round so (its root turned
 /// half a turn about y, its feature points with it) clones and plays as the avatar facing
 /// +z: the same morph weights, and the same turns of its `Head` and `Jaw` joints in their
@@ -208,36 +173,11 @@ fn an_avatar_facing_back_plays_as_the_one_facing_front() {
         let input = d.join(format!("{name}.glb"));
         std::fs::write(&input, a.to_glb()).unwrap();
         let cloned = d.join(format!("{name}-cloned.glb"));
-        let o = run(&[
-            "clone".as_ref(),
-            "alma".as_ref(),
-            input.as_os_str(),
-            "--fp-target".as_ref(),
-            fp.as_os_str(),
-            "-o".as_ref(),
-            cloned.as_os_str(),
-        ]);
-        assert!(o.status.success(), "{}", text(&o.stderr));
+        clone_alma_to(&input, fp, &cloned);
         let out = d.join(format!("{name}-played.glb"));
-        let o = run(&[
-            "play".as_ref(),
-            cloned.as_os_str(),
-            speech.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]);
-        assert!(o.status.success(), "{}", text(&o.stderr));
-        let bytes = std::fs::read(&out).unwrap();
-        let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
-        let bin = chunks.bin.unwrap_or_default().to_vec();
-        let json: Value = serde_json::from_slice(chunks.json).unwrap();
-        let play = json["animations"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|a| a["name"] == "play")
-            .unwrap()
-            .clone();
+        play_to(&cloned, &speech, &out);
+        let (json, bin) = support::glb::open(&out);
+        let play = support::glb::play_animation(&json);
         // (node, path) → sampler output values.
         let mut channels: Vec<((u64, String), Vec<f64>)> = play["channels"]
             .as_array()
@@ -245,7 +185,10 @@ fn an_avatar_facing_back_plays_as_the_one_facing_front() {
             .iter()
             .map(|c| {
                 let s = &play["samplers"][c["sampler"].as_u64().unwrap() as usize];
-                let values = floats(&json, &bin, s["output"].as_u64().unwrap() as usize);
+                let values: Vec<f64> = floats(&json, &bin, s["output"].as_u64().unwrap() as usize)
+                    .into_iter()
+                    .map(f64::from)
+                    .collect();
                 (
                     (
                         c["target"]["node"].as_u64().unwrap(),

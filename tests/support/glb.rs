@@ -1,5 +1,6 @@
 //! The binary glTF container: a JSON chunk and a BIN chunk behind a 12-byte header (glTF 2.0
 //! §4.4), for tests that build their own `.glb` assets.
+#![allow(dead_code)]
 
 /// `json` and `bin` as `.glb` bytes: the JSON padded with spaces and the buffer with zeros
 /// to 4 bytes, as the container requires; `buffers[0].byteLength` is set to the buffer's.
@@ -79,4 +80,45 @@ impl Buffer {
         json!({"attributes": {"POSITION": self.accessors.len() - 2},
             "indices": self.accessors.len() - 1})
     }
+}
+
+/// A `.glb` file's JSON and its BIN chunk (empty when it has none).
+pub fn open(path: &std::path::Path) -> (serde_json::Value, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    let chunks = fbakit::gltf::parse_glb(&bytes).unwrap();
+    let json = serde_json::from_slice(chunks.json).unwrap();
+    (json, chunks.bin.unwrap_or_default().to_vec())
+}
+
+/// The values of float accessor `a` (tightly packed in its view, no sparse), as fbakit and
+/// the test avatars write animation samplers and morph targets.
+pub fn floats(json: &serde_json::Value, bin: &[u8], a: usize) -> Vec<f32> {
+    let acc = &json["accessors"][a];
+    assert_eq!(acc["componentType"], 5126, "accessor {a} is not float");
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let per = match acc["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC2" => 2,
+        "VEC3" => 3,
+        "VEC4" => 4,
+        t => panic!("{t}"),
+    };
+    let n = acc["count"].as_u64().unwrap() as usize * per;
+    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+        + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
+    bin[start..start + 4 * n]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+/// The animation `play` added to a document (named `play`).
+pub fn play_animation(json: &serde_json::Value) -> serde_json::Value {
+    json["animations"]
+        .as_array()
+        .expect("animations")
+        .iter()
+        .find(|a| a["name"] == "play")
+        .expect("an animation named play")
+        .clone()
 }
