@@ -34,7 +34,8 @@ use super::gltf::FaceMorphs;
 use super::gltf_carried::carries_point;
 use super::gltf_eye_parts::{eye_parts, EyePart};
 use super::gltf_rotations::{
-    head_node, jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes, HEAD_FAPS,
+    face_axes, head_node, jaw_node, rotated_nodes, same_hemisphere, JawNode, RotationNodes,
+    HEAD_FAPS,
 };
 use super::gltf_user_nodes::{eye_transforms, world_delta, UserNode};
 use crate::error::{Diagnostic, Result};
@@ -682,10 +683,7 @@ fn head_turns_on_node(
             continue;
         };
         // About the face's own axis (turned from the file's for a face modelled facing −z).
-        let axis = face
-            .feature_points
-            .upright_turn()
-            .map_or(axis, |t| (t.transpose() * axis).normalize());
+        let axis = (face_axes(face) * axis).normalize();
         table.meshes.clear();
         // One AU (1e-5 rad) per FAP unit, the standard's angle.
         table

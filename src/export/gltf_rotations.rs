@@ -252,7 +252,7 @@ fn local_rotation(n: &Value) -> Quat {
 
 /// The face's own axes in its file as the columns of a matrix (face frame → file): the
 /// identity for a face modelled upright, quarter turns for one modelled turned.
-fn face_axes(face: &crate::face::FaceModel) -> Mat3 {
+pub(super) fn face_axes(face: &crate::face::FaceModel) -> Mat3 {
     face.feature_points
         .upright_turn()
         .map_or(Mat3::IDENTITY, |t| t.transpose())

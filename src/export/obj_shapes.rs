@@ -278,7 +278,7 @@ fn write_arkit_set(
     }
     let mut files = Vec::new();
     // A batch at a time on rayon's threads, as the FAT-named set.
-    for shapes in rig.shapes.chunks(2 * rayon::current_num_threads().max(1)) {
+    for shapes in rig.shapes.chunks(ObjPoses::batch_len()) {
         let mut batch = Vec::with_capacity(shapes.len());
         for shape in shapes {
             let mut positions = neutral_world.to_vec();

@@ -445,9 +445,8 @@ pub fn write_morph_set(
     let points = FeaturePointTable::from_set(&merged_feature_points(face));
     out_dir.write_file(FEATURE_POINTS_FILE, |p| write_csv_file(p, &points))?;
 
-    // Poses are evaluated one by one and written a batch at a time on rayon's threads, so the
-    // memory held is a few poses whatever the FAT's size.
-    let batch_len = 2 * rayon::current_num_threads().max(1);
+    // Poses are evaluated one by one and written a batch at a time on rayon's threads.
+    let batch_len = ObjPoses::batch_len();
     let mut batch = Vec::with_capacity(batch_len);
     let mut written = Vec::new();
     for (key, values) in morph_values(face, value) {

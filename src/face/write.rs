@@ -100,9 +100,10 @@ impl<'f> ObjPoses<'f> {
         })
     }
 
-    /// Whether the files are the user's OBJ text with only the `v` lines rewritten.
-    pub fn user_layout(&self) -> bool {
-        self.lines.is_some()
+    /// How many poses a caller gathers before [`ObjPoses::write`]: a few per thread, so the
+    /// threads stay busy and the poses held stay few whatever the FAT's size.
+    pub fn batch_len() -> usize {
+        2 * rayon::current_num_threads().max(1)
     }
 
     /// The OBJ text of one pose.

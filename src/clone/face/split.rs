@@ -232,7 +232,7 @@ pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
         .collect();
     // The cuts are found by place in the face's upright frame (a face modelled facing −z is
     // read turned round, [`super::upright`]) and, being polygon lists, applied to the face.
-    let plans = {
+    let mut plans = {
         let look = super::upright::for_recognition(face);
         let look = look.as_ref();
         let frames = look.frames();
@@ -246,7 +246,6 @@ pub(super) fn split_view(face: &FaceModel) -> Option<SplitView> {
         plans.extend(eye_layer_plans(look, &frames, diag, &planned));
         plans
     };
-    let mut plans = plans;
     plans.retain(|p| !deformed.contains(face.meshes[p.mesh].name.as_str()));
     if plans.is_empty() {
         return None;

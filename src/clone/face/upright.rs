@@ -22,18 +22,10 @@ use glam::Mat3;
 use crate::face::FaceModel;
 use crate::spec::FeaturePointId;
 
-/// The turn that stands `face` up in its file's axes: a rotation by quarter turns, as a
-/// matrix taking file coordinates into upright ones
-/// ([`crate::fdp::FeaturePointSet::upright_turn`]); `None` when the face is upright
-/// already, its pupils and mouth are not all known, or they are a mirror image.
-pub(super) fn upright_turn(face: &FaceModel) -> Option<Mat3> {
-    face.feature_points.upright_turn()
-}
-
 /// `face` itself when it stands upright in its file (or its axes are unknown), else its
 /// [`upright_copy`]: what part recognition reads.
 pub(super) fn for_recognition(face: &FaceModel) -> Cow<'_, FaceModel> {
-    match upright_turn(face) {
+    match face.feature_points.upright_turn() {
         Some(turn) => Cow::Owned(upright_copy(face, turn)),
         None => Cow::Borrowed(face),
     }
@@ -74,7 +66,7 @@ mod tests {
     fn a_face_turned_by_quarter_turns_is_read_upright() {
         let face = crate::face::read("alma").unwrap();
         // Upright (its small tilts included): read as it is.
-        assert!(upright_turn(&face).is_none());
+        assert!(face.feature_points.upright_turn().is_none());
         assert!(matches!(for_recognition(&face), Cow::Borrowed(_)));
         let half_y = Mat3::from_rotation_y(std::f32::consts::PI);
         let z_up = Mat3::from_rotation_x(std::f32::consts::FRAC_PI_2);
@@ -82,7 +74,10 @@ mod tests {
         let tilt = Mat3::from_rotation_z(0.2);
         for turned_by in [half_y, z_up, z_up * half_y, half_y * tilt] {
             let turned = upright_copy(&face, turned_by);
-            let turn = upright_turn(&turned).expect("a turned face is stood up");
+            let turn = turned
+                .feature_points
+                .upright_turn()
+                .expect("a turned face is stood up");
             let back = for_recognition(&turned);
             let Cow::Owned(back) = back else {
                 panic!("a turned face must be read upright")

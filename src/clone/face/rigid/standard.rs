@@ -158,7 +158,7 @@ pub(in crate::clone::face) fn add_standard_rotations_cut(
 /// face upright in its file (every standard rotation then turns about the file's axes as
 /// before, bit for bit).
 fn face_axes(face: &FaceModel) -> Option<(DMat3, DMat3)> {
-    let up = crate::clone::face::upright::upright_turn(face)?.as_dmat3();
+    let up = face.feature_points.upright_turn()?.as_dmat3();
     Some((up, up.transpose()))
 }
 
@@ -368,16 +368,12 @@ fn add_transform_tables(
         install_center(face, t, centre);
     }
     let frames = face.frames();
+    let axes = face_axes(face);
     for f in keys {
         let Some(axis) = f.info().rotation_axis() else {
             continue;
         };
-        let local = local_axis(
-            face,
-            &frames,
-            t,
-            file_axis(face_axes(face), axis.as_dvec3()),
-        );
+        let local = local_axis(face, &frames, t, file_axis(axes, axis.as_dvec3()));
         let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
         table
             .transforms
@@ -395,6 +391,7 @@ fn add_eye_tables(
     cut: Option<Option<(&SplitView, &FaceParts)>>,
     out: &mut StandardRotations,
 ) {
+    let axes = face_axes(face);
     let (vface, parts, map) = part_view(face, cut);
     let vframes = vface.frames();
     for (eye, left) in [(Part::LeftEye, true), (Part::RightEye, false)] {
@@ -456,7 +453,7 @@ fn add_eye_tables(
             };
             let turn = Turn {
                 centre: centre.as_dvec3(),
-                axis: file_axis(face_axes(face), axis.as_dvec3()),
+                axis: file_axis(axes, axis.as_dvec3()),
             };
             let mut table = FaceDefTable::new(TableKey::LowLevel(*f));
             for (&fi, vs) in &rows {
